@@ -1,0 +1,5 @@
+//! Asset loaders: meshes and materials from OBJ/MTL, textures from images.
+
+pub mod mesh;
+pub mod obj;
+pub mod texture;

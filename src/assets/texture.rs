@@ -1,0 +1,274 @@
+//! Decoded textures and their sampling.
+//!
+//! Texels are kept as RGBA8 (a quarter of the memory of floats, so more of a
+//! 4096² map stays in cache) and turned into linear floats per fetch: color
+//! maps through a 256-entry sRGB->linear table, data maps by /255. Filtering
+//! always happens on linear values. Texture coordinates here use the image's
+//! convention: (0,0) is the top-left corner of the first row; loaders convert
+//! (OBJ's v runs upwards, see `assets::obj`).
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use glam::{Vec2, Vec4};
+
+use crate::error::Error;
+use crate::scene::desc::AddressMode;
+
+#[derive(Debug)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major RGBA8, row 0 at the top of the image.
+    pub texels: Vec<[u8; 4]>,
+    /// Color data stored sRGB-encoded (decoded to linear on fetch).
+    pub srgb: bool,
+}
+
+/// How a material refers to a texture: the texture plus the MTL options that
+/// change its lookup.
+#[derive(Debug, Clone)]
+pub struct TextureRef {
+    pub texture: std::sync::Arc<Texture>,
+    /// `-s`: scales texture coordinates.
+    pub scale: Vec2,
+    /// `-o`: offsets texture coordinates.
+    pub offset: Vec2,
+    /// Per-texture address mode (`-clamp on`), else the scene's.
+    pub address: Option<AddressMode>,
+}
+
+/// sRGB-encoded byte -> linear float.
+pub fn srgb_to_linear_table() -> &'static [f32; 256] {
+    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = [0.0f32; 256];
+        for (i, v) in t.iter_mut().enumerate() {
+            *v = srgb_to_linear(i as f32 / 255.0);
+        }
+        t
+    })
+}
+
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Border color for `address = "border"` and NaN coordinates: transparent black.
+pub const BORDER: Vec4 = Vec4::ZERO;
+
+impl Texture {
+    /// Decodes PNG, TGA (RLE, either origin) or JPEG by content.
+    pub fn load(path: &Path, srgb: bool) -> Result<Texture, Error> {
+        let reader = image::ImageReader::open(path)
+            .map_err(|e| Error::asset(path, None, format!("cannot open texture: {e}")))?
+            .with_guessed_format()
+            .map_err(|e| Error::asset(path, None, format!("cannot read texture: {e}")))?;
+        let img = reader
+            .decode()
+            .map_err(|e| Error::asset(path, None, format!("cannot decode texture: {e}")))?;
+        let rgba = img.to_rgba8();
+        let (width, height) = rgba.dimensions();
+        if width == 0 || height == 0 {
+            return Err(Error::asset(path, None, "texture has no pixels"));
+        }
+        let texels = rgba.pixels().map(|p| p.0).collect();
+        Ok(Texture {
+            width,
+            height,
+            texels,
+            srgb,
+        })
+    }
+
+    pub fn from_rgba8(width: u32, height: u32, texels: Vec<[u8; 4]>, srgb: bool) -> Texture {
+        assert_eq!(texels.len(), (width * height) as usize);
+        Texture {
+            width,
+            height,
+            texels,
+            srgb,
+        }
+    }
+
+    #[inline]
+    fn fetch(&self, x: i64, y: i64) -> Vec4 {
+        let t = self.texels[(y as usize) * self.width as usize + x as usize];
+        if self.srgb {
+            let lut = srgb_to_linear_table();
+            Vec4::new(
+                lut[t[0] as usize],
+                lut[t[1] as usize],
+                lut[t[2] as usize],
+                t[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(t[0] as f32, t[1] as f32, t[2] as f32, t[3] as f32) * (1.0 / 255.0)
+        }
+    }
+
+    /// Nearest-texel lookup at texture coordinates `uv` (top-left origin).
+    pub fn sample_nearest(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+        if !uv.is_finite() {
+            return BORDER;
+        }
+        let x = (uv.x as f64 * self.width as f64).floor();
+        let y = (uv.y as f64 * self.height as f64).floor();
+        match (address(x, self.width, mode), address(y, self.height, mode)) {
+            (Some(x), Some(y)) => self.fetch(x, y),
+            _ => BORDER,
+        }
+    }
+
+    /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
+    pub fn sample_bilinear(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+        if !uv.is_finite() {
+            return BORDER;
+        }
+        // f64 keeps the fraction exact for coordinates far from the origin.
+        let x = uv.x as f64 * self.width as f64 - 0.5;
+        let y = uv.y as f64 * self.height as f64 - 0.5;
+        let x0 = x.floor();
+        let y0 = y.floor();
+        let fx = (x - x0) as f32;
+        let fy = (y - y0) as f32;
+        let xs = [
+            address(x0, self.width, mode),
+            address(x0 + 1.0, self.width, mode),
+        ];
+        let ys = [
+            address(y0, self.height, mode),
+            address(y0 + 1.0, self.height, mode),
+        ];
+        let get = |xi: Option<i64>, yi: Option<i64>| match (xi, yi) {
+            (Some(x), Some(y)) => self.fetch(x, y),
+            _ => BORDER,
+        };
+        let top = get(xs[0], ys[0]).lerp(get(xs[1], ys[0]), fx);
+        let bottom = get(xs[0], ys[1]).lerp(get(xs[1], ys[1]), fx);
+        top.lerp(bottom, fy)
+    }
+}
+
+/// Maps an integer texel coordinate (given as a whole f64) into the texture,
+/// or None for a border texel. Works for any finite input (no loops).
+#[inline]
+fn address(c: f64, size: u32, mode: AddressMode) -> Option<i64> {
+    let n = size as i64;
+    // Saturating conversion: huge coordinates stay huge, never wrap around.
+    let i = c as i64;
+    Some(match mode {
+        AddressMode::Repeat => i.rem_euclid(n),
+        AddressMode::Mirror => {
+            let m = i.rem_euclid(2 * n);
+            if m >= n { 2 * n - 1 - m } else { m }
+        }
+        AddressMode::Clamp => i.clamp(0, n - 1),
+        AddressMode::Border => {
+            if i < 0 || i >= n {
+                return None;
+            }
+            i
+        }
+    })
+}
+
+impl TextureRef {
+    pub fn new(texture: std::sync::Arc<Texture>) -> TextureRef {
+        TextureRef {
+            texture,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+            address: None,
+        }
+    }
+
+    #[inline]
+    pub fn sample(&self, uv: Vec2, default_mode: AddressMode, nearest: bool) -> Vec4 {
+        let uv = uv * self.scale + self.offset;
+        let mode = self.address.unwrap_or(default_mode);
+        if nearest {
+            self.texture.sample_nearest(uv, mode)
+        } else {
+            self.texture.sample_bilinear(uv, mode)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn checker() -> Texture {
+        // 2x2: white, black / black, white (linear data)
+        Texture::from_rgba8(
+            2,
+            2,
+            vec![[255; 4], [0, 0, 0, 255], [0, 0, 0, 255], [255; 4]],
+            false,
+        )
+    }
+
+    #[test]
+    fn srgb_tables_round_trip() {
+        let lut = srgb_to_linear_table();
+        assert_eq!(lut[0], 0.0);
+        assert!((lut[255] - 1.0).abs() < 1e-6);
+        assert!((lut[188] - 0.5029).abs() < 1e-3);
+        for i in 0..=255u8 {
+            let back = (linear_to_srgb(lut[i as usize]) * 255.0).round() as u8;
+            assert_eq!(back, i);
+        }
+    }
+
+    #[test]
+    fn bilinear_hits_texel_centers_and_blends_between() {
+        let t = checker();
+        let c = t.sample_bilinear(Vec2::new(0.25, 0.25), AddressMode::Repeat);
+        assert!((c.x - 1.0).abs() < 1e-6);
+        let mid = t.sample_bilinear(Vec2::new(0.5, 0.25), AddressMode::Clamp);
+        assert!((mid.x - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn address_modes_handle_any_finite_coordinate() {
+        let t = checker();
+        for mode in [
+            AddressMode::Repeat,
+            AddressMode::Mirror,
+            AddressMode::Clamp,
+            AddressMode::Border,
+        ] {
+            for u in [1e9f32, -1e9, 3.75, -0.25, f32::MAX, f32::MIN, 1e30] {
+                let c = t.sample_bilinear(Vec2::new(u, 0.3), mode);
+                assert!(c.is_finite(), "{mode:?} {u}");
+                let c = t.sample_nearest(Vec2::new(u, u), mode);
+                assert!(c.is_finite(), "{mode:?} {u}");
+            }
+            assert_eq!(t.sample_bilinear(Vec2::new(f32::NAN, 0.5), mode), BORDER);
+            assert_eq!(
+                t.sample_nearest(Vec2::new(0.5, f32::INFINITY), mode),
+                BORDER
+            );
+        }
+        // repeat wraps, mirror reflects, clamp holds the edge, border is black
+        assert_eq!(address(2.0, 2, AddressMode::Repeat), Some(0));
+        assert_eq!(address(-1.0, 2, AddressMode::Repeat), Some(1));
+        assert_eq!(address(2.0, 2, AddressMode::Mirror), Some(1));
+        assert_eq!(address(-1.0, 2, AddressMode::Mirror), Some(0));
+        assert_eq!(address(5.0, 2, AddressMode::Clamp), Some(1));
+        assert_eq!(address(2.0, 2, AddressMode::Border), None);
+    }
+}

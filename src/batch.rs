@@ -1,0 +1,111 @@
+//! A render job: every requested frame of every requested camera, rendered
+//! in order and written by a writer thread, so PNG encoding of frame N
+//! overlaps the rendering of frame N+1.
+
+use std::ops::Range;
+use std::path::PathBuf;
+use std::sync::mpsc;
+use std::time::Instant;
+
+use crate::error::Error;
+use crate::output::{self, Image8};
+use crate::render::render_frame;
+use crate::scene::Scene;
+
+pub struct RenderJob {
+    pub scene: Scene,
+    /// Half-open frame range.
+    pub frames: Range<u32>,
+    /// Indices into `scene.cameras`.
+    pub cameras: Vec<usize>,
+}
+
+/// Reported once per finished (written) frame and camera.
+#[derive(Debug, Clone)]
+pub struct FrameDone {
+    pub frame: u32,
+    pub camera: String,
+    pub files: Vec<PathBuf>,
+    /// Render time (without writing).
+    pub render_seconds: f64,
+}
+
+impl RenderJob {
+    pub fn total(&self) -> usize {
+        self.frames.len() * self.cameras.len()
+    }
+
+    /// Renders and writes everything; calls `on_done` as frames land.
+    pub fn run(&self, mut on_done: impl FnMut(&FrameDone)) -> Result<(), Error> {
+        let scene = &self.scene;
+        let (to_writer, writer_rx) = mpsc::sync_channel::<(FrameDone, Option<Image8>)>(2);
+        let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
+        let writer = std::thread::spawn(move || {
+            for (done, img) in writer_rx {
+                let r = match (&img, done.files.first()) {
+                    (Some(img), Some(path)) => output::png::write(path, img).map(|_| done),
+                    _ => Ok(done),
+                };
+                let failed = r.is_err();
+                if done_tx.send(r).is_err() || failed {
+                    break;
+                }
+            }
+        });
+        let mut result = Ok(());
+        let drain = |block: bool, on_done: &mut dyn FnMut(&FrameDone)| -> Result<(), Error> {
+            loop {
+                let msg = if block {
+                    done_rx.recv().ok()
+                } else {
+                    done_rx.try_recv().ok()
+                };
+                match msg {
+                    Some(Ok(d)) => on_done(&d),
+                    Some(Err(e)) => return Err(e),
+                    None => return Ok(()),
+                }
+            }
+        };
+        'frames: for frame in self.frames.clone() {
+            for &cam in &self.cameras {
+                let name = &scene.cameras[cam].name;
+                let t0 = Instant::now();
+                let f = render_frame(scene, cam, frame);
+                let img = scene
+                    .output
+                    .color
+                    .then(|| output::resolve(&f, &scene.settings));
+                let render_seconds = t0.elapsed().as_secs_f64();
+                let mut files = Vec::new();
+                if img.is_some() {
+                    files.push(
+                        scene
+                            .output
+                            .dir
+                            .join(format!("{}.png", scene.file_stem(name, frame))),
+                    );
+                }
+                let done = FrameDone {
+                    frame,
+                    camera: name.clone(),
+                    files,
+                    render_seconds,
+                };
+                if to_writer.send((done, img)).is_err() {
+                    break 'frames;
+                }
+                if let Err(e) = drain(false, &mut on_done) {
+                    result = Err(e);
+                    break 'frames;
+                }
+            }
+        }
+        drop(to_writer);
+        if result.is_ok() {
+            result = drain(true, &mut on_done);
+        }
+        let _ = writer.join();
+        result
+    }
+}

@@ -1,0 +1,193 @@
+//! `softraster bench`: the reference turntables, set up like the llvmpipe
+//! anchor in `../shared/bench/llvmpipe/turntable.py` (same camera framing,
+//! lights, ambient, background, material constants, 5-degree steps), so the
+//! two can be run side by side and compared as a ratio.
+//!
+//! Per-frame time = render + resolve to sRGB bytes (llvmpipe's figure ends
+//! with glReadPixels of an sRGB8 framebuffer); PNG encoding is timed apart.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::Vec3;
+
+use crate::error::Error;
+use crate::output;
+use crate::render::render_frame;
+use crate::scene::Scene;
+use crate::scene::build::LoadOptions;
+use crate::scene::light::{Light, LightKind};
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// The shared model directory.
+    #[arg(long, default_value = "../shared/assets")]
+    pub assets: PathBuf,
+    /// Which workloads: diablo3, nefertiti, or all.
+    #[arg(long, default_value = "all")]
+    pub case: String,
+    #[arg(long, default_value_t = 72)]
+    pub frames: u32,
+    #[arg(long, default_value_t = 700)]
+    pub size: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Also write the frames as PNG here (to look at them).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone)]
+pub struct BenchResult {
+    pub name: String,
+    pub triangles: usize,
+    pub load_ms: f64,
+    /// Median of frames 1..n (frame 0 warms caches).
+    pub steady_ms: f64,
+    pub min_ms: f64,
+    pub total_ms: f64,
+    pub png_ms: f64,
+}
+
+fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<String, Error> {
+    let d3 = assets.join("tinyrenderer/diablo3_pose");
+    let p = |p: PathBuf| -> Result<String, Error> {
+        if !p.is_file() {
+            return Err(Error::asset(
+                &p,
+                None,
+                "benchmark model not found (pass --assets)",
+            ));
+        }
+        Ok(p.display().to_string().replace('\\', "/"))
+    };
+    let common = format!(
+        "[output]\nwidth = {size}\nheight = {size}\nbackground = [0.02, 0.02, 0.025]\n\
+         [render]\ntexture_filter = \"bilinear\"\n[ambient]\ncolor = [0.06, 0.06, 0.07]\n\
+         [animation]\nframes = {frames}\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = {} }}\n",
+        5.0 * frames as f32
+    );
+    Ok(match case {
+        "diablo3" => format!(
+            "{common}[[model]]\npath = \"{}\"\n[model.material]\nkd = [1.0, 1.0, 1.0]\nks = [0.5, 0.5, 0.5]\nns = 32.0\n\
+             map_kd = \"{}\"\nmap_ks = \"{}\"\nmap_ke = \"{}\"\nke = [1.0, 1.0, 1.0]\n",
+            p(d3.join("diablo3_pose.obj"))?,
+            p(d3.join("diablo3_pose_diffuse.tga"))?,
+            p(d3.join("diablo3_pose_spec.tga"))?,
+            p(d3.join("diablo3_pose_glow.tga"))?,
+        ),
+        "nefertiti" => format!(
+            "{common}[[model]]\npath = \"{}\"\nrotate = [-90.0, 0.0, 0.0]\n[model.material]\n\
+             kd = [0.8, 0.8, 0.8]\nks = [0.5, 0.5, 0.5]\nns = 32.0\n",
+            p(assets.join("common/nefertiti.obj"))?
+        ),
+        other => {
+            return Err(Error::Argument(format!(
+                "bench --case {other}: expected diablo3, nefertiti or all"
+            )));
+        }
+    })
+}
+
+/// The llvmpipe harness's two lights, placed relative to the model's
+/// bounding sphere.
+fn anchor_lights(scene: &Scene) -> Vec<Light> {
+    let r = scene.bounds_radius;
+    let dir_l = Vec3::new(-0.5, 0.75, 0.45).normalize();
+    let pt = Vec3::new(1.2, 0.6, 1.6) * r;
+    let e = 0.6 * pt.length_squared();
+    vec![
+        Light {
+            kind: LightKind::Directional {
+                direction: -dir_l,
+                irradiance: 1.0,
+            },
+            color: Vec3::new(0.9, 0.88, 0.85),
+            shadows: false,
+        },
+        Light {
+            kind: LightKind::Point {
+                position: scene.bounds_center + pt,
+                intensity: e,
+            },
+            color: Vec3::new(1.0, 0.95, 0.9),
+            shadows: false,
+        },
+    ]
+}
+
+pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
+    let text = scene_text(case, &args.assets, args.size, args.frames)?;
+    let t0 = Instant::now();
+    let mut scene = Scene::from_text(
+        Path::new(&format!("bench-{case}.toml")),
+        &text,
+        &LoadOptions::default(),
+    )?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    scene.lights = anchor_lights(&scene);
+    let mut times = Vec::new();
+    let mut png_ms = 0.0;
+    for f in 0..args.frames {
+        let t = Instant::now();
+        let frame = render_frame(&scene, 0, f);
+        let img = output::resolve(&frame, &scene.settings);
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        let dir = args.out.clone().unwrap_or_else(std::env::temp_dir);
+        let path = dir.join(format!("softraster-bench-{case}-{f:04}.png"));
+        output::png::write(&path, &img)?;
+        if args.out.is_none() {
+            let _ = std::fs::remove_file(&path);
+        }
+        png_ms += t.elapsed().as_secs_f64() * 1e3;
+    }
+    let mut steady: Vec<f64> = times.iter().skip(1).copied().collect();
+    if steady.is_empty() {
+        steady = times.clone();
+    }
+    steady.sort_by(f64::total_cmp);
+    Ok(BenchResult {
+        name: case.to_string(),
+        triangles: scene.triangle_count(),
+        load_ms,
+        steady_ms: steady[steady.len() / 2],
+        min_ms: steady[0],
+        total_ms: times.iter().sum(),
+        png_ms: png_ms / args.frames as f64,
+    })
+}
+
+pub fn run(args: &BenchArgs) -> Result<(), Error> {
+    let cases: Vec<&str> = match args.case.as_str() {
+        "all" => vec!["diablo3", "nefertiti"],
+        c => vec![c],
+    };
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        builder = builder.num_threads(n.max(1));
+    }
+    let pool = builder
+        .build()
+        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))?;
+    println!(
+        "softraster bench: {} frames at {}x{}, {} thread(s)",
+        args.frames,
+        args.size,
+        args.size,
+        pool.current_num_threads()
+    );
+    println!(
+        "| case | triangles | load ms | steady ms/frame (median 1..n) | min ms | render total ms | png ms/frame |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for c in cases {
+        let r = pool.install(|| run_case(c, args))?;
+        println!(
+            "| {} | {} | {:.1} | {:.2} | {:.2} | {:.0} | {:.2} |",
+            r.name, r.triangles, r.load_ms, r.steady_ms, r.min_ms, r.total_ms, r.png_ms
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,136 @@
+//! The library's typed errors. Every error that comes from user input names
+//! where it was found (file, and line and column where the format has them).
+//! `exit_code` maps each kind to the CLI's exit status: 2 for a bad scene,
+//! bad asset or bad arguments (permanent: rerunning will not help), 1 for a
+//! render or I/O failure.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A place in a text file, 1-based.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    pub file: PathBuf,
+    pub line: usize,
+    pub column: usize,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.column)
+    }
+}
+
+impl Location {
+    /// The location of byte offset `offset` in `text`.
+    pub fn from_offset(file: &Path, text: &str, offset: usize) -> Location {
+        let offset = offset.min(text.len());
+        let before = &text[..offset];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map(|i| i + 1).unwrap_or(0);
+        let column = text[line_start..offset].chars().count() + 1;
+        Location {
+            file: file.to_path_buf(),
+            line,
+            column,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene file is malformed, has an unknown key, a wrong type or an
+    /// out-of-range value.
+    #[error("{location}: {message}")]
+    Scene { location: Location, message: String },
+
+    /// A scene-level problem that has no single place in the file (e.g. two
+    /// cameras with the same name when both were defaulted).
+    #[error("{file}: {message}")]
+    SceneGlobal { file: PathBuf, message: String },
+
+    /// A feature the scene format defines but this build does not implement
+    /// yet. Never silently ignored.
+    #[error("{location}: {what} is not supported yet ({note})")]
+    Unsupported {
+        location: Location,
+        what: String,
+        note: String,
+    },
+
+    /// A model, material library or texture that cannot be read or is
+    /// malformed. `line` is set when the format is text and the line is known.
+    #[error("{}{}: {message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Asset {
+        path: PathBuf,
+        line: Option<usize>,
+        message: String,
+    },
+
+    /// A command-line argument is invalid.
+    #[error("{0}")]
+    Argument(String),
+
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// Encoding an output image failed.
+    #[error("{}: {message}", path.display())]
+    Encode { path: PathBuf, message: String },
+}
+
+impl Error {
+    /// 2: the input is wrong and a rerun will fail the same way.
+    /// 1: the render or the file system failed.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Scene { .. }
+            | Error::SceneGlobal { .. }
+            | Error::Unsupported { .. }
+            | Error::Asset { .. }
+            | Error::Argument(_) => 2,
+            Error::Io { .. } | Error::Encode { .. } => 1,
+        }
+    }
+
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Error {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    pub fn asset(
+        path: impl Into<PathBuf>,
+        line: Option<usize>,
+        message: impl Into<String>,
+    ) -> Error {
+        Error::Asset {
+            path: path.into(),
+            line,
+            message: message.into(),
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_map_to_lines_and_columns() {
+        let text = "a = 1\nbb = 2\n";
+        let l = Location::from_offset(Path::new("s.toml"), text, 6 + 5);
+        assert_eq!((l.line, l.column), (2, 6));
+        let l = Location::from_offset(Path::new("s.toml"), text, 0);
+        assert_eq!((l.line, l.column), (1, 1));
+        assert_eq!(l.to_string(), "s.toml:1:1");
+    }
+}

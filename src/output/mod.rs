@@ -1,0 +1,86 @@
+//! Frame buffers to files: the resolve to display bytes, and the writers
+//! (one format per file). Every file is written to a temporary name in its
+//! directory and renamed into place, so an interrupted render never leaves a
+//! half-written frame under the final name.
+
+pub mod png;
+
+use std::io::Write;
+use std::path::Path;
+
+use crate::error::Error;
+use crate::render::Frame;
+use crate::scene::RenderSettings;
+use crate::scene::desc::{Background, ShadingMode};
+use crate::shade::tonemap::{encode_linear, encode_srgb, tonemap};
+
+/// 8-bit display image: RGB, or RGBA for a transparent background.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Image8 {
+    pub width: u32,
+    pub height: u32,
+    pub channels: u8,
+    pub data: Vec<u8>,
+}
+
+/// Exposure, tone map and sRGB encoding (the data views are written as
+/// their values, without a transfer curve).
+pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
+    let alpha = s.background == Background::Transparent;
+    let channels = if alpha { 4 } else { 3 };
+    let data_view = matches!(
+        s.shading,
+        ShadingMode::Normals | ShadingMode::Depth | ShadingMode::Wireframe
+    );
+    let scale = s.exposure.exp2();
+    let mut data = vec![0u8; frame.color.len() * channels];
+    use rayon::prelude::*;
+    data.par_chunks_mut(channels * frame.width as usize)
+        .zip(frame.color.par_chunks(frame.width as usize))
+        .for_each(|(out, row)| {
+            for (o, c) in out.chunks_exact_mut(channels).zip(row) {
+                let rgb = if data_view {
+                    [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+                } else {
+                    let t = tonemap(c.truncate(), s.tonemap, scale);
+                    [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
+                };
+                o[..3].copy_from_slice(&rgb);
+                if alpha {
+                    o[3] = encode_linear(c.w);
+                }
+            }
+        });
+    Image8 {
+        width: frame.width,
+        height: frame.height,
+        channels: channels as u8,
+        data,
+    }
+}
+
+/// Writes `bytes` produced by `write` to `path` atomically.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<(), Error>,
+) -> Result<(), Error> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w)?;
+        w.flush().map_err(|e| Error::io(&tmp, e))?;
+        w.get_ref().sync_data().map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,0 +1,308 @@
+//! Procedural meshes and textures: the showcase scene's assets, made by code
+//! so the repository holds no third-party model. `softraster generate-assets
+//! assets/showcase` writes them; a test checks the committed files are what
+//! this code produces.
+
+use std::f32::consts::{PI, TAU};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::Error;
+use crate::output::{Image8, png};
+
+/// A mesh as OBJ text: positions, uvs (OBJ convention, v up), normals, faces.
+pub struct ObjText {
+    pub text: String,
+}
+
+struct Builder {
+    v: Vec<[f32; 3]>,
+    vt: Vec<[f32; 2]>,
+    vn: Vec<[f32; 3]>,
+    f: Vec<[usize; 3]>,
+}
+
+impl Builder {
+    fn new() -> Builder {
+        Builder {
+            v: vec![],
+            vt: vec![],
+            vn: vec![],
+            f: vec![],
+        }
+    }
+
+    fn vertex(&mut self, p: [f32; 3], uv: [f32; 2], n: [f32; 3]) -> usize {
+        self.v.push(p);
+        self.vt.push(uv);
+        self.vn.push(n);
+        self.v.len()
+    }
+
+    /// A (rows+1) x (cols+1) vertex grid from `f(u, v)` -> (position, normal),
+    /// triangulated counter-clockwise seen from the normal side.
+    fn grid(
+        &mut self,
+        cols: usize,
+        rows: usize,
+        uv_scale: [f32; 2],
+        f: impl Fn(f32, f32) -> ([f32; 3], [f32; 3]),
+    ) {
+        let base = self.v.len();
+        for r in 0..=rows {
+            for c in 0..=cols {
+                let (u, v) = (c as f32 / cols as f32, r as f32 / rows as f32);
+                let (p, n) = f(u, v);
+                self.vertex(p, [u * uv_scale[0], v * uv_scale[1]], n);
+            }
+        }
+        let idx = |r: usize, c: usize| base + r * (cols + 1) + c + 1;
+        for r in 0..rows {
+            for c in 0..cols {
+                let (a, b, cc, d) = (idx(r, c), idx(r, c + 1), idx(r + 1, c + 1), idx(r + 1, c));
+                self.f.push([a, b, cc]);
+                self.f.push([a, cc, d]);
+            }
+        }
+    }
+
+    fn finish(self, name: &str, mtllib: &str, material: &str) -> ObjText {
+        let mut t = String::new();
+        let _ = writeln!(
+            t,
+            "# softraster procedural mesh `{name}` (generated, do not edit)"
+        );
+        let _ = writeln!(t, "mtllib {mtllib}\no {name}");
+        for p in &self.v {
+            let _ = writeln!(t, "v {:.5} {:.5} {:.5}", p[0], p[1], p[2]);
+        }
+        for uv in &self.vt {
+            let _ = writeln!(t, "vt {:.5} {:.5}", uv[0], uv[1]);
+        }
+        for n in &self.vn {
+            let _ = writeln!(t, "vn {:.5} {:.5} {:.5}", n[0], n[1], n[2]);
+        }
+        let _ = writeln!(t, "usemtl {material}");
+        for f in &self.f {
+            let _ = writeln!(t, "f {0}/{0}/{0} {1}/{1}/{1} {2}/{2}/{2}", f[0], f[1], f[2]);
+        }
+        ObjText { text: t }
+    }
+}
+
+/// UV sphere of radius `r`: u around +Y, v from the south pole up.
+pub fn sphere(r: f32, cols: usize, rows: usize) -> Builder2 {
+    let mut b = Builder::new();
+    b.grid(cols, rows, [2.0, 1.0], |u, v| {
+        let phi = u * TAU;
+        let theta = v * PI - PI / 2.0;
+        let n = [
+            theta.cos() * phi.sin(),
+            theta.sin(),
+            theta.cos() * phi.cos(),
+        ];
+        ([n[0] * r, n[1] * r, n[2] * r], n)
+    });
+    Builder2(b)
+}
+
+/// Torus around +Y with major radius `big` and tube radius `small`.
+pub fn torus(big: f32, small: f32, cols: usize, rows: usize) -> Builder2 {
+    let mut b = Builder::new();
+    b.grid(cols, rows, [8.0, 2.0], |u, v| {
+        let a = u * TAU;
+        // Tube angle runs so that faces wind counter-clockwise outward.
+        let t = v * TAU;
+        let n = [t.cos() * a.sin(), t.sin(), t.cos() * a.cos()];
+        let c = [big * a.sin(), 0.0, big * a.cos()];
+        (
+            [
+                c[0] + small * n[0],
+                c[1] + small * n[1],
+                c[2] + small * n[2],
+            ],
+            n,
+        )
+    });
+    Builder2(b)
+}
+
+/// Square in the XZ plane at height `y`, facing +Y, UVs repeating `tiles` times.
+pub fn ground(half: f32, y: f32, tiles: f32) -> Builder2 {
+    let mut b = Builder::new();
+    b.grid(1, 1, [tiles, tiles], |u, v| {
+        (
+            [(u * 2.0 - 1.0) * half, y, (1.0 - v * 2.0) * half],
+            [0.0, 1.0, 0.0],
+        )
+    });
+    Builder2(b)
+}
+
+/// An axis-aligned cube of half-size `h` centered at `c`, faces facing out.
+pub fn cube(c: [f32; 3], h: f32) -> Builder2 {
+    let mut b = Builder::new();
+    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
+        ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
+        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
+        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+    ];
+    for (n, s, t) in faces {
+        b.grid(1, 1, [1.0, 1.0], |u, v| {
+            let (a, bb) = (u * 2.0 - 1.0, v * 2.0 - 1.0);
+            let p = [
+                c[0] + h * (n[0] + a * s[0] + bb * t[0]),
+                c[1] + h * (n[1] + a * s[1] + bb * t[1]),
+                c[2] + h * (n[2] + a * s[2] + bb * t[2]),
+            ];
+            (p, n)
+        });
+    }
+    Builder2(b)
+}
+
+/// Opaque wrapper so callers cannot poke the builder's internals.
+pub struct Builder2(Builder);
+
+impl Builder2 {
+    pub fn to_obj(self, name: &str, mtllib: &str, material: &str) -> ObjText {
+        self.0.finish(name, mtllib, material)
+    }
+}
+
+/// Two-color checkerboard, `cells` cells across, sRGB bytes.
+pub fn checker(size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Image8 {
+    let mut data = Vec::with_capacity((size * size * 3) as usize);
+    let cell = size / cells;
+    for y in 0..size {
+        for x in 0..size {
+            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
+                a
+            } else {
+                b
+            };
+            data.extend_from_slice(&c);
+        }
+    }
+    Image8 {
+        width: size,
+        height: size,
+        channels: 3,
+        data,
+    }
+}
+
+/// Horizontal bands with soft edges (for the torus).
+pub fn bands(size: u32, colors: &[[u8; 3]]) -> Image8 {
+    let mut data = Vec::with_capacity((size * size * 3) as usize);
+    let n = colors.len() as u32;
+    for y in 0..size {
+        for x in 0..size {
+            let band = (x * n / size) as usize;
+            let c = colors[band];
+            // darker grooves between bands and along v, to show texture filtering
+            let groove = (x * n % size) < size / 32 || y % (size / 4) < size / 64;
+            let k = if groove { 0.35 } else { 1.0 };
+            data.extend(c.iter().map(|v| (*v as f32 * k) as u8));
+        }
+    }
+    Image8 {
+        width: size,
+        height: size,
+        channels: 3,
+        data,
+    }
+}
+
+const MTL: &str = "# softraster showcase materials (generated, do not edit)
+newmtl ground
+Kd 1.0 1.0 1.0
+Ks 0.05 0.05 0.05
+Ns 16
+illum 2
+map_Kd checker.png
+
+newmtl sphere
+Kd 0.9 0.9 0.9
+Ks 0.6 0.6 0.6
+Ns 96
+illum 2
+map_Kd -s 1 1 globe.png
+
+newmtl torus
+Kd 1.0 1.0 1.0
+Ks 0.4 0.4 0.4
+Ns 48
+illum 2
+map_Kd bands.png
+
+newmtl cube
+Kd 0.2 0.45 0.8
+Ks 0.3 0.3 0.3
+Ns 32
+Ke 0.0 0.0 0.0
+illum 2
+";
+
+/// Writes the showcase's meshes, material library and textures into `dir`.
+pub fn write_showcase_assets(dir: &Path) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let text_files = [
+        ("showcase.mtl", MTL.to_string()),
+        (
+            "ground.obj",
+            ground(4.0, 0.0, 8.0)
+                .to_obj("ground", "showcase.mtl", "ground")
+                .text,
+        ),
+        (
+            "sphere.obj",
+            sphere(0.8, 48, 24)
+                .to_obj("sphere", "showcase.mtl", "sphere")
+                .text,
+        ),
+        (
+            "torus.obj",
+            torus(0.75, 0.28, 64, 24)
+                .to_obj("torus", "showcase.mtl", "torus")
+                .text,
+        ),
+        (
+            "cube.obj",
+            cube([0.0, 0.0, 0.0], 0.45)
+                .to_obj("cube", "showcase.mtl", "cube")
+                .text,
+        ),
+    ];
+    for (name, text) in text_files {
+        let p = dir.join(name);
+        crate::output::write_atomic(&p, |w| {
+            use std::io::Write;
+            w.write_all(text.as_bytes()).map_err(|e| Error::io(&p, e))
+        })?;
+    }
+    png::write(
+        &dir.join("checker.png"),
+        &checker(256, 8, [230, 226, 214], [62, 66, 78]),
+    )?;
+    png::write(
+        &dir.join("globe.png"),
+        &checker(256, 16, [214, 92, 62], [245, 236, 200]),
+    )?;
+    png::write(
+        &dir.join("bands.png"),
+        &bands(
+            256,
+            &[
+                [60, 170, 140],
+                [240, 190, 70],
+                [200, 80, 90],
+                [90, 120, 210],
+            ],
+        ),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,91 @@
+//! Binning: which triangles touch which screen tile. Tiles are rendered
+//! independently (one thread each, owning its pixels); each tile's list keeps
+//! submission order, which makes the result independent of scheduling.
+
+use super::setup::Tri;
+
+pub const TILE: i32 = 64;
+
+#[derive(Debug, Clone, Copy)]
+pub struct TileGrid {
+    pub width: u32,
+    pub height: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileRect {
+    pub x0: i32,
+    pub y0: i32,
+    /// Exclusive.
+    pub x1: i32,
+    pub y1: i32,
+}
+
+impl TileRect {
+    pub fn width(&self) -> usize {
+        (self.x1 - self.x0) as usize
+    }
+    pub fn height(&self) -> usize {
+        (self.y1 - self.y0) as usize
+    }
+}
+
+impl TileGrid {
+    pub fn new(width: u32, height: u32) -> TileGrid {
+        TileGrid {
+            width,
+            height,
+            tiles_x: width.div_ceil(TILE as u32),
+            tiles_y: height.div_ceil(TILE as u32),
+        }
+    }
+
+    pub fn count(&self) -> usize {
+        (self.tiles_x * self.tiles_y) as usize
+    }
+
+    pub fn rect(&self, index: usize) -> TileRect {
+        let tx = (index as u32 % self.tiles_x) as i32;
+        let ty = (index as u32 / self.tiles_x) as i32;
+        TileRect {
+            x0: tx * TILE,
+            y0: ty * TILE,
+            x1: ((tx + 1) * TILE).min(self.width as i32),
+            y1: ((ty + 1) * TILE).min(self.height as i32),
+        }
+    }
+}
+
+/// Per tile, the indices (into `tris`) of the triangles that may cover one of
+/// its pixels, in order.
+pub fn bin(tris: &[Tri], grid: &TileGrid) -> Vec<Vec<u32>> {
+    let mut bins = vec![Vec::new(); grid.count()];
+    for (i, t) in tris.iter().enumerate() {
+        let (tx0, tx1) = (t.min_x / TILE, t.max_x / TILE);
+        let (ty0, ty1) = (t.min_y / TILE, t.max_y / TILE);
+        let single = tx0 == tx1 && ty0 == ty1;
+        let edges = t.edges();
+        for ty in ty0..=ty1 {
+            for tx in tx0..=tx1 {
+                let index = (ty as u32 * grid.tiles_x + tx as u32) as usize;
+                if !single && !touches(&edges, grid.rect(index)) {
+                    continue;
+                }
+                bins[index].push(i as u32);
+            }
+        }
+    }
+    bins
+}
+
+/// False when one edge function is negative at every pixel center of the
+/// tile (checked at the corner where it is largest).
+fn touches(edges: &[super::setup::Edge; 3], r: TileRect) -> bool {
+    edges.iter().all(|e| {
+        let px = if e.a > 0 { r.x1 - 1 } else { r.x0 } as i64;
+        let py = if e.b > 0 { r.y1 - 1 } else { r.y0 } as i64;
+        e.at(px, py) + e.bias >= 0
+    })
+}

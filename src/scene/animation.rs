@@ -1,0 +1,70 @@
+//! The turntable: frame i turns by i * degrees / frames about an axis through
+//! the models' bounding-box center, so the last frame is one step short of the
+//! first and the loop is seamless.
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::desc::TurntableTarget;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Turntable {
+    pub axis: Vec3,
+    pub degrees: f32,
+    pub rotate: TurntableTarget,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Animation {
+    pub frames: u32,
+    pub turntable: Option<Turntable>,
+    /// Bounding-box center of all models at rest (the turntable's pivot).
+    pub pivot: Vec3,
+}
+
+impl Animation {
+    /// The rigid turn of frame `i` about the pivot (identity without turntable).
+    pub fn turn(&self, frame: u32) -> Mat4 {
+        match &self.turntable {
+            None => Mat4::IDENTITY,
+            Some(t) => {
+                let angle = (frame as f64 * t.degrees as f64 / self.frames as f64).to_radians();
+                Mat4::from_translation(self.pivot)
+                    * Mat4::from_quat(Quat::from_axis_angle(t.axis, angle as f32))
+                    * Mat4::from_translation(-self.pivot)
+            }
+        }
+    }
+
+    pub fn rotates_models(&self) -> bool {
+        matches!(&self.turntable, Some(t) if t.rotate == TurntableTarget::Models)
+    }
+
+    pub fn rotates_camera(&self) -> bool {
+        matches!(&self.turntable, Some(t) if t.rotate == TurntableTarget::Camera)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seventy_two_frames_step_five_degrees_and_never_repeat_frame_zero() {
+        let a = Animation {
+            frames: 72,
+            turntable: Some(Turntable {
+                axis: Vec3::Y,
+                degrees: 360.0,
+                rotate: TurntableTarget::Models,
+            }),
+            pivot: Vec3::new(1.0, 0.0, 0.0),
+        };
+        let p = Vec3::new(2.0, 0.0, 0.0);
+        let q = a.turn(18).transform_point3(p);
+        // 90 degrees about +Y around (1,0,0): (2,0,0) -> (1,0,-1)
+        assert!((q - Vec3::new(1.0, 0.0, -1.0)).length() < 1e-5, "{q}");
+        let last = a.turn(71).transform_point3(p);
+        assert!((last - p).length() > 1e-3);
+        assert!(a.turn(0).abs_diff_eq(Mat4::IDENTITY, 1e-7));
+    }
+}

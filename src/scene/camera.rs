@@ -1,0 +1,154 @@
+//! Cameras: placement, projection, and the matrices named `a_from_b`.
+//!
+//! Clip space is Direct3D/Vulkan style: x and y in [-w, w], z in [0, w].
+//! Reverse-Z maps the near plane to depth 1 and the far plane to 0 (the
+//! floating-point precision then follows the perspective division), standard
+//! maps near to 0 and far to 1.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::desc::DepthMode;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Vertical field of view in degrees.
+    Perspective { fov_y: f32 },
+    /// Height of the view volume in world units.
+    Orthographic { height: f32 },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Camera {
+    pub name: String,
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub projection: Projection,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    /// The camera that frames a bounding sphere from +Z (the default camera).
+    /// Distance so that the sphere fills the vertical field of view; near and
+    /// far leave room for the sphere (and anything turning inside it).
+    pub fn framing(name: String, center: Vec3, radius: f32, fov_y: f32) -> Camera {
+        let radius = radius.max(1e-6);
+        let dist = radius / (fov_y.to_radians() * 0.5).sin();
+        let eye = center + Vec3::new(0.0, 0.0, dist);
+        let (near, far) = fitted_planes(dist, radius);
+        Camera {
+            name,
+            eye,
+            target: center,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y },
+            near,
+            far,
+        }
+    }
+
+    pub fn forward(&self) -> Vec3 {
+        (self.target - self.eye).normalize()
+    }
+
+    /// World -> camera space (right-handed, looking down -Z).
+    pub fn view_from_world(&self) -> Mat4 {
+        let f = self.forward();
+        let s = f.cross(self.up).normalize();
+        let u = s.cross(f);
+        Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
+        )
+    }
+
+    pub fn clip_from_view(&self, aspect: f32, depth: DepthMode) -> Mat4 {
+        let (n, f) = (self.near, self.far);
+        // Depth as a function of view-space z (negative in front):
+        // z_clip = a * z_view + b, w_clip = -z_view (perspective) or 1 (ortho).
+        match self.projection {
+            Projection::Perspective { fov_y } => {
+                let t = 1.0 / (fov_y.to_radians() * 0.5).tan();
+                let (a, b) = match depth {
+                    // near -> 0, far -> 1
+                    DepthMode::Standard => (f / (n - f), n * f / (n - f)),
+                    // near -> 1, far -> 0
+                    DepthMode::ReverseZ => (n / (f - n), n * f / (f - n)),
+                };
+                Mat4::from_cols(
+                    Vec4::new(t / aspect, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, t, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, a, -1.0),
+                    Vec4::new(0.0, 0.0, b, 0.0),
+                )
+            }
+            Projection::Orthographic { height } => {
+                let sy = 2.0 / height;
+                let (a, b) = match depth {
+                    DepthMode::Standard => (-1.0 / (f - n), -n / (f - n)),
+                    DepthMode::ReverseZ => (1.0 / (f - n), f / (f - n)),
+                };
+                Mat4::from_cols(
+                    Vec4::new(sy / aspect, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, sy, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, a, 0.0),
+                    Vec4::new(0.0, 0.0, b, 1.0),
+                )
+            }
+        }
+    }
+}
+
+/// Near and far planes around a bounding sphere at distance `dist` from the
+/// eye: they enclose the sphere with a margin, and the near plane never gets
+/// closer than 1/1000 of the far one (the eye may be inside the sphere).
+pub fn fitted_planes(dist: f32, radius: f32) -> (f32, f32) {
+    let far = dist + radius * 1.5;
+    let near = (dist - radius * 1.5).max(far * 1e-3);
+    (near, far)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn depth_of(cam: &Camera, mode: DepthMode, z_view: f32) -> f32 {
+        let c = cam.clip_from_view(1.0, mode) * Vec4::new(0.0, 0.0, z_view, 1.0);
+        c.z / c.w
+    }
+
+    #[test]
+    fn depth_ranges_map_near_and_far() {
+        for proj in [
+            Projection::Perspective { fov_y: 45.0 },
+            Projection::Orthographic { height: 2.0 },
+        ] {
+            let cam = Camera {
+                name: "c".into(),
+                eye: Vec3::ZERO,
+                target: -Vec3::Z,
+                up: Vec3::Y,
+                projection: proj,
+                near: 0.5,
+                far: 20.0,
+            };
+            assert!((depth_of(&cam, DepthMode::Standard, -0.5) - 0.0).abs() < 1e-6);
+            assert!((depth_of(&cam, DepthMode::Standard, -20.0) - 1.0).abs() < 1e-6);
+            assert!((depth_of(&cam, DepthMode::ReverseZ, -0.5) - 1.0).abs() < 1e-6);
+            assert!((depth_of(&cam, DepthMode::ReverseZ, -20.0) - 0.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn framing_camera_sees_the_whole_sphere() {
+        let cam = Camera::framing("c".into(), Vec3::new(1.0, 2.0, 3.0), 2.0, 45.0);
+        let d = (cam.eye - cam.target).length();
+        assert!(cam.near < d - 2.0 && cam.far > d + 2.0);
+        // The sphere's top tangent is inside the vertical field of view.
+        let angle = (2.0f32 / d).asin().to_degrees();
+        assert!(angle <= 22.5 + 1e-3);
+    }
+}

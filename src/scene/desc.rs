@@ -1,0 +1,725 @@
+//! The scene file as data: serde structs mirroring `docs/scene-format.md`
+//! one to one. Nothing here loads files or knows about rendering; every value
+//! that can be out of range keeps its span so that `validate` (and later
+//! `build`) can point at it. Unknown keys and wrong types are rejected by serde
+//! with the span of the offending key or value.
+
+use std::path::Path;
+
+use serde::Deserialize;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use toml::Spanned;
+
+use crate::error::{Error, Location};
+
+pub type S<T> = Spanned<T>;
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    #[serde(default)]
+    pub output: OutputDesc,
+    #[serde(default)]
+    pub render: RenderDesc,
+    #[serde(default)]
+    pub ambient: AmbientDesc,
+    #[serde(default, rename = "model")]
+    pub models: Vec<S<ModelDesc>>,
+    #[serde(default, rename = "light")]
+    pub lights: Vec<S<LightDesc>>,
+    #[serde(default, rename = "camera")]
+    pub cameras: Vec<S<CameraDesc>>,
+    #[serde(default)]
+    pub animation: AnimationDesc,
+}
+
+/// `[output]`. Defaults: 800x800, `out/<scene stem>`, `{camera}_{frame:04}`,
+/// color PNG on, depth/ao EXR off, no GIF, black background.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDesc {
+    pub width: Option<S<i64>>,
+    pub height: Option<S<i64>>,
+    pub dir: Option<S<String>>,
+    pub name: Option<S<String>>,
+    pub color: Option<S<bool>>,
+    pub depth: Option<S<bool>>,
+    pub ao: Option<S<bool>>,
+    pub gif: Option<S<String>>,
+    pub gif_delay_ms: Option<S<i64>>,
+    pub background: Option<S<Background>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Background {
+    Color([f32; 3]),
+    Transparent,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadingMode {
+    #[default]
+    BlinnPhong,
+    Flat,
+    Gouraud,
+    Unlit,
+    Normals,
+    Depth,
+    Wireframe,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum TextureFilter {
+    Nearest,
+    #[default]
+    Bilinear,
+    Trilinear,
+    Anisotropic,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum AddressMode {
+    #[default]
+    Repeat,
+    Mirror,
+    Clamp,
+    Border,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CullMode {
+    #[default]
+    Back,
+    Front,
+    None,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DepthMode {
+    #[default]
+    ReverseZ,
+    Standard,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowMethod {
+    Off,
+    Hard,
+    #[default]
+    Pcf,
+    Raytraced,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum AoMethod {
+    #[default]
+    Off,
+    Ssao,
+    Raytraced,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Tonemap {
+    #[default]
+    Clamp,
+    Reinhard,
+    Aces,
+}
+
+/// `[render]`. Defaults: blinn-phong, msaa 1, bilinear, anisotropy 16,
+/// repeat, back-face culling, reverse-Z, pcf (for lights that cast shadows),
+/// 2048 shadow maps, AO off, clamp tone mapping, exposure 0.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    pub shading: Option<S<ShadingMode>>,
+    pub msaa: Option<S<i64>>,
+    pub texture_filter: Option<S<TextureFilter>>,
+    pub max_anisotropy: Option<S<i64>>,
+    pub address: Option<S<AddressMode>>,
+    pub cull: Option<S<CullMode>>,
+    pub depth: Option<S<DepthMode>>,
+    pub shadows: Option<S<ShadowMethod>>,
+    pub shadow_map_size: Option<S<i64>>,
+    pub ao: Option<S<AoDesc>>,
+    pub tonemap: Option<S<Tonemap>>,
+    pub exposure: Option<S<f32>>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AoDesc {
+    pub method: Option<S<AoMethod>>,
+    pub radius: Option<S<f32>>,
+    pub samples: Option<S<i64>>,
+}
+
+/// `[ambient]`. Default color 0.03 grey.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AmbientDesc {
+    pub color: Option<S<[f32; 3]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelDesc {
+    pub name: Option<S<String>>,
+    pub path: S<String>,
+    pub translate: Option<S<[f32; 3]>>,
+    pub rotate: Option<S<[f32; 3]>>,
+    pub scale: Option<S<Scale>>,
+    pub normalize: Option<S<bool>>,
+    pub lights: Option<S<bool>>,
+    pub cameras: Option<S<bool>>,
+    pub material: Option<S<MaterialOverride>>,
+    #[serde(default)]
+    pub materials: std::collections::BTreeMap<String, S<MaterialOverride>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scale(pub [f32; 3]);
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalSpace {
+    Tangent,
+    Object,
+}
+
+/// Overrides of MTL values; keys are the MTL keys in lower case.
+#[derive(Debug, Deserialize, Default, Clone)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialOverride {
+    pub ka: Option<S<[f32; 3]>>,
+    pub kd: Option<S<[f32; 3]>>,
+    pub ks: Option<S<[f32; 3]>>,
+    pub ke: Option<S<[f32; 3]>>,
+    pub ns: Option<S<f32>>,
+    pub ni: Option<S<f32>>,
+    pub d: Option<S<f32>>,
+    pub illum: Option<S<i64>>,
+    pub map_ka: Option<S<String>>,
+    pub map_kd: Option<S<String>>,
+    pub map_ks: Option<S<String>>,
+    pub map_ke: Option<S<String>>,
+    pub map_ns: Option<S<String>>,
+    pub map_d: Option<S<String>>,
+    pub map_bump: Option<S<String>>,
+    pub norm: Option<S<String>>,
+    pub disp: Option<S<String>>,
+    pub bump_scale: Option<S<f32>>,
+    pub normal_space: Option<S<NormalSpace>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightKind {
+    #[default]
+    Point,
+    Directional,
+    Spot,
+}
+
+/// `[[light]]`. Defaults: point light at the origin, intensity 10, white,
+/// directional irradiance 1 travelling down -Y, spot cone 20/30 degrees,
+/// no shadows.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    pub kind: Option<S<LightKind>>,
+    pub position: Option<S<[f32; 3]>>,
+    pub direction: Option<S<[f32; 3]>>,
+    pub intensity: Option<S<f32>>,
+    pub irradiance: Option<S<f32>>,
+    pub color: Option<S<[f32; 3]>>,
+    pub shadows: Option<S<bool>>,
+    pub inner_angle: Option<S<f32>>,
+    pub outer_angle: Option<S<f32>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Projection {
+    #[default]
+    Perspective,
+    Orthographic,
+}
+
+/// `[[camera]]`. Defaults: framed on the bounding sphere of all models from
+/// +Z, up +Y, fov 45, near/far fitted to the bounding sphere.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub name: Option<S<String>>,
+    pub eye: Option<S<[f32; 3]>>,
+    pub target: Option<S<[f32; 3]>>,
+    pub up: Option<S<[f32; 3]>>,
+    pub fov: Option<S<f32>>,
+    pub projection: Option<S<Projection>>,
+    pub height: Option<S<f32>>,
+    pub near: Option<S<f32>>,
+    pub far: Option<S<f32>>,
+}
+
+/// `[animation]`. Default: one frame, no turntable.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationDesc {
+    pub frames: Option<S<i64>>,
+    pub turntable: Option<S<TurntableDesc>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum TurntableTarget {
+    #[default]
+    Models,
+    Camera,
+}
+
+/// Defaults: axis +Y, 360 degrees, rotate the models.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct TurntableDesc {
+    pub axis: Option<S<[f32; 3]>>,
+    pub degrees: Option<S<f32>>,
+    pub rotate: Option<S<TurntableTarget>>,
+}
+
+// ---------------------------------------------------------------------------
+// Values with two spellings.
+
+impl<'de> Deserialize<'de> for Background {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Background;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an RGB array like [0.0, 0.0, 0.0] or the string \"transparent\"")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<Background, E> {
+                if s == "transparent" {
+                    Ok(Background::Transparent)
+                } else {
+                    Err(E::invalid_value(de::Unexpected::Str(s), &self))
+                }
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Background, A::Error> {
+                Ok(Background::Color(read_vec3(seq, &self)?))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Scale;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or an array [x, y, z]")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Scale, E> {
+                Ok(Scale([v as f32; 3]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Scale, E> {
+                Ok(Scale([v as f32; 3]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Scale, E> {
+                Ok(Scale([v as f32; 3]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Scale, A::Error> {
+                Ok(Scale(read_vec3(seq, &self)?))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+fn read_vec3<'de, A: SeqAccess<'de>>(
+    mut seq: A,
+    exp: &dyn de::Expected,
+) -> Result<[f32; 3], A::Error> {
+    let mut out = [0.0f32; 3];
+    for (i, slot) in out.iter_mut().enumerate() {
+        *slot = seq
+            .next_element::<f32>()?
+            .ok_or_else(|| de::Error::invalid_length(i, exp))?;
+    }
+    if seq.next_element::<de::IgnoredAny>()?.is_some() {
+        return Err(de::Error::invalid_length(4, exp));
+    }
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------
+// Parsing and validation.
+
+impl SceneDesc {
+    /// Parses scene text. `file` is only used to name locations in errors.
+    pub fn parse(file: &Path, text: &str) -> Result<SceneDesc, Error> {
+        let desc: SceneDesc = toml::from_str(text).map_err(|e| {
+            let offset = e.span().map(|s| s.start).unwrap_or(0);
+            Error::Scene {
+                location: Location::from_offset(file, text, offset),
+                message: format!("{}{}", e.message().trim_end(), source_excerpt(text, offset)),
+            }
+        })?;
+        desc.validate(&Ctx { file, text })?;
+        Ok(desc)
+    }
+
+    fn validate(&self, c: &Ctx) -> Result<(), Error> {
+        if self.models.is_empty() {
+            return Err(Error::SceneGlobal {
+                file: c.file.to_path_buf(),
+                message: "the scene has no [[model]]: at least one with a `path` is required"
+                    .into(),
+            });
+        }
+        let o = &self.output;
+        c.int_range(&o.width, "output.width", 1, 16384)?;
+        c.int_range(&o.height, "output.height", 1, 16384)?;
+        c.int_range(&o.gif_delay_ms, "output.gif_delay_ms", 10, 655_350)?;
+        if let Some(bg) = &o.background
+            && let Background::Color(col) = bg.get_ref()
+        {
+            c.color(bg.span(), col, "output.background")?;
+        }
+        if let Some(n) = &o.name
+            && n.get_ref().trim().is_empty()
+        {
+            return Err(c.err(n.span(), "output.name must not be empty"));
+        }
+        let r = &self.render;
+        if let Some(m) = &r.msaa
+            && ![1, 2, 4, 8, 16].contains(m.get_ref())
+        {
+            return Err(c.err(
+                m.span(),
+                format!(
+                    "render.msaa = {}: expected one of 1, 2, 4, 8, 16",
+                    m.get_ref()
+                ),
+            ));
+        }
+        c.int_range(&r.max_anisotropy, "render.max_anisotropy", 1, 16)?;
+        c.int_range(&r.shadow_map_size, "render.shadow_map_size", 16, 16384)?;
+        c.float_range(&r.exposure, "render.exposure", -64.0, 64.0)?;
+        if let Some(ao) = &r.ao {
+            let ao = ao.get_ref();
+            c.float_range(&ao.radius, "render.ao.radius", f32::MIN_POSITIVE, 1e9)?;
+            c.int_range(&ao.samples, "render.ao.samples", 1, 4096)?;
+        }
+        if let Some(a) = &self.ambient.color {
+            c.color(a.span(), a.get_ref(), "ambient.color")?;
+        }
+        for m in &self.models {
+            validate_model(c, m.get_ref())?;
+        }
+        for l in &self.lights {
+            validate_light(c, l.get_ref())?;
+        }
+        for cam in &self.cameras {
+            validate_camera(c, cam.get_ref())?;
+        }
+        let a = &self.animation;
+        c.int_range(&a.frames, "animation.frames", 1, 1_000_000)?;
+        if let Some(t) = &a.turntable {
+            let t = t.get_ref();
+            c.finite(&t.degrees, "animation.turntable.degrees")?;
+            c.direction(&t.axis, "animation.turntable.axis")?;
+        }
+        Ok(())
+    }
+}
+
+fn validate_model(c: &Ctx, m: &ModelDesc) -> Result<(), Error> {
+    if m.path.get_ref().trim().is_empty() {
+        return Err(c.err(m.path.span(), "model.path must not be empty"));
+    }
+    c.vec3(&m.translate, "model.translate")?;
+    c.vec3(&m.rotate, "model.rotate")?;
+    if let Some(s) = &m.scale
+        && s.get_ref().0.iter().any(|v| !v.is_finite() || *v == 0.0)
+    {
+        return Err(c.err(
+            s.span(),
+            "model.scale must be finite and non-zero (a number or [x, y, z])",
+        ));
+    }
+    if let Some(o) = &m.material {
+        validate_override(c, o.get_ref())?;
+    }
+    for o in m.materials.values() {
+        validate_override(c, o.get_ref())?;
+    }
+    Ok(())
+}
+
+fn validate_override(c: &Ctx, o: &MaterialOverride) -> Result<(), Error> {
+    for (v, key) in [(&o.ka, "ka"), (&o.kd, "kd"), (&o.ks, "ks"), (&o.ke, "ke")] {
+        if let Some(v) = v {
+            c.color(v.span(), v.get_ref(), key)?;
+        }
+    }
+    c.float_range(&o.ns, "ns", 0.0, 1e6)?;
+    c.float_range(&o.ni, "ni", 0.0, 100.0)?;
+    c.float_range(&o.d, "d", 0.0, 1.0)?;
+    c.int_range(&o.illum, "illum", 0, 10)?;
+    c.finite(&o.bump_scale, "bump_scale")?;
+    Ok(())
+}
+
+fn validate_light(c: &Ctx, l: &LightDesc) -> Result<(), Error> {
+    c.vec3(&l.position, "light.position")?;
+    c.direction(&l.direction, "light.direction")?;
+    c.float_range(&l.intensity, "light.intensity", 0.0, 1e30)?;
+    c.float_range(&l.irradiance, "light.irradiance", 0.0, 1e30)?;
+    if let Some(col) = &l.color {
+        c.color(col.span(), col.get_ref(), "light.color")?;
+    }
+    c.float_range(&l.inner_angle, "light.inner_angle", 0.0, 90.0)?;
+    c.float_range(&l.outer_angle, "light.outer_angle", 0.0, 90.0)?;
+    let inner = l.inner_angle.as_ref().map(|v| *v.get_ref()).unwrap_or(20.0);
+    let outer = l.outer_angle.as_ref().map(|v| *v.get_ref()).unwrap_or(30.0);
+    if inner > outer {
+        let span = l
+            .inner_angle
+            .as_ref()
+            .or(l.outer_angle.as_ref())
+            .map(|s| s.span())
+            .unwrap_or(0..0);
+        return Err(c.err(
+            span,
+            format!("light.inner_angle ({inner}) must not exceed light.outer_angle ({outer})"),
+        ));
+    }
+    Ok(())
+}
+
+fn validate_camera(c: &Ctx, cam: &CameraDesc) -> Result<(), Error> {
+    c.vec3(&cam.eye, "camera.eye")?;
+    c.vec3(&cam.target, "camera.target")?;
+    c.direction(&cam.up, "camera.up")?;
+    c.float_range(&cam.fov, "camera.fov", 0.01, 179.0)?;
+    c.float_range(&cam.height, "camera.height", 1e-6, 1e9)?;
+    c.float_range(&cam.near, "camera.near", 1e-7, 1e9)?;
+    c.float_range(&cam.far, "camera.far", 1e-6, 1e12)?;
+    if let (Some(n), Some(f)) = (&cam.near, &cam.far)
+        && f.get_ref() <= n.get_ref()
+    {
+        return Err(c.err(
+            f.span(),
+            format!(
+                "camera.far ({}) must be greater than camera.near ({})",
+                f.get_ref(),
+                n.get_ref()
+            ),
+        ));
+    }
+    if let (Some(e), Some(t)) = (&cam.eye, &cam.target)
+        && e.get_ref() == t.get_ref()
+    {
+        return Err(c.err(t.span(), "camera.target must differ from camera.eye"));
+    }
+    Ok(())
+}
+
+/// Validation context: turns spans into located errors.
+pub struct Ctx<'a> {
+    pub file: &'a Path,
+    pub text: &'a str,
+}
+
+impl Ctx<'_> {
+    pub fn err(&self, span: std::ops::Range<usize>, message: impl Into<String>) -> Error {
+        Error::Scene {
+            location: Location::from_offset(self.file, self.text, span.start),
+            message: format!(
+                "{}{}",
+                message.into(),
+                source_excerpt(self.text, span.start)
+            ),
+        }
+    }
+
+    pub fn location(&self, span: std::ops::Range<usize>) -> Location {
+        Location::from_offset(self.file, self.text, span.start)
+    }
+
+    fn int_range(&self, v: &Option<S<i64>>, key: &str, lo: i64, hi: i64) -> Result<(), Error> {
+        if let Some(v) = v
+            && !(lo..=hi).contains(v.get_ref())
+        {
+            return Err(self.err(
+                v.span(),
+                format!(
+                    "{key} = {}: expected an integer from {lo} to {hi}",
+                    v.get_ref()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn float_range(&self, v: &Option<S<f32>>, key: &str, lo: f32, hi: f32) -> Result<(), Error> {
+        if let Some(v) = v {
+            let x = *v.get_ref();
+            if !(x.is_finite() && x >= lo && x <= hi) {
+                return Err(self.err(
+                    v.span(),
+                    format!("{key} = {x}: expected a number from {lo} to {hi}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn finite(&self, v: &Option<S<f32>>, key: &str) -> Result<(), Error> {
+        self.float_range(v, key, f32::MIN, f32::MAX)
+    }
+
+    fn vec3(&self, v: &Option<S<[f32; 3]>>, key: &str) -> Result<(), Error> {
+        if let Some(v) = v
+            && v.get_ref().iter().any(|x| !x.is_finite())
+        {
+            return Err(self.err(v.span(), format!("{key}: expected three finite numbers")));
+        }
+        Ok(())
+    }
+
+    fn direction(&self, v: &Option<S<[f32; 3]>>, key: &str) -> Result<(), Error> {
+        self.vec3(v, key)?;
+        if let Some(v) = v
+            && v.get_ref().iter().all(|x| *x == 0.0)
+        {
+            return Err(self.err(v.span(), format!("{key}: expected a non-zero direction")));
+        }
+        Ok(())
+    }
+
+    fn color(&self, span: std::ops::Range<usize>, c: &[f32; 3], key: &str) -> Result<(), Error> {
+        if c.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            return Err(self.err(
+                span,
+                format!("{key}: expected three finite, non-negative linear RGB values"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The offending line of the scene, printed under a message, compiler style.
+fn source_excerpt(text: &str, offset: usize) -> String {
+    let offset = offset.min(text.len());
+    let start = text[..offset].rfind('\n').map(|i| i + 1).unwrap_or(0);
+    let end = text[offset..]
+        .find('\n')
+        .map(|i| offset + i)
+        .unwrap_or(text.len());
+    let line_no = text[..offset].matches('\n').count() + 1;
+    let line = text[start..end].trim_end();
+    if line.is_empty() {
+        return String::new();
+    }
+    format!("\n  {line_no} | {line}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(t: &str) -> Result<SceneDesc, Error> {
+        SceneDesc::parse(Path::new("t.toml"), t)
+    }
+
+    #[test]
+    fn smallest_scene_parses() {
+        let d = parse("[[model]]\npath = \"a.obj\"\n").unwrap();
+        assert_eq!(d.models.len(), 1);
+        assert!(d.cameras.is_empty());
+    }
+
+    #[test]
+    fn full_example_of_the_contract_parses() {
+        let d = parse(include_str!("../../tests/data/full_example.toml")).unwrap();
+        assert_eq!(d.lights.len(), 3);
+        assert_eq!(
+            d.models[0].get_ref().materials.len(),
+            1,
+            "per-material override table"
+        );
+    }
+
+    #[test]
+    fn unknown_key_names_line_and_column() {
+        let e = parse("[[model]]\npath = \"a.obj\"\n[render]\nmsa = 4\n").unwrap_err();
+        let s = e.to_string();
+        assert!(s.starts_with("t.toml:4:1:"), "{s}");
+        assert!(s.contains("msa"), "{s}");
+    }
+
+    #[test]
+    fn wrong_type_and_range_are_located() {
+        let e = parse("[[model]]\npath = \"a.obj\"\n[output]\nwidth = \"big\"\n").unwrap_err();
+        assert!(e.to_string().starts_with("t.toml:4:9:"), "{e}");
+        let e = parse("[[model]]\npath = \"a.obj\"\n[render]\nmsaa = 3\n").unwrap_err();
+        assert!(
+            e.to_string().contains("expected one of 1, 2, 4, 8, 16"),
+            "{e}"
+        );
+        assert!(e.to_string().starts_with("t.toml:4:8:"), "{e}");
+        let e = parse("[[model]]\npath = \"a.obj\"\n[render]\nshading = \"toon\"\n").unwrap_err();
+        assert!(e.to_string().contains("blinn-phong"), "{e}");
+    }
+
+    #[test]
+    fn missing_model_is_an_error() {
+        let e = parse("[output]\nwidth = 10\n").unwrap_err();
+        assert!(e.to_string().contains("[[model]]"));
+        assert_eq!(e.exit_code(), 2);
+    }
+
+    #[test]
+    fn scale_and_background_accept_both_spellings() {
+        let d = parse(
+            "[[model]]\npath = \"a.obj\"\nscale = 2\n[output]\nbackground = \"transparent\"\n",
+        )
+        .unwrap();
+        assert_eq!(
+            d.models[0].get_ref().scale.as_ref().unwrap().get_ref().0,
+            [2.0; 3]
+        );
+        assert_eq!(
+            *d.output.background.as_ref().unwrap().get_ref(),
+            Background::Transparent
+        );
+        let d = parse("[[model]]\npath = \"a.obj\"\nscale = [1, 2, 3.5]\n").unwrap();
+        assert_eq!(
+            d.models[0].get_ref().scale.as_ref().unwrap().get_ref().0,
+            [1.0, 2.0, 3.5]
+        );
+        assert!(parse("[[model]]\npath = \"a.obj\"\nscale = [1, 2]\n").is_err());
+        assert!(parse("[[model]]\npath = \"a.obj\"\nscale = 0\n").is_err());
+    }
+
+    #[test]
+    fn spot_cone_must_be_ordered() {
+        let e = parse(
+            "[[model]]\npath = \"a.obj\"\n[[light]]\nkind = \"spot\"\ninner_angle = 40\nouter_angle = 30\n",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("inner_angle"), "{e}");
+    }
+}

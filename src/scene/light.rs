@@ -1,0 +1,134 @@
+//! Lights in world space and the irradiance they deliver to a point.
+
+use glam::Vec3;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightKind {
+    /// Radiant intensity `intensity` (times `color`) from `position`.
+    Point { position: Vec3, intensity: f32 },
+    /// Irradiance `irradiance` on a surface facing the light; `direction` is
+    /// the unit vector the light travels along.
+    Directional { direction: Vec3, irradiance: f32 },
+    /// A point light limited to a cone around `direction` (unit), with the
+    /// KHR_lights_punctual smooth falloff between the cone angles.
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: f32,
+        cos_inner: f32,
+        cos_outer: f32,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    pub kind: LightKind,
+    pub color: Vec3,
+    pub shadows: bool,
+}
+
+/// What one light delivers to a shaded point.
+#[derive(Debug, Clone, Copy)]
+pub struct Incidence {
+    /// Unit vector from the point towards the light.
+    pub l: Vec3,
+    /// Irradiance on a surface facing the light (RGB), before the cosine.
+    pub e: Vec3,
+}
+
+impl Light {
+    /// Unit direction to the light and its irradiance at `p`; None where the
+    /// light contributes nothing (outside a spot cone, at the light itself).
+    #[inline]
+    pub fn incidence(&self, p: Vec3) -> Option<Incidence> {
+        match self.kind {
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => Some(Incidence {
+                l: -direction,
+                e: self.color * irradiance,
+            }),
+            LightKind::Point {
+                position,
+                intensity,
+            } => {
+                let d = position - p;
+                let r2 = d.length_squared();
+                if r2 <= 0.0 {
+                    return None;
+                }
+                let l = d / r2.sqrt();
+                Some(Incidence {
+                    l,
+                    e: self.color * (intensity / r2),
+                })
+            }
+            LightKind::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => {
+                let d = position - p;
+                let r2 = d.length_squared();
+                if r2 <= 0.0 {
+                    return None;
+                }
+                let l = d / r2.sqrt();
+                let f = spot_falloff(-l.dot(direction), cos_inner, cos_outer);
+                if f <= 0.0 {
+                    return None;
+                }
+                Some(Incidence {
+                    l,
+                    e: self.color * (intensity * f / r2),
+                })
+            }
+        }
+    }
+}
+
+/// KHR_lights_punctual: t = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1),
+/// attenuation t². Equal cone angles give a hard edge.
+#[inline]
+pub fn spot_falloff(cos_a: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    let span = cos_inner - cos_outer;
+    if span <= 1e-7 {
+        return if cos_a >= cos_outer { 1.0 } else { 0.0 };
+    }
+    let t = ((cos_a - cos_outer) / span).clamp(0.0, 1.0);
+    t * t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_light_follows_inverse_square() {
+        let l = Light {
+            kind: LightKind::Point {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                intensity: 8.0,
+            },
+            color: Vec3::ONE,
+            shadows: false,
+        };
+        let i = l.incidence(Vec3::ZERO).unwrap();
+        assert!((i.e.x - 2.0).abs() < 1e-6);
+        assert!((i.l - Vec3::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn spot_cone_is_smooth_and_bounded() {
+        let (ci, co) = (20f32.to_radians().cos(), 30f32.to_radians().cos());
+        assert_eq!(spot_falloff(1.0, ci, co), 1.0);
+        assert_eq!(spot_falloff(35f32.to_radians().cos(), ci, co), 0.0);
+        let mid = spot_falloff(25f32.to_radians().cos(), ci, co);
+        assert!(mid > 0.0 && mid < 1.0);
+        assert_eq!(spot_falloff(0.9, 0.5, 0.5), 1.0);
+        assert_eq!(spot_falloff(0.4, 0.5, 0.5), 0.0);
+    }
+}
