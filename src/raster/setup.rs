@@ -1,4 +1,4 @@
-//! Triangle setup: clip space -> viewport in 24.8 fixed point, culling, and
+//! Triangle setup: clip space -> viewport in 17.15 fixed point, culling, and
 //! the edge functions with the top-left fill rule.
 //!
 //! Screen space has its origin at the top-left corner and y down; pixel
@@ -13,14 +13,18 @@ use glam::Vec3;
 use super::clip::ClipVertex;
 use crate::scene::desc::CullMode;
 
-pub const SUBPIXEL_BITS: u32 = 8;
+/// 1/32768 pixel. Coordinates stay within 2^14 pixels of the viewport center
+/// (guard band), so each edge-function product stays below 2^60: no
+/// overflow in i64, and vertex snapping moves depth by ~1e-7 relative rather
+/// than the 1e-4 that 8 bits give at grazing angles.
+pub const SUBPIXEL_BITS: u32 = 15;
 pub const SUBPIXEL: i64 = 1 << SUBPIXEL_BITS;
 const HALF: i64 = SUBPIXEL / 2;
 
 /// A triangle ready to rasterize.
 #[derive(Debug, Clone, Copy)]
 pub struct Tri {
-    /// Fixed-point screen coordinates (1/256 pixel), positive-area order.
+    /// Fixed-point screen coordinates (1/2^15 pixel), positive-area order.
     pub x: [i32; 3],
     pub y: [i32; 3],
     /// Inclusive pixel bounds, clamped to the viewport.
@@ -59,7 +63,7 @@ impl Edge {
     fn new(ax: i64, ay: i64, bx: i64, by: i64) -> Edge {
         let dx = bx - ax;
         let dy = by - ay;
-        // E(p) = dx * (p.y - ay) - dy * (p.x - ax), p = 256 * pixel + 128.
+        // E(p) = dx * (p.y - ay) - dy * (p.x - ax), p = SUBPIXEL * (pixel + 1/2).
         let a = -dy * SUBPIXEL;
         let b = dx * SUBPIXEL;
         let c = dx * (HALF - ay) - dy * (HALF - ax);
@@ -120,20 +124,20 @@ pub fn setup(
     draw: u32,
     prim: u32,
 ) -> Option<Tri> {
-    let (w, h) = (vp.width as f32, vp.height as f32);
+    let (w, h) = (vp.width as f64, vp.height as f64);
     let mut x = [0i32; 3];
     let mut y = [0i32; 3];
     let mut z = [0f32; 3];
     let mut inv_w = [0f32; 3];
     for k in 0..3 {
         let p = v[k].pos;
-        let iw = 1.0 / p.w;
-        let sx = (p.x * iw * 0.5 + 0.5) * w;
-        let sy = (0.5 - p.y * iw * 0.5) * h;
-        x[k] = (sx * SUBPIXEL as f32).round() as i32;
-        y[k] = (sy * SUBPIXEL as f32).round() as i32;
-        z[k] = p.z * iw;
-        inv_w[k] = iw;
+        let iw = 1.0 / p.w as f64;
+        let sx = (p.x as f64 * iw * 0.5 + 0.5) * w;
+        let sy = (0.5 - p.y as f64 * iw * 0.5) * h;
+        x[k] = (sx * SUBPIXEL as f64).round() as i32;
+        y[k] = (sy * SUBPIXEL as f64).round() as i32;
+        z[k] = (p.z as f64 * iw) as f32;
+        inv_w[k] = iw as f32;
     }
     let area2 = (x[1] as i64 - x[0] as i64) * (y[2] as i64 - y[0] as i64)
         - (y[1] as i64 - y[0] as i64) * (x[2] as i64 - x[0] as i64);
@@ -157,7 +161,7 @@ pub fn setup(
     }
     let (lo_x, hi_x) = (*x.iter().min()? as i64, *x.iter().max()? as i64);
     let (lo_y, hi_y) = (*y.iter().min()? as i64, *y.iter().max()? as i64);
-    // Pixel px is a candidate when lo <= 256 px + 128 <= hi.
+    // Pixel px is a candidate when lo <= SUBPIXEL px + HALF <= hi.
     let min_x = (lo_x - HALF + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
     let max_x = (hi_x - HALF).div_euclid(SUBPIXEL).min(vp.width as i64 - 1);
     let min_y = (lo_y - HALF + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
