@@ -3,6 +3,7 @@
 //! directory and renamed into place, so an interrupted render never leaves a
 //! half-written frame under the final name.
 
+pub mod compare;
 pub mod png;
 
 use std::io::Write;

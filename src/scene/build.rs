@@ -220,7 +220,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                 path: p,
                 line: None,
                 message: format!(
-                    "model file not found (from {})",
+                    "model file not found: put the model there or change `path` (from {})",
                     ctx.location(m.get_ref().path.span())
                 ),
             });

@@ -1,0 +1,244 @@
+//! The binary end to end: exit codes and messages for bad input,
+//! determinism across thread counts, atomic output.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_softraster"))
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(args: &[&str]) -> (i32, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn frames_are_byte_identical_whatever_the_thread_count() {
+    let dir = common::scratch("determinism");
+    let scene = root().join("scenes/showcase.toml");
+    let mut outputs = Vec::new();
+    for threads in ["1", "4"] {
+        let out = dir.join(threads);
+        let (code, err) = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            threads,
+            "--frames",
+            "0..3",
+            "--quiet",
+            "--set",
+            "output.width=200",
+            "--set",
+            "output.height=150",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let mut files: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        assert_eq!(files.len(), 3);
+        outputs.push(
+            files
+                .iter()
+                .map(|f| std::fs::read(f).unwrap())
+                .collect::<Vec<_>>(),
+        );
+        // No temporary files left behind.
+        assert!(
+            files
+                .iter()
+                .all(|f| !f.file_name().unwrap().to_string_lossy().starts_with('.'))
+        );
+    }
+    assert!(outputs[0] == outputs[1], "1 and 4 threads differ");
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn malformed_toml_exits_2_naming_file_and_line() {
+    let dir = common::scratch("bad_toml");
+    let s = write(
+        &dir,
+        "bad.toml",
+        "[[model]]\npath = \"a.obj\"\n[render\nmsaa = 4\n",
+    );
+    let (code, err) = run(&["render", s.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("bad.toml:3:"), "{err}");
+    let s = write(
+        &dir,
+        "unknown.toml",
+        "[[model]]\npath = \"a.obj\"\n[render]\nshadin = \"flat\"\n",
+    );
+    let (code, err) = run(&["render", s.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("unknown.toml:4:1") && err.contains("shadin"),
+        "{err}"
+    );
+}
+
+#[test]
+fn missing_model_exits_2_naming_the_resolved_path() {
+    let dir = common::scratch("missing_model");
+    let s = write(&dir, "s.toml", "[[model]]\npath = \"nowhere/gone.obj\"\n");
+    let (code, err) = run(&["render", s.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("nowhere/gone.obj") && err.contains("s.toml:2:"),
+        "{err}"
+    );
+}
+
+#[test]
+fn out_of_range_obj_index_exits_2_naming_the_line() {
+    let dir = common::scratch("bad_obj");
+    write(
+        &dir,
+        "m.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
+    );
+    let s = write(&dir, "s.toml", "[[model]]\npath = \"m.obj\"\n");
+    let (code, err) = run(&[
+        "render",
+        s.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("m.obj:5") && err.contains("index 9"), "{err}");
+}
+
+#[test]
+fn features_of_later_issues_are_refused_not_ignored() {
+    let dir = common::scratch("unsupported");
+    write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    for (key, text) in [
+        ("render.msaa", "[render]\nmsaa = 4\n"),
+        ("light.shadows", "[[light]]\nshadows = true\n"),
+        ("output.depth", "[output]\ndepth = true\n"),
+        ("render.ao", "[render]\nao = { method = \"ssao\" }\n"),
+    ] {
+        let s = write(
+            &dir,
+            "s.toml",
+            &format!("[[model]]\npath = \"m.obj\"\n{text}"),
+        );
+        let (code, err) = run(&[
+            "render",
+            s.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{key}: {err}");
+        assert!(err.contains("not supported yet"), "{key}: {err}");
+    }
+}
+
+#[test]
+fn set_overrides_and_bad_arguments() {
+    let dir = common::scratch("set");
+    write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let s = write(&dir, "s.toml", "[[model]]\npath = \"m.obj\"\n");
+    let out = dir.join("out");
+    let (code, err) = run(&[
+        "render",
+        s.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "output.width=32",
+        "--set",
+        "output.height=16",
+        "--set",
+        "output.name=\"x{frame:02}\"",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let img = image::open(out.join("x00.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (32, 16));
+    let (code, err) = run(&["render", s.to_str().unwrap(), "--set", "render.msaa=3"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("render.msaa"), "{err}");
+    assert_eq!(
+        run(&["render", s.to_str().unwrap(), "--frames", "3..9"]).0,
+        2
+    );
+    assert_eq!(
+        run(&["render", s.to_str().unwrap(), "--camera", "nope"]).0,
+        2
+    );
+    assert_eq!(run(&["render"]).0, 2);
+}
+
+#[test]
+fn melina_without_the_model_says_where_to_put_it() {
+    let scene = root().join("scenes/melina.toml");
+    if root().join("assets/melina/melina.obj").exists() {
+        eprintln!("SKIPPED: a Melina export is present");
+        return;
+    }
+    let (code, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        common::scratch("melina").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("assets/melina/melina.obj"), "{err}");
+}
+
+#[test]
+fn unwritable_output_exits_1() {
+    let dir = common::scratch("unwritable");
+    write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let s = write(
+        &dir,
+        "s.toml",
+        "[[model]]\npath = \"m.obj\"\n[output]\nwidth = 8\nheight = 8\n",
+    );
+    // A file where the output directory should be.
+    let blocker = write(&dir, "blocker", "");
+    let (code, err) = run(&[
+        "render",
+        s.to_str().unwrap(),
+        "--out",
+        blocker.join("sub").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+}
+
+#[test]
+fn committed_showcase_assets_are_what_the_generator_makes() {
+    let dir = common::scratch("assets");
+    softraster::procedural::write_showcase_assets(&dir).unwrap();
+    let committed = root().join("assets/showcase");
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap();
+        let want = std::fs::read(committed.join(name)).unwrap();
+        assert!(
+            std::fs::read(&p).unwrap() == want,
+            "{name:?} differs: run softraster generate-assets assets/showcase"
+        );
+    }
+}

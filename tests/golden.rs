@@ -1,0 +1,134 @@
+//! Golden images: small scenes rendered and compared with committed PNGs
+//! under `tests/golden/`. Tolerance: a pixel differs when a channel is off by
+//! more than 2/255; at most 0.1% of pixels may differ (room for last-bit
+//! floating-point differences across CPUs, none for a real regression).
+//!
+//! On a mismatch the new image and a diff image (magenta = differing pixel)
+//! are written to `tests/failures/`. To accept new output as the golden:
+//! `UPDATE_GOLDENS=1 cargo test --test golden`, then look at the images.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use softraster::output::compare::{Tolerance, compare};
+use softraster::output::{png, resolve};
+use softraster::render::render_frame;
+use softraster::scene::Scene;
+use softraster::scene::build::LoadOptions;
+use softraster::scene::overrides::SetOverride;
+
+const TOLERANCE: Tolerance = Tolerance {
+    channel: 2,
+    fraction: 0.001,
+};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn check(name: &str, scene: &Path, frame: u32, sets: &[&str]) {
+    let opts = LoadOptions {
+        sets: sets
+            .iter()
+            .map(|s| s.parse::<SetOverride>().unwrap())
+            .collect(),
+        out_dir: None,
+    };
+    let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);
+    let golden = root().join("tests/golden").join(format!("{name}.png"));
+    if std::env::var_os("UPDATE_GOLDENS").is_some() {
+        png::write(&golden, &img).unwrap();
+        eprintln!("updated {}", golden.display());
+        return;
+    }
+    let reference = png::read(&golden).unwrap_or_else(|e| {
+        panic!("{e}: no golden yet? run UPDATE_GOLDENS=1 cargo test --test golden")
+    });
+    let fail_dir = root().join("tests/failures");
+    let save = || {
+        png::write(&fail_dir.join(format!("{name}.new.png")), &img).unwrap();
+    };
+    let Some((cmp, diff)) = compare(&reference, &img, TOLERANCE) else {
+        save();
+        panic!("{name}: size or channels differ from {}", golden.display());
+    };
+    if !cmp.passes(TOLERANCE) {
+        save();
+        png::write(&fail_dir.join(format!("{name}.diff.png")), &diff).unwrap();
+        panic!(
+            "{name}: {} of {} pixels differ (max channel diff {}); new image and diff in {}",
+            cmp.differing_pixels,
+            cmp.pixels,
+            cmp.max_channel_diff,
+            fail_dir.display()
+        );
+    }
+}
+
+#[test]
+fn showcase() {
+    check(
+        "showcase_f3",
+        &root().join("scenes/showcase.toml"),
+        3,
+        &["output.width=320", "output.height=240"],
+    );
+}
+
+#[test]
+fn showcase_shading_modes() {
+    for mode in ["flat", "gouraud", "unlit", "normals", "depth", "wireframe"] {
+        check(
+            &format!("showcase_{mode}"),
+            &root().join("scenes/showcase.toml"),
+            0,
+            &[
+                "output.width=160",
+                "output.height=120",
+                &format!("render.shading={mode}"),
+            ],
+        );
+    }
+}
+
+fn real(name: &str) {
+    if common::shared_assets().is_none() {
+        return;
+    }
+    check(
+        name,
+        &root().join(format!("tests/scenes/{name}.toml")),
+        0,
+        &[],
+    );
+}
+
+#[test]
+fn diablo3_pose_textures_by_override() {
+    real("diablo3_pose");
+}
+
+#[test]
+fn diablo3_pose_mtl() {
+    real("diablo3_pose_mtl");
+}
+
+#[test]
+fn african_head_full_three_objects() {
+    real("african_head_full");
+}
+
+#[test]
+fn spot_triangulated_and_quads() {
+    real("spot_triangulated");
+    real("spot_quads");
+}
+
+#[test]
+fn bunny_nefertiti_teapot() {
+    real("bunny");
+    real("nefertiti");
+    real("teapot");
+}
