@@ -179,7 +179,7 @@ pub fn checker(size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Image8 {
     let cell = size / cells;
     for y in 0..size {
         for x in 0..size {
-            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
+            let c = if ((x / cell) + (y / cell)).is_multiple_of(2) {
                 a
             } else {
                 b

@@ -76,7 +76,6 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let result = tobj::load_obj_buf(&mut BufReader::new(text.as_bytes()), &opts, |p| {
         let mtl_path = dir.join(fix_separators(&p.to_string_lossy()));
@@ -284,10 +283,7 @@ pub fn parse_map(raw: &str, base: &Path) -> Result<MapSpec, String> {
         clamp: false,
     };
     let mut rest = raw.trim();
-    loop {
-        let Some(opt) = rest.strip_prefix('-') else {
-            break;
-        };
+    while let Some(opt) = rest.strip_prefix('-') {
         let (name, after) = split_word(opt);
         // How many arguments each option takes (at most, for -s -o -t).
         let (min, max) = match name {

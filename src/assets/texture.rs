@@ -105,18 +105,7 @@ impl Texture {
 
     #[inline]
     fn fetch(&self, x: i64, y: i64) -> Vec4 {
-        let t = self.texels[(y as usize) * self.width as usize + x as usize];
-        if self.srgb {
-            let lut = srgb_to_linear_table();
-            Vec4::new(
-                lut[t[0] as usize],
-                lut[t[1] as usize],
-                lut[t[2] as usize],
-                t[3] as f32 / 255.0,
-            )
-        } else {
-            Vec4::new(t[0] as f32, t[1] as f32, t[2] as f32, t[3] as f32) * (1.0 / 255.0)
-        }
+        self.decode(self.texels[(y as usize) * self.width as usize + x as usize])
     }
 
     /// Nearest-texel lookup at texture coordinates `uv` (top-left origin).
@@ -133,7 +122,43 @@ impl Texture {
     }
 
     /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
+    #[inline]
     pub fn sample_bilinear(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+        // Fast path: all four texels inside the image, so no address mode
+        // applies (the case for almost every lookup of a model's own UVs).
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        if x >= 0.0 && y >= 0.0 && x < (self.width - 1) as f32 && y < (self.height - 1) as f32 {
+            let (x0, y0) = (x as u32, y as u32);
+            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+            let i = (y0 * self.width + x0) as usize;
+            let w = self.width as usize;
+            let t = &self.texels;
+            let (a, b, c, d) = (t[i], t[i + 1], t[i + w], t[i + w + 1]);
+            let top = self.decode(a).lerp(self.decode(b), fx);
+            let bottom = self.decode(c).lerp(self.decode(d), fx);
+            return top.lerp(bottom, fy);
+        }
+        self.sample_bilinear_wrapped(uv, mode)
+    }
+
+    #[inline]
+    fn decode(&self, t: [u8; 4]) -> Vec4 {
+        if self.srgb {
+            let lut = srgb_to_linear_table();
+            Vec4::new(
+                lut[t[0] as usize],
+                lut[t[1] as usize],
+                lut[t[2] as usize],
+                t[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(t[0] as f32, t[1] as f32, t[2] as f32, t[3] as f32) * (1.0 / 255.0)
+        }
+    }
+
+    /// The general case: any finite coordinate, through the address mode.
+    fn sample_bilinear_wrapped(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
         if !uv.is_finite() {
             return BORDER;
         }
@@ -240,6 +265,22 @@ mod tests {
         assert!((c.x - 1.0).abs() < 1e-6);
         let mid = t.sample_bilinear(Vec2::new(0.5, 0.25), AddressMode::Clamp);
         assert!((mid.x - 0.5).abs() < 1e-6);
+        // The fast path and the general path agree inside the image.
+        let big = Texture::from_rgba8(
+            3,
+            3,
+            (0..9u8).map(|i| [i * 20, i, 255 - i, 255]).collect(),
+            true,
+        );
+        for uv in [
+            Vec2::new(0.4, 0.6),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.21, 0.7),
+        ] {
+            let a = big.sample_bilinear(uv, AddressMode::Repeat);
+            let b = big.sample_bilinear_wrapped(uv, AddressMode::Repeat);
+            assert!((a - b).abs().max_element() < 1e-5, "{a} {b}");
+        }
     }
 
     #[test]

@@ -46,6 +46,7 @@ fn plane_distances(p: Vec4, guard_x: f32, guard_y: f32) -> [f32; 6] {
     ]
 }
 
+#[allow(clippy::large_enum_variant)] // returned by value per triangle; boxing would allocate
 pub enum Clipped {
     /// Entirely outside one plane.
     Rejected,
@@ -60,6 +61,7 @@ pub enum Clipped {
 pub fn clip_triangle(v: [Vec4; 3], guard_x: f32, guard_y: f32) -> Clipped {
     let d = v.map(|p| plane_distances(p, guard_x, guard_y));
     let mut any_out = false;
+    #[allow(clippy::needless_range_loop)] // k indexes the planes of all three vertices
     for k in 0..6 {
         let out = [d[0][k] < 0.0, d[1][k] < 0.0, d[2][k] < 0.0];
         if out[0] && out[1] && out[2] {
