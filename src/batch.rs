@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::output::{self, Image8};
-use crate::render::render_frame;
+use crate::render::{Frame, FrameSetup, render_into};
 use crate::scene::Scene;
 
 pub struct RenderJob {
@@ -67,15 +67,16 @@ impl RenderJob {
                 }
             }
         };
+        let mut buffer = Frame::new(0, 0);
         'frames: for frame in self.frames.clone() {
             for &cam in &self.cameras {
                 let name = &scene.cameras[cam].name;
                 let t0 = Instant::now();
-                let f = render_frame(scene, cam, frame);
+                render_into(&FrameSetup::new(scene, cam, frame), &mut buffer);
                 let img = scene
                     .output
                     .color
-                    .then(|| output::resolve(&f, &scene.settings));
+                    .then(|| output::resolve(&buffer, &scene.settings));
                 let render_seconds = t0.elapsed().as_secs_f64();
                 let mut files = Vec::new();
                 if img.is_some() {

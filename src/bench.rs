@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::output;
-use crate::render::render_frame;
+use crate::render::{Frame, FrameSetup, render_into};
 use crate::scene::Scene;
 use crate::scene::build::LoadOptions;
 use crate::scene::light::{Light, LightKind};
@@ -129,9 +129,10 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     scene.lights = anchor_lights(&scene);
     let mut times = Vec::new();
     let mut png_ms = 0.0;
+    let mut frame = Frame::new(0, 0);
     for f in 0..args.frames {
         let t = Instant::now();
-        let frame = render_frame(&scene, 0, f);
+        render_into(&FrameSetup::new(&scene, 0, f), &mut frame);
         let img = output::resolve(&frame, &scene.settings);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         let t = Instant::now();

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::coverage::{NO_TRIANGLE, Visibility};
-use crate::raster::interp;
+use crate::raster::interp::Interpolator;
 use crate::raster::setup::{Tri, Viewport, setup};
 use crate::scene::Scene;
 use crate::scene::camera::{Camera, Projection};
@@ -33,6 +33,26 @@ pub struct Frame {
     /// Distance along the view axis at the pixel center; +inf where nothing
     /// was drawn.
     pub depth: Vec<f32>,
+}
+
+impl Frame {
+    pub fn new(width: u32, height: u32) -> Frame {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            color: vec![Vec4::ZERO; n],
+            depth: vec![f32::INFINITY; n],
+        }
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        let n = width as usize * height as usize;
+        self.width = width;
+        self.height = height;
+        self.color.resize(n, Vec4::ZERO);
+        self.depth.resize(n, f32::INFINITY);
+    }
 }
 
 /// The draw list of one frame: everything placed where it is at this frame.
@@ -116,8 +136,17 @@ pub fn render_frame(scene: &Scene, camera: usize, frame: u32) -> Frame {
 }
 
 pub fn render_setup(fs: &FrameSetup) -> Frame {
+    let mut frame = Frame::new(0, 0);
+    render_into(fs, &mut frame);
+    frame
+}
+
+/// Renders into `frame`, reusing its buffers (resized to the scene's
+/// output size); every pixel is written.
+pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
     let scene = fs.scene;
     let s = &scene.settings;
+    frame.resize(s.width, s.height);
     let vp = Viewport {
         width: s.width,
         height: s.height,
@@ -154,7 +183,7 @@ pub fn render_setup(fs: &FrameSetup) -> Frame {
     }
 
     // Clip, set up and bin, chunk by chunk; merged in submission order.
-    let grid = TileGrid::new(s.width, s.height);
+    let grid = TileGrid::bands(s.width, s.height);
     let (gx, gy) = vp.guard_band();
     let cull = s.cull;
     let per_chunk: Vec<(Vec<Tri>, Vec<Vec<u32>>)> = chunks
@@ -200,9 +229,15 @@ pub fn render_setup(fs: &FrameSetup) -> Frame {
     let ctx = shade_context(fs);
     let bg = background(s.background);
     let reverse = s.depth == DepthMode::ReverseZ;
-    let tiles: Vec<(Vec<Vec4>, Vec<f32>)> = (0..grid.count())
-        .into_par_iter()
-        .map(|ti| {
+    // Each band owns its rows of the frame: visibility, then shading
+    // straight into the frame buffer.
+    let band = (grid.tile_w * grid.tile_h) as usize;
+    frame
+        .color
+        .par_chunks_mut(band)
+        .zip(frame.depth.par_chunks_mut(band))
+        .enumerate()
+        .for_each(|(ti, (color, depth))| {
             let rect = grid.rect(ti);
             let mut vis = Visibility::new(rect, reverse);
             for ((_, bins), off) in per_chunk.iter().zip(&offsets) {
@@ -215,29 +250,8 @@ pub fn render_setup(fs: &FrameSetup) -> Frame {
                     }
                 }
             }
-            shade_tile(fs, &ctx, &verts, &draws, &tris, &vis, bg)
-        })
-        .collect();
-
-    // Assemble the tiles into the frame.
-    let (w, h) = (s.width as usize, s.height as usize);
-    let mut color = vec![Vec4::ZERO; w * h];
-    let mut depth = vec![f32::INFINITY; w * h];
-    for (ti, (c, d)) in tiles.iter().enumerate() {
-        let r = grid.rect(ti);
-        let tw = r.width();
-        for row in 0..r.height() {
-            let dst = (r.y0 as usize + row) * w + r.x0 as usize;
-            color[dst..dst + tw].copy_from_slice(&c[row * tw..(row + 1) * tw]);
-            depth[dst..dst + tw].copy_from_slice(&d[row * tw..(row + 1) * tw]);
-        }
-    }
-    Frame {
-        width: s.width,
-        height: s.height,
-        color,
-        depth,
-    }
+            shade_tile(fs, &ctx, &verts, &draws, &tris, &vis, bg, color, depth);
+        });
 }
 
 fn vertex_stage(
@@ -327,13 +341,18 @@ fn shade_tile(
     tris: &[Tri],
     vis: &Visibility,
     bg: Vec4,
-) -> (Vec<Vec4>, Vec<f32>) {
+    color: &mut [Vec4],
+    depth: &mut [f32],
+) {
     let rect = vis.rect;
     let tw = rect.width();
-    let mut color = vec![bg; vis.id.len()];
-    let mut depth = vec![f32::INFINITY; vis.id.len()];
+    color.fill(bg);
+    depth.fill(f32::INFINITY);
     let mode = ctx.mode;
     let ortho = ctx.orthographic;
+    // Runs of pixels from one triangle share its interpolator.
+    let mut current = NO_TRIANGLE;
+    let mut it: Option<Interpolator> = None;
     for (i, &id) in vis.id.iter().enumerate() {
         if id == NO_TRIANGLE {
             continue;
@@ -341,7 +360,12 @@ fn shade_tile(
         let px = rect.x0 + (i % tw) as i32;
         let py = rect.y0 + (i / tw) as i32;
         let t = &tris[id as usize];
-        let frag = interp::at_pixel(t, px, py);
+        if id != current {
+            current = id;
+            it = Some(Interpolator::new(t));
+        }
+        let Some(it) = &it else { continue };
+        let frag = it.at_pixel(px, py);
         let d = draws[t.draw as usize];
         let model = &fs.scene.models[d.model];
         let mv = &verts[d.model];
@@ -376,7 +400,7 @@ fn shade_tile(
             )
         });
         let edge_distance = if mode == ShadingMode::Wireframe {
-            edge_distance(t, px, py, l)
+            edge_distance(it, px, py, l)
         } else {
             f32::INFINITY
         };
@@ -399,15 +423,14 @@ fn shade_tile(
         };
         depth[i] = view_depth;
     }
-    (color, depth)
 }
 
 /// Screen-space distance (pixels) from the pixel center to the nearest edge
 /// of the original triangle: each barycentric over the length of its
 /// screen-space gradient.
-fn edge_distance(t: &Tri, px: i32, py: i32, l: Vec3) -> f32 {
-    let dx = interp::at(t, px as f64 + 1.5, py as f64 + 0.5).lambda - l;
-    let dy = interp::at(t, px as f64 + 0.5, py as f64 + 1.5).lambda - l;
+fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
+    let dx = it.at_pixel(px + 1, py).lambda - l;
+    let dy = it.at_pixel(px, py + 1).lambda - l;
     let mut best = f32::INFINITY;
     for k in 0..3 {
         let g = Vec2::new(dx[k], dy[k]).length();

@@ -9,6 +9,8 @@ pub mod png;
 use std::io::Write;
 use std::path::Path;
 
+use glam::Vec4;
+
 use crate::error::Error;
 use crate::render::Frame;
 use crate::scene::RenderSettings;
@@ -39,16 +41,29 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
     data.par_chunks_mut(channels * frame.width as usize)
         .zip(frame.color.par_chunks(frame.width as usize))
         .for_each(|(out, row)| {
+            // Runs of one color (the background, mostly) resolve once.
+            let mut last: Option<(Vec4, [u8; 4])> = None;
             for (o, c) in out.chunks_exact_mut(channels).zip(row) {
-                let rgb = if data_view {
-                    [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
-                } else {
-                    let t = tonemap(c.truncate(), s.tonemap, scale);
-                    [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
+                let px = match last {
+                    Some((lc, px)) if lc == *c => px,
+                    _ => {
+                        let rgb = if data_view {
+                            [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+                        } else {
+                            let t = tonemap(c.truncate(), s.tonemap, scale);
+                            [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
+                        };
+                        let px = [rgb[0], rgb[1], rgb[2], encode_linear(c.w)];
+                        last = Some((*c, px));
+                        px
+                    }
                 };
-                o[..3].copy_from_slice(&rgb);
+                // Fixed-size copies (a slice copy of 3 bytes calls memcpy).
+                o[0] = px[0];
+                o[1] = px[1];
+                o[2] = px[2];
                 if alpha {
-                    o[3] = encode_linear(c.w);
+                    o[3] = px[3];
                 }
             }
         });
