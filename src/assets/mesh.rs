@@ -25,6 +25,10 @@ pub struct Mesh {
     /// Counter-clockwise triangles (front faces).
     pub triangles: Vec<[u32; 3]>,
     pub groups: Vec<Group>,
+    /// Per triangle corner (3 per triangle): unit tangent (xyz) and
+    /// bitangent sign (w), MikkTSpace; empty unless a normal or bump map
+    /// needs them (`compute_tangents`).
+    pub tangents: Vec<glam::Vec4>,
 }
 
 impl Mesh {
@@ -37,6 +41,68 @@ impl Mesh {
 
     pub fn has_uvs(&self) -> bool {
         !self.uvs.is_empty()
+    }
+}
+
+impl Mesh {
+    /// MikkTSpace tangents per triangle corner, for OBJ-convention texture
+    /// coordinates (v up, so the bitangent points up the image, the way
+    /// OpenGL-style tangent-space normal maps store green). Corners whose
+    /// triangle has no usable UV area get a tangent perpendicular to the
+    /// normal instead, never NaN.
+    pub fn compute_tangents(&mut self) {
+        let n = self.triangles.len() * 3;
+        self.tangents = vec![glam::Vec4::ZERO; n];
+        if self.has_uvs() {
+            let mut g = MikkGeometry {
+                mesh: self,
+                out: vec![glam::Vec4::ZERO; n],
+            };
+            mikktspace::generate_tangents(&mut g);
+            let out = g.out;
+            self.tangents = out;
+        }
+        for (c, t) in self.tangents.iter_mut().enumerate() {
+            let nrm = self.normals[self.triangles[c / 3][c % 3] as usize];
+            let xyz = t.truncate();
+            let ok = xyz.is_finite() && xyz.length_squared() > 1e-12 && t.w != 0.0;
+            let xyz = if ok {
+                (xyz - nrm * nrm.dot(xyz)).try_normalize()
+            } else {
+                None
+            };
+            *t = match xyz {
+                Some(v) => v.extend(if t.w < 0.0 { -1.0 } else { 1.0 }),
+                None => nrm.any_orthonormal_vector().extend(1.0),
+            };
+        }
+    }
+}
+
+struct MikkGeometry<'a> {
+    mesh: &'a Mesh,
+    out: Vec<glam::Vec4>,
+}
+
+impl mikktspace::Geometry for MikkGeometry<'_> {
+    fn num_faces(&self) -> usize {
+        self.mesh.triangles.len()
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.positions[self.mesh.triangles[face][vert] as usize].to_array()
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.normals[self.mesh.triangles[face][vert] as usize].to_array()
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        let uv = self.mesh.uvs[self.mesh.triangles[face][vert] as usize];
+        [uv.x, 1.0 - uv.y]
+    }
+    fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
+        self.out[face * 3 + vert] = glam::Vec4::from_array(tangent);
     }
 }
 
@@ -99,6 +165,49 @@ mod tests {
         assert!((n[1] - Vec3::Y).length() < 1e-6, "{:?}", n[1]);
         assert_eq!(n[1], n[3]);
         assert!((n[0] - Vec3::new(-1.0, 1.0, 0.0).normalize()).length() < 1e-6);
+    }
+
+    #[test]
+    fn tangents_follow_u_and_survive_zero_uv_area() {
+        // A quad in the xy plane, u along +x, v (OBJ, up) along +y; a third
+        // triangle whose UVs are all equal.
+        let mut m = Mesh {
+            positions: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(3.0, 0.0, 0.0),
+                Vec3::new(2.0, 1.0, 0.0),
+            ],
+            normals: vec![Vec3::Z; 7],
+            // image convention: v down
+            uvs: vec![
+                Vec2::new(0.0, 1.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(0.0, 0.0),
+                Vec2::splat(0.5),
+                Vec2::splat(0.5),
+                Vec2::splat(0.5),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]],
+            groups: vec![],
+            tangents: vec![],
+        };
+        m.compute_tangents();
+        for c in 0..6 {
+            let t = m.tangents[c];
+            assert!((t.truncate() - Vec3::X).length() < 1e-4, "{t}");
+            // bitangent = w * n x t = +y (up the image)
+            assert!((Vec3::Z.cross(t.truncate()) * t.w - Vec3::Y).length() < 1e-4);
+        }
+        for c in 6..9 {
+            let t = m.tangents[c];
+            assert!(t.is_finite() && (t.truncate().length() - 1.0).abs() < 1e-4);
+            assert!(t.truncate().dot(Vec3::Z).abs() < 1e-4);
+        }
     }
 
     #[test]

@@ -28,6 +28,8 @@ pub struct MapSpec {
     pub offset: [f32; 3],
     /// `-clamp on`.
     pub clamp: bool,
+    /// `-mm base gain` (displacement and bump heights: base + gain * h).
+    pub mm: Option<(f32, f32)>,
 }
 
 /// A material as the MTL file states it; unset keys stay `None`.
@@ -48,8 +50,18 @@ pub struct MtlMaterial {
     pub map_ke: Option<MapSpec>,
     pub map_ns: Option<MapSpec>,
     pub map_d: Option<MapSpec>,
+    /// `map_Bump` / `bump`: a normal map or a height map, told apart by
+    /// content (a grey image is heights).
     pub map_bump: Option<MapSpec>,
+    /// `norm`: always a normal map.
+    pub norm: Option<MapSpec>,
     pub disp: Option<MapSpec>,
+    /// Scene-only keys (overrides), absent from MTL files.
+    pub bump_scale: Option<f32>,
+    pub normal_space: Option<crate::scene::desc::NormalSpace>,
+    pub alpha_mode: Option<crate::scene::desc::AlphaModeDesc>,
+    pub alpha_cutoff: Option<f32>,
+    pub disp_scale: Option<f32>,
     /// Made up by the loader for faces without a material (no MTL, or no
     /// `usemtl`): the renderer's defaults apply rather than MTL's.
     pub synthetic: bool,
@@ -258,9 +270,11 @@ fn convert_material(m: &tobj::Material, base: &Path, mtl: &Path) -> Result<MtlMa
         map_ke: map(unknown("map_Ke"))?,
         map_ns: map(m.shininess_texture.as_ref())?,
         map_d: map(m.dissolve_texture.as_ref())?,
-        map_bump: map(m.normal_texture.as_ref().or(unknown("norm")))?,
+        map_bump: map(m.normal_texture.as_ref().or(unknown("bump")))?,
+        norm: map(unknown("norm"))?,
         disp: map(unknown("disp"))?,
         synthetic: false,
+        ..Default::default()
     })
 }
 
@@ -281,6 +295,7 @@ pub fn parse_map(raw: &str, base: &Path) -> Result<MapSpec, String> {
         scale: [1.0; 3],
         offset: [0.0; 3],
         clamp: false,
+        mm: None,
     };
     let mut rest = raw.trim();
     while let Some(opt) = rest.strip_prefix('-') {
@@ -319,6 +334,7 @@ pub fn parse_map(raw: &str, base: &Path) -> Result<MapSpec, String> {
         match name {
             "bm" => spec.bump_scale = Some(num(0)),
             "clamp" => spec.clamp = args[0] == "on",
+            "mm" => spec.mm = Some((num(0), num(1))),
             "s" => {
                 for (i, s) in spec.scale.iter_mut().enumerate().take(args.len()) {
                     *s = num(i);

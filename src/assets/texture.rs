@@ -19,18 +19,37 @@ use std::sync::OnceLock;
 use glam::{Vec2, Vec4};
 
 use crate::error::Error;
-use crate::scene::desc::AddressMode;
+use crate::scene::desc::{AddressMode, TextureFilter};
+
+/// One image of a mip chain: RGBA8 in 4x4 blocks (see the module notes).
+#[derive(Debug)]
+pub struct Level {
+    pub width: u32,
+    pub height: u32,
+    texels: Vec<[u8; 4]>,
+    /// Blocks per row of blocks.
+    blocks_x: u32,
+}
 
 #[derive(Debug)]
 pub struct Texture {
     pub width: u32,
     pub height: u32,
-    /// RGBA8 in 4x4 blocks (see the module notes); row 0 at the top.
-    texels: Vec<[u8; 4]>,
-    /// Blocks per row of blocks.
-    blocks_x: u32,
+    /// Level 0, as decoded.
+    base: Level,
+    /// Levels 1.. (down to 1x1), built on first need (`ensure_mips`).
+    mips: OnceLock<Vec<Level>>,
     /// Color data stored sRGB-encoded (decoded to linear on fetch).
     pub srgb: bool,
+    /// Index in the scene's texture list (per-frame state is kept by it).
+    pub id: usize,
+    /// Some texel has alpha below 255.
+    pub has_alpha: bool,
+    /// Of the texels with alpha below 255, the share that is 0 or 255-ish
+    /// (a cutout rather than a gradual mask); 1 without alpha.
+    pub binary_alpha: f32,
+    /// Every texel has R = G = B (a height map rather than a normal map).
+    pub grey: bool,
 }
 
 /// How a material refers to a texture: the texture plus the MTL options that
@@ -44,6 +63,22 @@ pub struct TextureRef {
     pub offset: Vec2,
     /// Per-texture address mode (`-clamp on`), else the scene's.
     pub address: Option<AddressMode>,
+}
+
+/// How to filter a lookup that carries screen-space derivatives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Filtering {
+    pub filter: TextureFilter,
+    pub max_anisotropy: f32,
+    /// False where this frame never minifies the texture: level 0 only.
+    pub mips: bool,
+}
+
+/// Texture-coordinate derivatives along screen x and y (from a 2x2 quad).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Gradients {
+    pub dx: Vec2,
+    pub dy: Vec2,
 }
 
 /// sRGB-encoded byte -> linear float.
@@ -77,6 +112,42 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 /// Border color for `address = "border"` and NaN coordinates: transparent black.
 pub const BORDER: Vec4 = Vec4::ZERO;
 
+impl Level {
+    fn new(width: u32, height: u32) -> Level {
+        let blocks_x = width.div_ceil(4);
+        let blocks_y = height.div_ceil(4);
+        Level {
+            width,
+            height,
+            texels: vec![[0; 4]; (blocks_x * blocks_y * 16) as usize],
+            blocks_x,
+        }
+    }
+
+    /// From row-major texels (row 0 at the top).
+    fn from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
+        let mut l = Level::new(width, height);
+        for (y, row) in rows.chunks_exact(width as usize).enumerate() {
+            for (x, &texel) in row.iter().enumerate() {
+                let i = l.index(x as u32, y as u32);
+                l.texels[i] = texel;
+            }
+        }
+        l
+    }
+
+    /// Position of texel (x, y) in the block layout.
+    #[inline(always)]
+    fn index(&self, x: u32, y: u32) -> usize {
+        ((((y >> 2) * self.blocks_x + (x >> 2)) << 4) | ((y & 3) << 2) | (x & 3)) as usize
+    }
+
+    #[inline]
+    pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
+        self.texels[self.index(x, y)]
+    }
+}
+
 impl Texture {
     /// Decodes PNG, TGA (RLE, either origin) or JPEG by content.
     pub fn load(path: &Path, srgb: bool) -> Result<Texture, Error> {
@@ -100,39 +171,65 @@ impl Texture {
     pub fn from_rgba8(width: u32, height: u32, texels: Vec<[u8; 4]>, srgb: bool) -> Texture {
         assert_eq!(texels.len(), (width as usize) * (height as usize));
         assert!(width > 0 && height > 0);
-        let blocks_x = width.div_ceil(4);
-        let blocks_y = height.div_ceil(4);
-        let mut t = Texture {
+        let grey = texels.iter().all(|t| t[0] == t[1] && t[1] == t[2]);
+        let partial = texels.iter().filter(|t| t[3] < 255).count();
+        let hard = texels.iter().filter(|t| t[3] < 8).count();
+        Texture {
             width,
             height,
-            texels: vec![[0; 4]; (blocks_x * blocks_y * 16) as usize],
-            blocks_x,
+            base: Level::from_rows(width, height, &texels),
+            mips: OnceLock::new(),
             srgb,
-        };
-        for (y, row) in texels.chunks_exact(width as usize).enumerate() {
-            for (x, &texel) in row.iter().enumerate() {
-                let i = t.index(x as u32, y as u32);
-                t.texels[i] = texel;
-            }
+            id: 0,
+            has_alpha: partial > 0,
+            binary_alpha: if partial == 0 {
+                1.0
+            } else {
+                hard as f32 / partial as f32
+            },
+            grey,
         }
-        t
     }
 
-    /// Position of texel (x, y) in the block layout.
-    #[inline(always)]
-    fn index(&self, x: u32, y: u32) -> usize {
-        ((((y >> 2) * self.blocks_x + (x >> 2)) << 4) | ((y & 3) << 2) | (x & 3)) as usize
-    }
-
-    /// The stored texel at (x, y), inside the image.
+    /// The stored texel at (x, y) of level 0.
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
-        self.texels[self.index(x, y)]
+        self.base.texel(x, y)
+    }
+
+    /// Number of levels of the full chain (down to 1x1).
+    pub fn level_count(&self) -> usize {
+        (32 - self.width.max(self.height).leading_zeros()) as usize
+    }
+
+    /// Whether the chain below level 0 has been built.
+    pub fn has_mips(&self) -> bool {
+        self.mips.get().is_some()
+    }
+
+    /// Builds levels 1.. once (box filter in linear space, parallel over
+    /// rows). Call outside of parallel shading.
+    pub fn ensure_mips(&self) {
+        self.mips
+            .get_or_init(|| crate::assets::mip::build_chain(self));
+    }
+
+    /// Level `i` (0 = base), if built.
+    pub fn level(&self, i: usize) -> Option<&Level> {
+        if i == 0 {
+            Some(&self.base)
+        } else {
+            self.mips.get().and_then(|m| m.get(i - 1))
+        }
+    }
+
+    pub(crate) fn level_from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
+        Level::from_rows(width, height, rows)
     }
 
     #[inline]
-    fn fetch(&self, x: i64, y: i64) -> Vec4 {
-        self.decode(self.texel(x as u32, y as u32))
+    fn fetch(&self, l: &Level, x: i64, y: i64) -> Vec4 {
+        self.decode(l.texel(x as u32, y as u32))
     }
 
     /// Nearest-texel lookup at texture coordinates `uv` (top-left origin).
@@ -140,31 +237,102 @@ impl Texture {
         if !uv.is_finite() {
             return BORDER;
         }
-        let x = (uv.x as f64 * self.width as f64).floor();
-        let y = (uv.y as f64 * self.height as f64).floor();
-        match (address(x, self.width, mode), address(y, self.height, mode)) {
-            (Some(x), Some(y)) => self.fetch(x, y),
+        let l = &self.base;
+        let x = (uv.x as f64 * l.width as f64).floor();
+        let y = (uv.y as f64 * l.height as f64).floor();
+        match (address(x, l.width, mode), address(y, l.height, mode)) {
+            (Some(x), Some(y)) => self.fetch(l, x, y),
             _ => BORDER,
         }
     }
 
-    /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
+    /// Bilinear lookup in level 0.
     #[inline]
     pub fn sample_bilinear(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+        self.bilinear(&self.base, uv, mode)
+    }
+
+    /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
+    #[inline]
+    pub fn bilinear(&self, l: &Level, uv: Vec2, mode: AddressMode) -> Vec4 {
         // Fast path: all four texels inside the image, so no address mode
         // applies (the case for almost every lookup of a model's own UVs).
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = uv.y * self.height as f32 - 0.5;
-        if x >= 0.0 && y >= 0.0 && x < (self.width - 1) as f32 && y < (self.height - 1) as f32 {
+        let x = uv.x * l.width as f32 - 0.5;
+        let y = uv.y * l.height as f32 - 0.5;
+        if x >= 0.0 && y >= 0.0 && x < (l.width - 1) as f32 && y < (l.height - 1) as f32 {
             let (x0, y0) = (x as u32, y as u32);
             let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-            let (a, b) = (self.texel(x0, y0), self.texel(x0 + 1, y0));
-            let (c, d) = (self.texel(x0, y0 + 1), self.texel(x0 + 1, y0 + 1));
+            let (a, b) = (l.texel(x0, y0), l.texel(x0 + 1, y0));
+            let (c, d) = (l.texel(x0, y0 + 1), l.texel(x0 + 1, y0 + 1));
             let top = self.decode(a).lerp(self.decode(b), fx);
             let bottom = self.decode(c).lerp(self.decode(d), fx);
             return top.lerp(bottom, fy);
         }
-        self.sample_bilinear_wrapped(uv, mode)
+        self.bilinear_wrapped(l, uv, mode)
+    }
+
+    /// Trilinear lookup at level of detail `lod` (clamped to the chain;
+    /// level 0 only while the chain is not built).
+    pub fn sample_lod(&self, uv: Vec2, mode: AddressMode, lod: f32) -> Vec4 {
+        let Some(mips) = self.mips.get().filter(|_| lod > 0.0) else {
+            return self.bilinear(&self.base, uv, mode);
+        };
+        let top = mips.len() as f32;
+        let lod = lod.min(top);
+        let i = lod.floor();
+        let f = lod - i;
+        let i = i as usize;
+        let level = |k: usize| if k == 0 { &self.base } else { &mips[k - 1] };
+        let a = self.bilinear(level(i), uv, mode);
+        if f <= 0.0 || i + 1 > mips.len() {
+            return a;
+        }
+        a.lerp(self.bilinear(level(i + 1), uv, mode), f)
+    }
+
+    /// Filtered lookup with screen-space derivatives: nearest and bilinear
+    /// read level 0; trilinear picks the level from the longer footprint
+    /// axis; anisotropic takes up to `max_anisotropy` trilinear probes
+    /// spread along the longer axis, at the level of the shorter one.
+    pub fn sample_grad(&self, uv: Vec2, g: Gradients, mode: AddressMode, f: Filtering) -> Vec4 {
+        match f.filter {
+            TextureFilter::Nearest => self.sample_nearest(uv, mode),
+            TextureFilter::Bilinear => self.sample_bilinear(uv, mode),
+            _ if !f.mips => self.sample_bilinear(uv, mode),
+            TextureFilter::Trilinear => {
+                let size = Vec2::new(self.width as f32, self.height as f32);
+                let (lx, ly) = ((g.dx * size).length(), (g.dy * size).length());
+                self.sample_lod(uv, mode, lod_of(lx.max(ly)))
+            }
+            TextureFilter::Anisotropic => {
+                let size = Vec2::new(self.width as f32, self.height as f32);
+                let (ax, ay) = (g.dx * size, g.dy * size);
+                let (lx, ly) = (ax.length(), ay.length());
+                let (major, minor, axis) = if lx >= ly {
+                    (lx, ly, g.dx)
+                } else {
+                    (ly, lx, g.dy)
+                };
+                let ratio = if minor > 0.0 {
+                    major / minor
+                } else {
+                    f32::INFINITY
+                };
+                let n = ratio.min(f.max_anisotropy).ceil().max(1.0);
+                if !n.is_finite() || n <= 1.0 {
+                    return self.sample_lod(uv, mode, lod_of(major));
+                }
+                // n probes cover the major axis; each filters major / n.
+                let lod = lod_of(major / n);
+                let count = n as u32;
+                let mut sum = Vec4::ZERO;
+                for k in 0..count {
+                    let t = (k as f32 + 0.5) / n - 0.5;
+                    sum += self.sample_lod(uv + axis * t, mode, lod);
+                }
+                sum / n
+            }
+        }
     }
 
     #[inline]
@@ -183,33 +351,38 @@ impl Texture {
     }
 
     /// The general case: any finite coordinate, through the address mode.
-    fn sample_bilinear_wrapped(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+    fn bilinear_wrapped(&self, l: &Level, uv: Vec2, mode: AddressMode) -> Vec4 {
         if !uv.is_finite() {
             return BORDER;
         }
         // f64 keeps the fraction exact for coordinates far from the origin.
-        let x = uv.x as f64 * self.width as f64 - 0.5;
-        let y = uv.y as f64 * self.height as f64 - 0.5;
+        let x = uv.x as f64 * l.width as f64 - 0.5;
+        let y = uv.y as f64 * l.height as f64 - 0.5;
         let x0 = x.floor();
         let y0 = y.floor();
         let fx = (x - x0) as f32;
         let fy = (y - y0) as f32;
-        let xs = [
-            address(x0, self.width, mode),
-            address(x0 + 1.0, self.width, mode),
-        ];
+        let xs = [address(x0, l.width, mode), address(x0 + 1.0, l.width, mode)];
         let ys = [
-            address(y0, self.height, mode),
-            address(y0 + 1.0, self.height, mode),
+            address(y0, l.height, mode),
+            address(y0 + 1.0, l.height, mode),
         ];
         let get = |xi: Option<i64>, yi: Option<i64>| match (xi, yi) {
-            (Some(x), Some(y)) => self.fetch(x, y),
+            (Some(x), Some(y)) => self.fetch(l, x, y),
             _ => BORDER,
         };
         let top = get(xs[0], ys[0]).lerp(get(xs[1], ys[0]), fx);
         let bottom = get(xs[0], ys[1]).lerp(get(xs[1], ys[1]), fx);
         top.lerp(bottom, fy)
     }
+}
+
+/// Level of detail for a footprint of `texels` texels per pixel. NaN (from
+/// degenerate derivatives) reads level 0.
+#[inline]
+fn lod_of(texels: f32) -> f32 {
+    let l = texels.log2();
+    if l.is_nan() { 0.0 } else { l.max(0.0) }
 }
 
 /// Maps an integer texel coordinate (given as a whole f64) into the texture,
@@ -254,6 +427,24 @@ impl TextureRef {
         } else {
             self.texture.sample_bilinear(uv, mode)
         }
+    }
+
+    /// Filtered lookup with derivatives (the `-s` scale applies to them).
+    #[inline]
+    pub fn sample_grad(
+        &self,
+        uv: Vec2,
+        g: Gradients,
+        default_mode: AddressMode,
+        f: Filtering,
+    ) -> Vec4 {
+        let uv = uv * self.scale + self.offset;
+        let g = Gradients {
+            dx: g.dx * self.scale,
+            dy: g.dy * self.scale,
+        };
+        let mode = self.address.unwrap_or(default_mode);
+        self.texture.sample_grad(uv, g, mode, f)
     }
 }
 
@@ -303,7 +494,7 @@ mod tests {
             Vec2::new(0.21, 0.7),
         ] {
             let a = big.sample_bilinear(uv, AddressMode::Repeat);
-            let b = big.sample_bilinear_wrapped(uv, AddressMode::Repeat);
+            let b = big.bilinear_wrapped(&big.base, uv, AddressMode::Repeat);
             assert!((a - b).abs().max_element() < 1e-5, "{a} {b}");
         }
     }

@@ -77,6 +77,18 @@ impl Visibility {
     /// triangle (submission order decides coplanar ties, deterministically).
     #[inline]
     pub fn draw<const REVERSE_Z: bool>(&mut self, t: &Tri, id: u32) {
+        self.draw_if::<REVERSE_Z>(t, id, |_, _| true);
+    }
+
+    /// As `draw`, for pixels that also pass `keep(px, py)` (the alpha test
+    /// of cutout materials), asked only where the depth test passes.
+    #[inline]
+    pub fn draw_if<const REVERSE_Z: bool>(
+        &mut self,
+        t: &Tri,
+        id: u32,
+        mut keep: impl FnMut(i32, i32) -> bool,
+    ) {
         let rect = self.rect;
         let stride = rect.width();
         let (depth, ids) = (&mut self.depth, &mut self.id);
@@ -88,10 +100,16 @@ impl Visibility {
                 z < depth[i]
             };
             // z outside [0,1] only comes from rounding at clipped edges.
-            if pass && (0.0..=1.0).contains(&z) {
+            if pass && (0.0..=1.0).contains(&z) && keep(px, py) {
                 depth[i] = z;
                 ids[i] = id;
             }
         });
     }
+}
+
+/// Whether depth `z` is in front of the stored depth `stored`.
+#[inline]
+pub fn in_front(z: f32, stored: f32, reverse_z: bool) -> bool {
+    (0.0..=1.0).contains(&z) && if reverse_z { z > stored } else { z < stored }
 }

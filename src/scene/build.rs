@@ -13,8 +13,9 @@ use rayon::prelude::*;
 use super::animation::{Animation, Turntable};
 use super::camera::{Camera, Projection, fitted_planes};
 use super::desc::{self, Ctx, MaterialOverride, S, SceneDesc};
+use super::desc::{AlphaModeDesc, NormalSpace};
 use super::light::{Light, LightKind};
-use super::material::Material;
+use super::material::{AlphaMode, Material, NormalMap};
 use super::overrides::{self, SetOverride};
 use super::{Model, OutputSettings, RenderSettings, Scene, check_pattern};
 use crate::assets::obj::{self, MapSpec, MtlMaterial};
@@ -30,7 +31,6 @@ pub struct LoadOptions {
     pub out_dir: Option<PathBuf>,
 }
 
-const TEXTURE_ISSUE: &str = "it comes with mip-mapped texturing";
 const SHADOW_ISSUE: &str = "it comes with shadows, AO and EXR outputs";
 const WORKFLOW_ISSUE: &str = "it comes with anti-aliasing and GIF output";
 const GLTF_ISSUE: &str = "it comes with glTF support";
@@ -78,19 +78,6 @@ fn refuse_unsupported(d: &SceneDesc, ctx: &Ctx) -> Result<(), Error> {
     {
         return Err(unsupported(ctx, m, "render.msaa > 1", WORKFLOW_ISSUE));
     }
-    if let Some(f) = &r.texture_filter
-        && matches!(
-            f.get_ref(),
-            desc::TextureFilter::Trilinear | desc::TextureFilter::Anisotropic
-        )
-    {
-        return Err(unsupported(
-            ctx,
-            f,
-            "render.texture_filter trilinear/anisotropic",
-            TEXTURE_ISSUE,
-        ));
-    }
     if let Some(ao) = &r.ao
         && get(&ao.get_ref().method, desc::AoMethod::Off) != desc::AoMethod::Off
     {
@@ -127,35 +114,6 @@ fn refuse_unsupported(d: &SceneDesc, ctx: &Ctx) -> Result<(), Error> {
                 return Err(unsupported(ctx, v, key, GLTF_ISSUE));
             }
         }
-        for o in m.material.iter().chain(m.materials.values()) {
-            refuse_override(ctx, o.get_ref())?;
-        }
-    }
-    Ok(())
-}
-
-fn refuse_override(ctx: &Ctx, o: &MaterialOverride) -> Result<(), Error> {
-    for (v, key) in [
-        (&o.map_ns, "map_ns"),
-        (&o.map_d, "map_d"),
-        (&o.map_bump, "map_bump"),
-        (&o.norm, "norm"),
-        (&o.disp, "disp"),
-    ] {
-        if let Some(v) = v {
-            return Err(unsupported(ctx, v, key, TEXTURE_ISSUE));
-        }
-    }
-    if let Some(v) = &o.bump_scale {
-        return Err(unsupported(ctx, v, "bump_scale", TEXTURE_ISSUE));
-    }
-    if let Some(v) = &o.normal_space {
-        return Err(unsupported(ctx, v, "normal_space", TEXTURE_ISSUE));
-    }
-    if let Some(v) = &o.d
-        && *v.get_ref() < 1.0
-    {
-        return Err(unsupported(ctx, v, "transparency (d < 1)", TEXTURE_ISSUE));
     }
     Ok(())
 }
@@ -175,6 +133,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         height: get(&o.height, 800) as u32,
         shading: get(&r.shading, Default::default()),
         texture_filter: get(&r.texture_filter, Default::default()),
+        max_anisotropy: get(&r.max_anisotropy, 16) as f32,
         address: get(&r.address, Default::default()),
         cull: get(&r.cull, Default::default()),
         depth: get(&r.depth, Default::default()),
@@ -202,8 +161,10 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     // Models: each file parsed once, even if several [[model]] use it.
     let textured = !matches!(
         settings.shading,
-        desc::ShadingMode::Normals | desc::ShadingMode::Depth | desc::ShadingMode::Wireframe
+        desc::ShadingMode::Depth | desc::ShadingMode::Wireframe
     );
+    // The normals view reads normal and bump maps only.
+    let normals_view = settings.shading == desc::ShadingMode::Normals;
     let mut files: BTreeMap<PathBuf, usize> = BTreeMap::new();
     let mut file_list = Vec::new();
     for m in &d.models {
@@ -263,9 +224,6 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                 Ok(mm)
             })
             .collect::<Result<Vec<_>, Error>>()?;
-        for mm in &mats {
-            warn_ignored(mm);
-        }
         model_mats.push(mats);
     }
     let mut wanted: BTreeMap<(PathBuf, bool), Option<Arc<Texture>>> = BTreeMap::new();
@@ -279,7 +237,10 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                 if !src.mesh.groups.iter().any(|g| g.material == i) {
                     continue;
                 }
-                for (map, srgb) in color_maps(mm) {
+                for (k, (map, srgb)) in shading_maps(mm).into_iter().enumerate() {
+                    if normals_view && k < 6 {
+                        continue;
+                    }
                     if let Some(map) = map {
                         wanted.insert((map.path.clone(), srgb), None);
                     }
@@ -290,8 +251,15 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let keys: Vec<_> = wanted.keys().cloned().collect();
     let decoded: Vec<Arc<Texture>> = keys
         .par_iter()
-        .map(|(p, srgb)| Texture::load(p, *srgb).map(Arc::new))
+        .enumerate()
+        .map(|(id, (p, srgb))| {
+            Texture::load(p, *srgb).map(|mut t| {
+                t.id = id;
+                Arc::new(t)
+            })
+        })
         .collect::<Result<_, _>>()?;
+    let textures = decoded.clone();
     for (k, t) in keys.into_iter().zip(decoded) {
         wanted.insert(k, Some(t));
     }
@@ -322,13 +290,22 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                 * Mat4::from_scale(Vec3::splat(1.0 / extent))
                 * Mat4::from_translation(-(lo + hi) * 0.5);
         }
+        let mut mesh = src.mesh.clone();
+        for (gi, mm) in mats.iter().enumerate() {
+            if let Some(spec) = &mm.disp {
+                displace(&mut mesh, gi, spec, mm.disp_scale)?;
+            }
+        }
+        if materials.iter().any(|m| m.needs_tangents()) && textured {
+            mesh.compute_tangents();
+        }
         models.push(Model {
             name: md
                 .name
                 .as_ref()
                 .map(|n| n.get_ref().clone())
                 .unwrap_or_else(|| format!("model{i}")),
-            mesh: Arc::new(src.mesh.clone()),
+            mesh: Arc::new(mesh),
             materials,
             world_from_object: world,
         });
@@ -379,6 +356,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         },
         bounds_center: center,
         bounds_radius: radius,
+        textures,
     })
 }
 
@@ -420,11 +398,31 @@ fn apply_override(
             .map(|s| obj::parse_map(s.get_ref(), scene_dir).map_err(|msg| ctx.err(s.span(), msg)))
             .transpose()
     };
+    if let Some(v) = &o.bump_scale {
+        m.bump_scale = Some(*v.get_ref());
+    }
+    if let Some(v) = &o.normal_space {
+        m.normal_space = Some(*v.get_ref());
+    }
+    if let Some(v) = &o.alpha_mode {
+        m.alpha_mode = Some(*v.get_ref());
+    }
+    if let Some(v) = &o.alpha_cutoff {
+        m.alpha_cutoff = Some(*v.get_ref());
+    }
+    if let Some(v) = &o.disp_scale {
+        m.disp_scale = Some(*v.get_ref());
+    }
     for (slot, v) in [
         (&mut m.map_ka, &o.map_ka),
         (&mut m.map_kd, &o.map_kd),
         (&mut m.map_ks, &o.map_ks),
         (&mut m.map_ke, &o.map_ke),
+        (&mut m.map_ns, &o.map_ns),
+        (&mut m.map_d, &o.map_d),
+        (&mut m.map_bump, &o.map_bump),
+        (&mut m.norm, &o.norm),
+        (&mut m.disp, &o.disp),
     ] {
         if let Some(spec) = map(v)? {
             if !spec.path.is_file() {
@@ -443,38 +441,19 @@ fn apply_override(
     Ok(())
 }
 
-/// The maps this issue's shading reads, with whether they hold sRGB color.
-fn color_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 4] {
+/// The maps shading reads, with whether they hold sRGB color (`disp` is
+/// read at load time, by `displace`).
+fn shading_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 8] {
     [
         (&m.map_ka, true),
         (&m.map_kd, true),
         (&m.map_ks, true),
         (&m.map_ke, true),
+        (&m.map_ns, false),
+        (&m.map_d, false),
+        (&m.map_bump, false),
+        (&m.norm, false),
     ]
-}
-
-/// MTL features that the texture issue will implement; said once per material.
-fn warn_ignored(m: &MtlMaterial) {
-    let mut ignored = Vec::new();
-    if m.map_bump.is_some() {
-        ignored.push("normal/bump map");
-    }
-    if m.disp.is_some() {
-        ignored.push("displacement map");
-    }
-    if m.map_ns.is_some() {
-        ignored.push("map_Ns");
-    }
-    if m.map_d.is_some() || m.d.is_some_and(|d| d < 1.0) {
-        ignored.push("transparency (d/map_d)");
-    }
-    if !ignored.is_empty() {
-        eprintln!(
-            "warning: material `{}`: {} not supported yet, rendered without",
-            m.name,
-            ignored.join(", ")
-        );
-    }
 }
 
 fn to_material(
@@ -486,6 +465,52 @@ fn to_material(
     let constant = |c: Option<[f32; 3]>, map: &Option<MapSpec>, fallback: Vec3| {
         c.map(Vec3::from)
             .unwrap_or(if map.is_some() { Vec3::ONE } else { fallback })
+    };
+    let map_kd = tex(&m.map_kd, true);
+    let map_d = tex(&m.map_d, false);
+    let opacity = m.d.unwrap_or(1.0);
+    let bump_scale = |spec: &Option<MapSpec>| {
+        m.bump_scale
+            .or(spec.as_ref().and_then(|s| s.bump_scale))
+            .unwrap_or(1.0)
+    };
+    let space = m.normal_space.unwrap_or(NormalSpace::Tangent);
+    let normal_map = if let Some(map) = tex(&m.norm, false) {
+        Some(NormalMap::Normals {
+            map,
+            space,
+            scale: bump_scale(&m.norm),
+        })
+    } else if let Some(map) = tex(&m.map_bump, false) {
+        // map_Bump holds either: a grey image is heights, a colored one normals.
+        let scale = bump_scale(&m.map_bump);
+        if map.texture.grey && m.normal_space.is_none() {
+            Some(NormalMap::Height { map, scale })
+        } else {
+            Some(NormalMap::Normals { map, space, scale })
+        }
+    } else {
+        None
+    };
+    // Opacity: a constant below 1 blends; an alpha channel that is (almost)
+    // all-or-nothing is a cutout, a gradual one blends.
+    let alpha_texture = map_d
+        .iter()
+        .chain(map_kd.iter())
+        .find(|t| t.texture.has_alpha);
+    let cutoff = m.alpha_cutoff.unwrap_or(0.5);
+    let alpha = match m.alpha_mode {
+        Some(AlphaModeDesc::Opaque) => AlphaMode::Opaque,
+        Some(AlphaModeDesc::Mask) => AlphaMode::Mask(cutoff),
+        Some(AlphaModeDesc::Blend) => AlphaMode::Blend,
+        None if opacity < 1.0 => AlphaMode::Blend,
+        None => match alpha_texture {
+            Some(t) if t.texture.binary_alpha >= 0.9 => AlphaMode::Mask(cutoff),
+            Some(_) => AlphaMode::Blend,
+            // A grey map_d without alpha channel: its red channel.
+            None if map_d.is_some() => AlphaMode::Blend,
+            None => AlphaMode::Opaque,
+        },
     };
     Material {
         name: m.name.clone(),
@@ -499,10 +524,83 @@ fn to_material(
         ns: m.ns.unwrap_or(d.ns),
         illum: m.illum.unwrap_or(2),
         map_ka: tex(&m.map_ka, true),
-        map_kd: tex(&m.map_kd, true),
+        map_kd,
         map_ks: tex(&m.map_ks, true),
         map_ke: tex(&m.map_ke, true),
+        map_ns: tex(&m.map_ns, false),
+        d: opacity,
+        map_d,
+        normal_map,
+        alpha,
     }
+}
+
+/// Displacement at load time: every vertex of material `group_material`'s
+/// triangles moves along its normal by `base + gain * height` (MTL `-mm`,
+/// default 0 and 1) times `scale` (scene `disp_scale`, default 1), the height
+/// read bilinearly from the map. Vertices at one position (UV seams) move by
+/// their mean, so the surface does not crack; their normals are then
+/// recomputed from the displaced faces.
+fn displace(
+    mesh: &mut crate::assets::mesh::Mesh,
+    group_material: usize,
+    spec: &MapSpec,
+    scale: Option<f32>,
+) -> Result<(), Error> {
+    let used: Vec<bool> = {
+        let mut used = vec![false; mesh.positions.len()];
+        for g in mesh.groups.iter().filter(|g| g.material == group_material) {
+            for t in &mesh.triangles[g.triangles.start as usize..g.triangles.end as usize] {
+                for &i in t {
+                    used[i as usize] = true;
+                }
+            }
+        }
+        used
+    };
+    if !used.iter().any(|u| *u) {
+        return Ok(());
+    }
+    if !mesh.has_uvs() {
+        return Err(Error::asset(
+            &spec.path,
+            None,
+            "disp: the model has no texture coordinates to read heights with",
+        ));
+    }
+    let tex = Texture::load(&spec.path, false)?;
+    let (base, gain) = spec.mm.unwrap_or((0.0, 1.0));
+    let scale = scale.unwrap_or(1.0);
+    let mode = if spec.clamp {
+        desc::AddressMode::Clamp
+    } else {
+        desc::AddressMode::Repeat
+    };
+    let map = |uv: Vec2| {
+        let uv = uv * Vec2::new(spec.scale[0], spec.scale[1])
+            + Vec2::new(spec.offset[0], spec.offset[1]);
+        tex.sample_bilinear(uv, mode).x
+    };
+    // Mean offset per welded position.
+    let mut sums: std::collections::HashMap<[u32; 3], (f32, u32)> = Default::default();
+    let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    for i in 0..mesh.positions.len() {
+        if used[i] {
+            let h = (base + gain * map(mesh.uvs[i])) * scale;
+            let e = sums.entry(key(mesh.positions[i])).or_insert((0.0, 0));
+            e.0 += h;
+            e.1 += 1;
+        }
+    }
+    let old = mesh.positions.clone();
+    for i in 0..mesh.positions.len() {
+        if used[i] {
+            let (sum, n) = sums[&key(old[i])];
+            mesh.positions[i] = old[i] + mesh.normals[i] * (sum / n as f32);
+        }
+    }
+    crate::assets::mesh::smooth_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals, &used);
+    Ok(())
 }
 
 fn to_light(l: &desc::LightDesc) -> Light {

@@ -73,8 +73,8 @@ pub enum ShadingMode {
 #[serde(rename_all = "kebab-case")]
 pub enum TextureFilter {
     Nearest,
-    #[default]
     Bilinear,
+    #[default]
     Trilinear,
     Anisotropic,
 }
@@ -218,6 +218,22 @@ pub struct MaterialOverride {
     pub disp: Option<S<String>>,
     pub bump_scale: Option<S<f32>>,
     pub normal_space: Option<S<NormalSpace>>,
+    /// Extension: "opaque" | "mask" | "blend" (default: from d, map_d and
+    /// the alpha of map_Kd).
+    pub alpha_mode: Option<S<AlphaModeDesc>>,
+    /// Extension: opacity below which a "mask" pixel is dropped (0.5).
+    pub alpha_cutoff: Option<S<f32>>,
+    /// Extension: world units per unit of `disp` height (default 1, or the
+    /// MTL's `-mm` gain).
+    pub disp_scale: Option<S<f32>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum AlphaModeDesc {
+    Opaque,
+    Mask,
+    Blend,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -478,6 +494,8 @@ fn validate_override(c: &Ctx, o: &MaterialOverride) -> Result<(), Error> {
     c.float_range(&o.d, "d", 0.0, 1.0)?;
     c.int_range(&o.illum, "illum", 0, 10)?;
     c.finite(&o.bump_scale, "bump_scale")?;
+    c.float_range(&o.alpha_cutoff, "alpha_cutoff", 0.0, 1.0)?;
+    c.finite(&o.disp_scale, "disp_scale")?;
     Ok(())
 }
 

@@ -28,6 +28,7 @@ pub struct RenderSettings {
     pub height: u32,
     pub shading: ShadingMode,
     pub texture_filter: TextureFilter,
+    pub max_anisotropy: f32,
     pub address: AddressMode,
     pub cull: CullMode,
     pub depth: DepthMode,
@@ -70,6 +71,8 @@ pub struct Scene {
     /// World-space bounding sphere of all models at rest.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
+    /// Every decoded texture; `Texture::id` indexes this list.
+    pub textures: Vec<Arc<crate::assets::texture::Texture>>,
 }
 
 impl Scene {

@@ -7,19 +7,20 @@
 //! Each tile owns its pixels: no locks, no shared writes, and the same frame
 //! whatever the number of threads.
 
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::raster::coverage::{NO_TRIANGLE, Visibility};
-use crate::raster::interp::Interpolator;
-use crate::raster::setup::{Tri, Viewport, setup};
+use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
 use crate::scene::Scene;
 use crate::scene::camera::{Camera, Projection};
-use crate::scene::desc::{DepthMode, ShadingMode};
+use crate::scene::desc::{DepthMode, ShadingMode, TextureFilter};
 use crate::scene::light::{Light, LightKind};
-use crate::shade::{ShadeContext, Surface, background, blinn_phong};
+use crate::scene::material::AlphaMode;
+use crate::shade::{ShadeContext, background, blinn_phong};
+
+mod band;
 
 /// A rendered frame in linear space, before tone mapping.
 #[derive(Debug, Clone)]
@@ -117,6 +118,10 @@ struct ModelVertices {
     clip: Vec<Vec4>,
     /// Gouraud only: per-vertex (diffuse, specular) light sums.
     light: Vec<(Vec3, Vec3)>,
+    /// Per triangle corner: world-space tangent and bitangent sign (empty
+    /// when the mesh has no tangents).
+    tangent: Vec<Vec4>,
+    normal_from_object: Mat3,
 }
 
 /// One model's triangles that share a material.
@@ -186,14 +191,26 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
     let grid = TileGrid::bands(s.width, s.height);
     let (gx, gy) = vp.guard_band();
     let cull = s.cull;
-    let per_chunk: Vec<(Vec<Tri>, Vec<Vec<u32>>)> = chunks
+    let filtered = matches!(
+        s.texture_filter,
+        TextureFilter::Trilinear | TextureFilter::Anisotropic
+    ) && !scene.textures.is_empty();
+    let per_chunk: Vec<(Vec<Tri>, Vec<Vec<u32>>, f32)> = chunks
         .par_iter()
         .map(|&(di, start, end)| {
             let d = draws[di];
             let mesh = &scene.models[d.model].mesh;
             let clip = &verts[d.model].clip;
             let mut tris = Vec::with_capacity((end - start) as usize);
+            let density = filtered
+                && mesh.has_uvs()
+                && scene.models[d.model].materials[d.material]
+                    .maps()
+                    .next()
+                    .is_some();
+            let mut max_density = 0.0f32;
             for prim in start..end {
+                let before = tris.len();
                 let idx = mesh.triangles[prim as usize];
                 let v = idx.map(|i| clip[i as usize]);
                 let base = |k: usize, b: Vec3| ClipVertex { pos: v[k], bary: b };
@@ -210,25 +227,71 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
                         }
                     }
                 }
+                if density {
+                    for t in &tris[before..] {
+                        max_density = max_density.max(uv_density(t, mesh, idx));
+                    }
+                }
             }
             let bins = bin(&tris, &grid);
-            (tris, bins)
+            (tris, bins, max_density)
         })
         .collect();
     let mut offsets = Vec::with_capacity(per_chunk.len());
     let mut total = 0u32;
-    for (t, _) in &per_chunk {
+    for (t, _, _) in &per_chunk {
         offsets.push(total);
         total += t.len() as u32;
     }
     let tris: Vec<Tri> = per_chunk
         .iter()
-        .flat_map(|(t, _)| t.iter().copied())
+        .flat_map(|(t, _, _)| t.iter().copied())
         .collect();
 
-    let ctx = shade_context(fs);
-    let bg = background(s.background);
-    let reverse = s.depth == DepthMode::ReverseZ;
+    // Mip chains for the textures this frame minifies (built once, on the
+    // first frame that needs them); the others read level 0 only, so a
+    // frame's pixels do not depend on which frames came before.
+    let mut mips = vec![false; scene.textures.len()];
+    for (&(di, _, _), (_, _, density)) in chunks.iter().zip(&per_chunk) {
+        let d = draws[di];
+        for map in scene.models[d.model].materials[d.material].maps() {
+            let t = &map.texture;
+            let texels =
+                density * t.width as f32 * t.height as f32 * (map.scale.x * map.scale.y).abs();
+            // Footprints of half a texel and up: the level-of-detail can
+            // pass 0 somewhere in such a triangle.
+            if texels > 0.25 {
+                mips[t.id] = true;
+            }
+        }
+    }
+    scene
+        .textures
+        .par_iter()
+        .filter(|t| mips[t.id])
+        .for_each(|t| t.ensure_mips());
+
+    let ctx = shade_context(fs, &mips);
+    let alpha: Vec<AlphaMode> = draws
+        .iter()
+        .map(|d| scene.models[d.model].materials[d.material].alpha)
+        .collect();
+    let data = band::FrameData {
+        fs,
+        ctx,
+        verts: &verts,
+        draws: &draws,
+        alpha: &alpha,
+        tris: &tris,
+        reverse: s.depth == DepthMode::ReverseZ,
+        bg: background(s.background),
+        grads: filtered,
+    };
+    let bins: Vec<(&[Vec<u32>], u32)> = per_chunk
+        .iter()
+        .zip(&offsets)
+        .map(|((_, b, _), off)| (b.as_slice(), *off))
+        .collect();
     // Each band owns its rows of the frame: visibility, then shading
     // straight into the frame buffer.
     let band = (grid.tile_w * grid.tile_h) as usize;
@@ -238,20 +301,24 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         .zip(frame.depth.par_chunks_mut(band))
         .enumerate()
         .for_each(|(ti, (color, depth))| {
-            let rect = grid.rect(ti);
-            let mut vis = Visibility::new(rect, reverse);
-            for ((_, bins), off) in per_chunk.iter().zip(&offsets) {
-                for &i in &bins[ti] {
-                    let id = off + i;
-                    if reverse {
-                        vis.draw::<true>(&tris[id as usize], id);
-                    } else {
-                        vis.draw::<false>(&tris[id as usize], id);
-                    }
-                }
-            }
-            shade_tile(fs, &ctx, &verts, &draws, &tris, &vis, bg, color, depth);
+            data.render_band(grid.rect(ti), ti, &bins, color, depth);
         });
+}
+
+/// UV area per pixel area of a set-up triangle (texture units squared per
+/// pixel squared), from its barycentrics in the original triangle.
+fn uv_density(t: &Tri, mesh: &crate::assets::mesh::Mesh, idx: [u32; 3]) -> f32 {
+    let uv = idx.map(|i| mesh.uvs[i as usize]);
+    let at = |b: Vec3| uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    let [a, b, c] = t.bary.map(at);
+    let uv_area = (b - a).perp_dot(c - a).abs();
+    let px = SUBPIXEL as f64;
+    let px_area = t.area2 as f64 / (px * px);
+    if px_area <= 0.0 {
+        return 0.0;
+    }
+    let d = (uv_area as f64 / px_area) as f32;
+    if d.is_finite() { d } else { 0.0 }
 }
 
 fn vertex_stage(
@@ -294,7 +361,7 @@ fn vertex_stage(
                 }
             }
         }
-        let ctx = shade_context(fs);
+        let ctx = shade_context(fs, &[]);
         light = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -303,15 +370,26 @@ fn vertex_stage(
             })
             .collect();
     }
+    // Tangents follow the surface (not the inverse transpose); a mirroring
+    // transform flips the bitangent.
+    let m3 = Mat3::from_mat4(world_from_object);
+    let flip = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
+    let tangent = mesh
+        .tangents
+        .par_iter()
+        .map(|t| (m3 * t.truncate()).normalize_or(Vec3::X).extend(t.w * flip))
+        .collect();
     ModelVertices {
         world,
         normal,
         clip,
         light,
+        tangent,
+        normal_from_object,
     }
 }
 
-fn shade_context<'a>(fs: &'a FrameSetup) -> ShadeContext<'a> {
+fn shade_context<'a>(fs: &'a FrameSetup, mips: &'a [bool]) -> ShadeContext<'a> {
     let s = &fs.scene.settings;
     let cam = &fs.camera;
     let forward = cam.forward();
@@ -327,116 +405,9 @@ fn shade_context<'a>(fs: &'a FrameSetup) -> ShadeContext<'a> {
         forward,
         orthographic: matches!(cam.projection, Projection::Orthographic { .. }),
         filter: s.texture_filter,
+        max_anisotropy: s.max_anisotropy,
         address: s.address,
+        mips,
         depth_range: (lo, hi),
     }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn shade_tile(
-    fs: &FrameSetup,
-    ctx: &ShadeContext,
-    verts: &[ModelVertices],
-    draws: &[Draw],
-    tris: &[Tri],
-    vis: &Visibility,
-    bg: Vec4,
-    color: &mut [Vec4],
-    depth: &mut [f32],
-) {
-    let rect = vis.rect;
-    let tw = rect.width();
-    color.fill(bg);
-    depth.fill(f32::INFINITY);
-    let mode = ctx.mode;
-    let ortho = ctx.orthographic;
-    // Runs of pixels from one triangle share its interpolator.
-    let mut current = NO_TRIANGLE;
-    let mut it: Option<Interpolator> = None;
-    for (i, &id) in vis.id.iter().enumerate() {
-        if id == NO_TRIANGLE {
-            continue;
-        }
-        let px = rect.x0 + (i % tw) as i32;
-        let py = rect.y0 + (i / tw) as i32;
-        let t = &tris[id as usize];
-        if id != current {
-            current = id;
-            it = Some(Interpolator::new(t));
-        }
-        let Some(it) = &it else { continue };
-        let frag = it.at_pixel(px, py);
-        let d = draws[t.draw as usize];
-        let model = &fs.scene.models[d.model];
-        let mv = &verts[d.model];
-        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
-        let l = frag.lambda;
-        let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
-        let position = lerp3(&mv.world);
-        let raw_normal = lerp3(&mv.normal);
-        let view_depth = if ortho {
-            (position - ctx.eye).dot(ctx.forward)
-        } else {
-            frag.w
-        };
-        let normal = if mode == ShadingMode::Flat {
-            let [a, b, c] = idx.map(|k| mv.world[k]);
-            (b - a).cross(c - a).normalize_or(raw_normal)
-        } else {
-            raw_normal.normalize_or(Vec3::Y)
-        };
-        // Light the side the camera sees.
-        let normal = if t.front { normal } else { -normal };
-        let uv = model.mesh.has_uvs().then(|| {
-            let uv = &model.mesh.uvs;
-            uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
-        });
-        let vertex_light = (!mv.light.is_empty()).then(|| {
-            let g = |k: usize| mv.light[idx[k]];
-            let (a, b, c) = (g(0), g(1), g(2));
-            (
-                a.0 * l.x + b.0 * l.y + c.0 * l.z,
-                a.1 * l.x + b.1 * l.y + c.1 * l.z,
-            )
-        });
-        let edge_distance = if mode == ShadingMode::Wireframe {
-            edge_distance(it, px, py, l)
-        } else {
-            f32::INFINITY
-        };
-        let surface = Surface {
-            material: &model.materials[d.material],
-            position,
-            normal,
-            raw_normal,
-            uv,
-            view_depth,
-            vertex_light,
-            edge_distance,
-        };
-        let c = ctx.shade(&surface);
-        // A NaN from degenerate input must not poison the frame.
-        color[i] = if c.is_finite() {
-            c.extend(1.0)
-        } else {
-            Vec4::W
-        };
-        depth[i] = view_depth;
-    }
-}
-
-/// Screen-space distance (pixels) from the pixel center to the nearest edge
-/// of the original triangle: each barycentric over the length of its
-/// screen-space gradient.
-fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
-    let dx = it.at_pixel(px + 1, py).lambda - l;
-    let dy = it.at_pixel(px, py + 1).lambda - l;
-    let mut best = f32::INFINITY;
-    for k in 0..3 {
-        let g = Vec2::new(dx[k], dy[k]).length();
-        if g > 0.0 {
-            best = best.min(l[k] / g);
-        }
-    }
-    best
 }

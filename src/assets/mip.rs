@@ -1,0 +1,145 @@
+//! Mip chains: each level half the size of the one above (rounded down, at
+//! least 1), down to 1x1, for any size including non-powers of two.
+//!
+//! Filtering happens in linear space (sRGB maps decoded first) with an
+//! area-weighted box: each texel of the smaller level averages the texels of
+//! the larger level under its footprint, with fractional weights at the
+//! edges of the footprint when a size is odd, so no texel is dropped and
+//! none counts twice. Levels are kept as RGBA8 (re-encoded to sRGB for color
+//! maps) in the same block layout as level 0. Alpha is averaged like the
+//! other channels (straight, not premultiplied).
+
+use glam::Vec4;
+use rayon::prelude::*;
+
+use super::texture::{Level, Texture, srgb_to_linear_table};
+use crate::shade::tonemap::{encode_linear, encode_srgb};
+
+/// Levels 1.. of `t` (empty for a 1x1 texture).
+pub fn build_chain(t: &Texture) -> Vec<Level> {
+    let mut levels = Vec::new();
+    let Some(base) = t.level(0) else {
+        return levels;
+    };
+    // Level 0 decoded row by row on the fly; later levels from floats.
+    let lut = srgb_to_linear_table();
+    let decode = |p: [u8; 4]| {
+        if t.srgb {
+            Vec4::new(
+                lut[p[0] as usize],
+                lut[p[1] as usize],
+                lut[p[2] as usize],
+                p[3] as f32 / 255.0,
+            )
+        } else {
+            Vec4::new(p[0] as f32, p[1] as f32, p[2] as f32, p[3] as f32) / 255.0
+        }
+    };
+    let (mut w, mut h) = (t.width, t.height);
+    let mut prev: Option<Vec<Vec4>> = None;
+    while w > 1 || h > 1 {
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let src = |x: u32, y: u32| -> Vec4 {
+            match &prev {
+                Some(p) => p[(y * w + x) as usize],
+                None => decode(base.texel(x, y)),
+            }
+        };
+        let wx = weights(w, nw);
+        let wy = weights(h, nh);
+        let mut next = vec![Vec4::ZERO; (nw * nh) as usize];
+        next.par_chunks_mut(nw as usize)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, out) in row.iter_mut().enumerate() {
+                    let mut acc = Vec4::ZERO;
+                    for &(sy, fy) in &wy[y] {
+                        for &(sx, fx) in &wx[x] {
+                            acc += src(sx, sy) * (fx * fy);
+                        }
+                    }
+                    *out = acc;
+                }
+            });
+        let bytes: Vec<[u8; 4]> = next
+            .par_iter()
+            .map(|c| {
+                let e = |v: f32| {
+                    if t.srgb {
+                        encode_srgb(v)
+                    } else {
+                        encode_linear(v)
+                    }
+                };
+                [e(c.x), e(c.y), e(c.z), encode_linear(c.w)]
+            })
+            .collect();
+        levels.push(Texture::level_from_rows(nw, nh, &bytes));
+        prev = Some(next);
+        (w, h) = (nw, nh);
+    }
+    levels
+}
+
+/// For each of the `dst` texels along one axis, the `src` texels under its
+/// footprint and their weights (summing to 1).
+fn weights(src: u32, dst: u32) -> Vec<Vec<(u32, f32)>> {
+    let step = src as f64 / dst as f64;
+    (0..dst)
+        .map(|i| {
+            let (a, b) = (i as f64 * step, (i + 1) as f64 * step);
+            let mut v = Vec::new();
+            let mut k = a.floor() as u32;
+            while (k as f64) < b && k < src {
+                let lo = (k as f64).max(a);
+                let hi = ((k + 1) as f64).min(b);
+                if hi > lo {
+                    v.push((k, ((hi - lo) / step) as f32));
+                }
+                k += 1;
+            }
+            v
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_cover_every_source_texel_once() {
+        for (s, d) in [(8, 4), (5, 2), (7, 3), (1, 1), (3, 1)] {
+            let w = weights(s, d);
+            let mut per_src = vec![0.0f32; s as usize];
+            for taps in &w {
+                let sum: f32 = taps.iter().map(|t| t.1).sum();
+                assert!((sum - 1.0).abs() < 1e-6, "{s}->{d}");
+                for &(k, f) in taps {
+                    per_src[k as usize] += f;
+                }
+            }
+            // Each source texel contributes the same total weight.
+            for v in per_src {
+                assert!((v - d as f32 / s as f32).abs() < 1e-5, "{s}->{d}");
+            }
+        }
+    }
+
+    #[test]
+    fn chain_of_a_non_power_of_two_keeps_the_mean_in_linear_space() {
+        // 5x3 sRGB texture: half black, half white columns.
+        let texels: Vec<[u8; 4]> = (0..15)
+            .map(|i| if i % 5 < 2 { [0, 0, 0, 255] } else { [255; 4] })
+            .collect();
+        let t = Texture::from_rgba8(5, 3, texels, true);
+        let chain = build_chain(&t);
+        let sizes: Vec<_> = chain.iter().map(|l| (l.width, l.height)).collect();
+        assert_eq!(sizes, vec![(2, 1), (1, 1)]);
+        assert_eq!(t.level_count(), 3);
+        // 3/5 white in linear: the 1x1 level is linear 0.6, sRGB ~203.
+        let top = chain[1].texel(0, 0);
+        let lin = srgb_to_linear_table()[top[0] as usize];
+        assert!((lin - 0.6).abs() < 0.01, "{top:?} {lin}");
+    }
+}

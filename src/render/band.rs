@@ -1,0 +1,297 @@
+//! One band of the frame: visibility (depth test, with the alpha test of
+//! cutout materials), then shading of each visible pixel in 2x2 quads, then
+//! the blended (transparent) triangles, back to front, over the result.
+//!
+//! Quads give texture-coordinate derivatives the way a GPU does: each
+//! triangle present in a quad is interpolated at all four of its pixel
+//! centers (extrapolated where it does not cover them, "helper lanes"), and
+//! the differences across the quad's top row and left column are d/dx and
+//! d/dy ("coarse" derivatives).
+
+use glam::{Vec2, Vec3, Vec4};
+
+use super::{Draw, FrameSetup, ModelVertices};
+use crate::assets::texture::Gradients;
+use crate::raster::bin::TileRect;
+use crate::raster::coverage::{NO_TRIANGLE, Visibility, in_front, raster_triangle};
+use crate::raster::interp::{Fragment, Interpolator};
+use crate::raster::setup::Tri;
+use crate::scene::desc::ShadingMode;
+use crate::scene::material::AlphaMode;
+use crate::shade::{ShadeContext, Surface};
+
+/// What every band of one frame reads.
+pub(super) struct FrameData<'a> {
+    pub fs: &'a FrameSetup<'a>,
+    pub ctx: ShadeContext<'a>,
+    pub verts: &'a [ModelVertices],
+    pub draws: &'a [Draw],
+    /// Per draw.
+    pub alpha: &'a [AlphaMode],
+    pub tris: &'a [Tri],
+    pub reverse: bool,
+    pub bg: Vec4,
+    /// Texture filtering needs derivatives (trilinear, anisotropic).
+    pub grads: bool,
+}
+
+impl FrameData<'_> {
+    /// Renders band `ti` (pixels `rect`) into its rows of the frame.
+    /// `bins`: per setup chunk, its per-band triangle lists and the index of
+    /// its first triangle.
+    pub fn render_band(
+        &self,
+        rect: TileRect,
+        ti: usize,
+        bins: &[(&[Vec<u32>], u32)],
+        color: &mut [Vec4],
+        depth: &mut [f32],
+    ) {
+        let mut vis = Visibility::new(rect, self.reverse);
+        let mut blended = Vec::new();
+        for (b, off) in bins {
+            for &i in &b[ti] {
+                let id = off + i;
+                let t = &self.tris[id as usize];
+                match self.alpha[t.draw as usize] {
+                    AlphaMode::Opaque => self.draw_opaque(&mut vis, t, id),
+                    AlphaMode::Mask(cutoff) => {
+                        let it = Interpolator::new(t);
+                        let keep = |px: i32, py: i32| {
+                            let f = it.at_pixel(px, py);
+                            let (m, uv) = self.material_uv(t, f.lambda);
+                            self.ctx.opacity(m, uv, Gradients::default()) >= cutoff
+                        };
+                        if self.reverse {
+                            vis.draw_if::<true>(t, id, keep);
+                        } else {
+                            vis.draw_if::<false>(t, id, keep);
+                        }
+                    }
+                    AlphaMode::Blend => blended.push(id),
+                }
+            }
+        }
+        self.shade_visible(&vis, color, depth);
+        if !blended.is_empty() {
+            self.blend(&vis, blended, color);
+        }
+    }
+
+    #[inline]
+    fn draw_opaque(&self, vis: &mut Visibility, t: &Tri, id: u32) {
+        if self.reverse {
+            vis.draw::<true>(t, id);
+        } else {
+            vis.draw::<false>(t, id);
+        }
+    }
+
+    /// Shades every visible pixel once, quad by quad.
+    fn shade_visible(&self, vis: &Visibility, color: &mut [Vec4], depth: &mut [f32]) {
+        let rect = vis.rect;
+        let (tw, th) = (rect.width(), rect.height());
+        color.fill(self.bg);
+        depth.fill(f32::INFINITY);
+        let mut current = NO_TRIANGLE;
+        let mut it: Option<Interpolator> = None;
+        for qy in (0..th).step_by(2) {
+            for qx in (0..tw).step_by(2) {
+                // Derivatives of the (at most four) triangles in this quad.
+                let mut quad: [(u32, Gradients); 4] = [(NO_TRIANGLE, Gradients::default()); 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (x, y) = (qx + dx, qy + dy);
+                    if x >= tw || y >= th {
+                        continue;
+                    }
+                    let i = y * tw + x;
+                    let id = vis.id[i];
+                    if id == NO_TRIANGLE {
+                        continue;
+                    }
+                    let t = &self.tris[id as usize];
+                    if id != current || it.is_none() {
+                        current = id;
+                        it = Some(Interpolator::new(t));
+                    }
+                    let Some(it) = &it else { continue };
+                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
+                    let g = if self.grads {
+                        let slot = quad
+                            .iter()
+                            .position(|q| q.0 == id || q.0 == NO_TRIANGLE)
+                            .unwrap_or(0);
+                        if quad[slot].0 != id {
+                            let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
+                            quad[slot] = (id, self.gradients(t, it, q0));
+                        }
+                        quad[slot].1
+                    } else {
+                        Gradients::default()
+                    };
+                    let frag = it.at_pixel(px, py);
+                    let (c, d) = self.shade(t, it, frag, px, py, g);
+                    // A NaN from degenerate input must not poison the frame.
+                    color[i] = if c.is_finite() {
+                        c.extend(1.0)
+                    } else {
+                        Vec4::W
+                    };
+                    depth[i] = d;
+                }
+            }
+        }
+    }
+
+    /// Blended triangles, farthest first (by mean depth; ties in submission
+    /// order), each pixel in front of the opaque surface composited over it.
+    fn blend(&self, vis: &Visibility, mut ids: Vec<u32>, color: &mut [Vec4]) {
+        let rect = vis.rect;
+        let tw = rect.width();
+        let far_key = |id: &u32| {
+            let z = self.tris[*id as usize].z;
+            let mean = (z[0] + z[1] + z[2]) / 3.0;
+            // Larger key = farther.
+            if self.reverse { -mean } else { mean }
+        };
+        ids.sort_by(|a, b| far_key(b).total_cmp(&far_key(a)).then(a.cmp(b)));
+        for id in ids {
+            let t = &self.tris[id as usize];
+            let it = Interpolator::new(t);
+            raster_triangle(t, rect, |px, py, z| {
+                let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
+                if !in_front(z, vis.depth[i], self.reverse) {
+                    return;
+                }
+                let g = if self.grads {
+                    self.gradients(t, &it, (px & !1, py & !1))
+                } else {
+                    Gradients::default()
+                };
+                let frag = it.at_pixel(px, py);
+                let (c, _) = self.shade(t, &it, frag, px, py, g);
+                let (m, uv) = self.material_uv(t, frag.lambda);
+                let a = self.ctx.opacity(m, uv, g).clamp(0.0, 1.0);
+                if !c.is_finite() {
+                    return;
+                }
+                let dst = color[i];
+                color[i] = (c * a + dst.truncate() * (1.0 - a)).extend(a + dst.w * (1.0 - a));
+            });
+        }
+    }
+
+    fn material_uv(&self, t: &Tri, l: Vec3) -> (&crate::scene::Material, Option<Vec2>) {
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let uv = model.mesh.has_uvs().then(|| {
+            let idx = model.mesh.triangles[t.prim as usize];
+            let uv = &model.mesh.uvs;
+            uv[idx[0] as usize] * l.x + uv[idx[1] as usize] * l.y + uv[idx[2] as usize] * l.z
+        });
+        (&model.materials[d.material], uv)
+    }
+
+    /// Texture-coordinate derivatives of `t` over the quad whose top-left
+    /// pixel is `q0`.
+    fn gradients(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
+        let uv = |px: i32, py: i32| self.material_uv(t, it.at_pixel(px, py).lambda).1;
+        match (uv(q0.0, q0.1), uv(q0.0 + 1, q0.1), uv(q0.0, q0.1 + 1)) {
+            (Some(a), Some(b), Some(c)) => Gradients {
+                dx: b - a,
+                dy: c - a,
+            },
+            _ => Gradients::default(),
+        }
+    }
+
+    /// Color (linear, or the data view's value) and view depth of triangle
+    /// `t` at pixel (px, py).
+    fn shade(
+        &self,
+        t: &Tri,
+        it: &Interpolator,
+        frag: Fragment,
+        px: i32,
+        py: i32,
+        grads: Gradients,
+    ) -> (Vec3, f32) {
+        let ctx = &self.ctx;
+        let mode = ctx.mode;
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let mv = &self.verts[d.model];
+        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
+        let l = frag.lambda;
+        let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
+        let position = lerp3(&mv.world);
+        let raw_normal = lerp3(&mv.normal);
+        let view_depth = if ctx.orthographic {
+            (position - ctx.eye).dot(ctx.forward)
+        } else {
+            frag.w
+        };
+        let normal = if mode == ShadingMode::Flat {
+            let [a, b, c] = idx.map(|k| mv.world[k]);
+            (b - a).cross(c - a).normalize_or(raw_normal)
+        } else {
+            raw_normal.normalize_or(Vec3::Y)
+        };
+        // Light the side the camera sees.
+        let normal = if t.front { normal } else { -normal };
+        let uv = model.mesh.has_uvs().then(|| {
+            let uv = &model.mesh.uvs;
+            uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
+        });
+        let tangent = (!mv.tangent.is_empty()).then(|| {
+            let c = t.prim as usize * 3;
+            let tt = &mv.tangent;
+            let v = tt[c] * l.x + tt[c + 1] * l.y + tt[c + 2] * l.z;
+            // The sign is per triangle (MikkTSpace keeps it constant).
+            v.truncate().extend(tt[c].w)
+        });
+        let vertex_light = (!mv.light.is_empty()).then(|| {
+            let g = |k: usize| mv.light[idx[k]];
+            let (a, b, c) = (g(0), g(1), g(2));
+            (
+                a.0 * l.x + b.0 * l.y + c.0 * l.z,
+                a.1 * l.x + b.1 * l.y + c.1 * l.z,
+            )
+        });
+        let edge_distance = if mode == ShadingMode::Wireframe {
+            edge_distance(it, px, py, l)
+        } else {
+            f32::INFINITY
+        };
+        let surface = Surface {
+            material: &model.materials[d.material],
+            position,
+            normal,
+            raw_normal,
+            uv,
+            grads,
+            tangent,
+            normal_from_object: mv.normal_from_object,
+            view_depth,
+            vertex_light,
+            edge_distance,
+        };
+        (ctx.shade(&surface), view_depth)
+    }
+}
+
+/// Screen-space distance (pixels) from the pixel center to the nearest edge
+/// of the original triangle: each barycentric over the length of its
+/// screen-space gradient.
+fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
+    let dx = it.at_pixel(px + 1, py).lambda - l;
+    let dy = it.at_pixel(px, py + 1).lambda - l;
+    let mut best = f32::INFINITY;
+    for k in 0..3 {
+        let g = Vec2::new(dx[k], dy[k]).length();
+        if g > 0.0 {
+            best = best.min(l[k] / g);
+        }
+    }
+    best
+}
