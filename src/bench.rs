@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::output;
-use crate::render::{Frame, FrameSetup, render_into};
+use crate::render::{Frame, FrameSetup, render_frame, render_into};
 use crate::scene::Scene;
 use crate::scene::build::LoadOptions;
 use crate::scene::light::{Light, LightKind};
@@ -161,6 +161,16 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
 }
 
 pub fn run(args: &BenchArgs) -> Result<(), Error> {
+    if args.case == "filters" {
+        let dir = std::env::temp_dir().join(format!("softraster-filters-{}", std::process::id()));
+        let r = filter_accuracy(&dir, 320, 240);
+        let _ = std::fs::remove_dir_all(&dir);
+        println!("filter,mean_abs_error_linear,ms_per_frame_320x240");
+        for f in r? {
+            println!("{},{:.5},{:.2}", f.filter, f.mean_error, f.ms);
+        }
+        return Ok(());
+    }
     let cases: Vec<&str> = match args.case.as_str() {
         "all" => vec!["diablo3", "nefertiti"],
         c => vec![c],
@@ -191,4 +201,75 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// One texture filter's accuracy on the grazing-angle checkerboard.
+#[derive(Debug, Clone)]
+pub struct FilterResult {
+    pub filter: &'static str,
+    /// Mean absolute error per channel against the 16x16 supersampled
+    /// reference, linear RGB.
+    pub mean_error: f64,
+    pub ms: f64,
+}
+
+/// A checkerboard plane seen at a grazing angle, rendered `width` x
+/// `height` with each texture filter and compared with the same frame
+/// rendered at 16x16 the resolution (anisotropic 16x) and box-averaged.
+/// Writes its plane and texture into `dir`.
+pub fn filter_accuracy(dir: &Path, width: u32, height: u32) -> Result<Vec<FilterResult>, Error> {
+    use crate::procedural;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let obj = procedural::ground(40.0, 0.0, 40.0).to_obj("plane", "plane.mtl", "checker");
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| Error::io(&p, e))
+    };
+    write("plane.obj", &obj.text)?;
+    write(
+        "plane.mtl",
+        "newmtl checker\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd checker.png\n",
+    )?;
+    output::png::write(
+        &dir.join("checker.png"),
+        &procedural::checker(64, 2, [235, 235, 235], [20, 20, 20]),
+    )?;
+    let scene = |w: u32, h: u32, filter: &str| -> Result<Scene, Error> {
+        let text = format!(
+            "[output]\nwidth = {w}\nheight = {h}\n[render]\ntexture_filter = \"{filter}\"\n\
+             max_anisotropy = 16\nshading = \"unlit\"\n[[model]]\npath = \"plane.obj\"\n\
+             [[camera]]\neye = [0.0, 0.6, 40.0]\ntarget = [3.0, 0.0, 20.0]\nfov = 50.0\nnear = 0.05\nfar = 200.0\n"
+        );
+        Scene::from_text(&dir.join("filters.toml"), &text, &LoadOptions::default())
+    };
+    const SS: u32 = 16;
+    let reference = render_frame(&scene(width * SS, height * SS, "anisotropic")?, 0, 0);
+    let mut results = Vec::new();
+    for filter in ["nearest", "bilinear", "trilinear", "anisotropic"] {
+        let s = scene(width, height, filter)?;
+        let t = Instant::now();
+        let f = render_frame(&s, 0, 0);
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let mut err = 0.0f64;
+        for y in 0..height {
+            for x in 0..width {
+                let mut acc = Vec3::ZERO;
+                for sy in 0..SS {
+                    let row = ((y * SS + sy) * width * SS + x * SS) as usize;
+                    for c in &reference.color[row..row + SS as usize] {
+                        acc += c.truncate();
+                    }
+                }
+                let r = acc / (SS * SS) as f32;
+                let c = f.color[(y * width + x) as usize].truncate();
+                err += (c - r).abs().element_sum() as f64;
+            }
+        }
+        results.push(FilterResult {
+            filter,
+            mean_error: err / (width * height * 3) as f64,
+            ms,
+        });
+    }
+    Ok(results)
 }

@@ -584,8 +584,8 @@ fn displace(
     // Mean offset per welded position.
     let mut sums: std::collections::HashMap<[u32; 3], (f32, u32)> = Default::default();
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-    for i in 0..mesh.positions.len() {
-        if used[i] {
+    for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
+        {
             let h = (base + gain * map(mesh.uvs[i])) * scale;
             let e = sums.entry(key(mesh.positions[i])).or_insert((0.0, 0));
             e.0 += h;
@@ -593,8 +593,8 @@ fn displace(
         }
     }
     let old = mesh.positions.clone();
-    for i in 0..mesh.positions.len() {
-        if used[i] {
+    for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
+        {
             let (sum, n) = sums[&key(old[i])];
             mesh.positions[i] = old[i] + mesh.normals[i] * (sum / n as f32);
         }
