@@ -132,3 +132,30 @@ fn bunny_nefertiti_teapot() {
     real("nefertiti");
     real("teapot");
 }
+
+#[test]
+fn address_modes() {
+    for mode in ["repeat", "mirror", "clamp", "border"] {
+        check(
+            &format!("address_{mode}"),
+            &root().join("tests/scenes/address.toml"),
+            0,
+            &[&format!("render.address={mode}")],
+        );
+    }
+}
+
+#[test]
+fn displacement_map() {
+    check(
+        "displacement",
+        &root().join("tests/scenes/displacement.toml"),
+        0,
+        &[],
+    );
+}
+
+#[test]
+fn african_head_blended_eye_shell_over_the_iris() {
+    real("african_head_eye");
+}

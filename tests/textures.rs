@@ -255,3 +255,28 @@ fn tangent_and_object_space_maps_of_diablo3_agree() {
     assert!(mean(&tp) > 1.0, "the tangent map changes the normals");
     assert!(within(&to, 10.0) > within(&op, 10.0) * 0.5);
 }
+
+#[test]
+fn mip_chains_are_built_only_for_minified_textures() {
+    let dir = scratch("mips_on_demand");
+    for (size, minified) in [(8u32, false), (256, true)] {
+        let img = Image8 {
+            width: size,
+            height: size,
+            channels: 4,
+            data: [200u8, 100, 50, 255].repeat((size * size) as usize),
+        };
+        png::write(&dir.join("t.png"), &img).unwrap();
+        let s = scene_in(
+            &dir,
+            &format!("{TOP_DOWN}[[model]]\npath = \"quad.obj\"\n"),
+            &[
+                ("quad.obj", QUAD),
+                ("quad.mtl", "newmtl m\nKd 1 1 1\nmap_Kd t.png\n"),
+            ],
+        );
+        assert!(!s.textures[0].has_mips());
+        render_frame(&s, 0, 0);
+        assert_eq!(s.textures[0].has_mips(), minified, "{size}x{size} on 32x32");
+    }
+}
