@@ -585,19 +585,15 @@ fn displace(
     let mut sums: std::collections::HashMap<[u32; 3], (f32, u32)> = Default::default();
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
-        {
-            let h = (base + gain * map(mesh.uvs[i])) * scale;
-            let e = sums.entry(key(mesh.positions[i])).or_insert((0.0, 0));
-            e.0 += h;
-            e.1 += 1;
-        }
+        let h = (base + gain * map(mesh.uvs[i])) * scale;
+        let e = sums.entry(key(mesh.positions[i])).or_insert((0.0, 0));
+        e.0 += h;
+        e.1 += 1;
     }
     let old = mesh.positions.clone();
     for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
-        {
-            let (sum, n) = sums[&key(old[i])];
-            mesh.positions[i] = old[i] + mesh.normals[i] * (sum / n as f32);
-        }
+        let (sum, n) = sums[&key(old[i])];
+        mesh.positions[i] = old[i] + mesh.normals[i] * (sum / n as f32);
     }
     crate::assets::mesh::smooth_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals, &used);
     Ok(())
