@@ -73,6 +73,18 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// Renders `scene` into `out`, expects exit status 2, returns stderr.
+fn exit_2(scene: &Path, out: &Path) -> String {
+    let (code, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    err
+}
+
 #[test]
 fn malformed_toml_exits_2_naming_file_and_line() {
     let dir = common::scratch("bad_toml");
@@ -81,16 +93,14 @@ fn malformed_toml_exits_2_naming_file_and_line() {
         "bad.toml",
         "[[model]]\npath = \"a.obj\"\n[render\nmsaa = 4\n",
     );
-    let (code, err) = run(&["render", s.to_str().unwrap()]);
-    assert_eq!(code, 2, "{err}");
+    let err = exit_2(&s, &dir);
     assert!(err.contains("bad.toml:3:"), "{err}");
     let s = write(
         &dir,
         "unknown.toml",
         "[[model]]\npath = \"a.obj\"\n[render]\nshadin = \"flat\"\n",
     );
-    let (code, err) = run(&["render", s.to_str().unwrap()]);
-    assert_eq!(code, 2);
+    let err = exit_2(&s, &dir);
     assert!(
         err.contains("unknown.toml:4:1") && err.contains("shadin"),
         "{err}"
@@ -101,8 +111,7 @@ fn malformed_toml_exits_2_naming_file_and_line() {
 fn missing_model_exits_2_naming_the_resolved_path() {
     let dir = common::scratch("missing_model");
     let s = write(&dir, "s.toml", "[[model]]\npath = \"nowhere/gone.obj\"\n");
-    let (code, err) = run(&["render", s.to_str().unwrap()]);
-    assert_eq!(code, 2);
+    let err = exit_2(&s, &dir);
     assert!(
         err.contains("nowhere/gone.obj") && err.contains("s.toml:2:"),
         "{err}"
@@ -118,13 +127,7 @@ fn out_of_range_obj_index_exits_2_naming_the_line() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
     );
     let s = write(&dir, "s.toml", "[[model]]\npath = \"m.obj\"\n");
-    let (code, err) = run(&[
-        "render",
-        s.to_str().unwrap(),
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 2);
+    let err = exit_2(&s, &dir);
     assert!(err.contains("m.obj:5") && err.contains("index 9"), "{err}");
 }
 
@@ -143,13 +146,7 @@ fn features_of_later_issues_are_refused_not_ignored() {
             "s.toml",
             &format!("[[model]]\npath = \"m.obj\"\n{text}"),
         );
-        let (code, err) = run(&[
-            "render",
-            s.to_str().unwrap(),
-            "--out",
-            dir.to_str().unwrap(),
-        ]);
-        assert_eq!(code, 2, "{key}: {err}");
+        let err = exit_2(&s, &dir);
         assert!(err.contains("not supported yet"), "{key}: {err}");
     }
 }

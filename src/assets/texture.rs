@@ -125,7 +125,7 @@ impl Level {
     }
 
     /// From row-major texels (row 0 at the top).
-    fn from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
+    pub(crate) fn from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
         let mut l = Level::new(width, height);
         for (y, row) in rows.chunks_exact(width as usize).enumerate() {
             for (x, &texel) in row.iter().enumerate() {
@@ -191,17 +191,6 @@ impl Texture {
         }
     }
 
-    /// The stored texel at (x, y) of level 0.
-    #[inline]
-    pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
-        self.base.texel(x, y)
-    }
-
-    /// Number of levels of the full chain (down to 1x1).
-    pub fn level_count(&self) -> usize {
-        (32 - self.width.max(self.height).leading_zeros()) as usize
-    }
-
     /// Whether the chain below level 0 has been built.
     pub fn has_mips(&self) -> bool {
         self.mips.get().is_some()
@@ -221,10 +210,6 @@ impl Texture {
         } else {
             self.mips.get().and_then(|m| m.get(i - 1))
         }
-    }
-
-    pub(crate) fn level_from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
-        Level::from_rows(width, height, rows)
     }
 
     #[inline]
@@ -335,8 +320,9 @@ impl Texture {
         }
     }
 
+    /// A stored texel as linear RGBA (sRGB color decoded, data /255).
     #[inline]
-    fn decode(&self, t: [u8; 4]) -> Vec4 {
+    pub(crate) fn decode(&self, t: [u8; 4]) -> Vec4 {
         if self.srgb {
             let lut = srgb_to_linear_table();
             Vec4::new(
@@ -415,17 +401,6 @@ impl TextureRef {
             scale: Vec2::ONE,
             offset: Vec2::ZERO,
             address: None,
-        }
-    }
-
-    #[inline]
-    pub fn sample(&self, uv: Vec2, default_mode: AddressMode, nearest: bool) -> Vec4 {
-        let uv = uv * self.scale + self.offset;
-        let mode = self.address.unwrap_or(default_mode);
-        if nearest {
-            self.texture.sample_nearest(uv, mode)
-        } else {
-            self.texture.sample_bilinear(uv, mode)
         }
     }
 

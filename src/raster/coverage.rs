@@ -94,13 +94,7 @@ impl Visibility {
         let (depth, ids) = (&mut self.depth, &mut self.id);
         raster_triangle(t, rect, |px, py, z| {
             let i = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
-            let pass = if REVERSE_Z {
-                z > depth[i]
-            } else {
-                z < depth[i]
-            };
-            // z outside [0,1] only comes from rounding at clipped edges.
-            if pass && (0.0..=1.0).contains(&z) && keep(px, py) {
+            if in_front(z, depth[i], REVERSE_Z) && keep(px, py) {
                 depth[i] = z;
                 ids[i] = id;
             }
@@ -108,7 +102,8 @@ impl Visibility {
     }
 }
 
-/// Whether depth `z` is in front of the stored depth `stored`.
+/// Whether depth `z` is in front of the stored depth `stored` (z outside
+/// [0,1] only comes from rounding at clipped edges and never passes).
 #[inline]
 pub fn in_front(z: f32, stored: f32, reverse_z: bool) -> bool {
     (0.0..=1.0).contains(&z) && if reverse_z { z > stored } else { z < stored }

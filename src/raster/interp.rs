@@ -93,11 +93,6 @@ impl Interpolator {
     }
 }
 
-/// Interpolates at screen position (x, y) in pixels (pixel centers at +0.5).
-pub fn at(t: &Tri, x: f64, y: f64) -> Fragment {
-    Interpolator::new(t).at(x, y)
-}
-
 /// Interpolates at the center of pixel (px, py).
 #[inline]
 pub fn at_pixel(t: &Tri, px: i32, py: i32) -> Fragment {

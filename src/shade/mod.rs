@@ -211,12 +211,13 @@ impl ShadeContext<'_> {
                 let (tt, b) = frame(t);
                 let tex = &map.texture;
                 let size = Vec2::new(tex.width as f32, tex.height as f32) * map.scale;
-                // One texel of the level being read, in each direction.
+                // Central differences across one pixel footprint (at least
+                // one texel), each sample filtered at the footprint's level.
                 let texels = (s.grads.dx * size)
                     .length()
                     .max((s.grads.dy * size).length());
                 let step = texels.max(1.0) / size;
-                let h = |d: Vec2| self.sample(map, uv + d, Gradients::default()).x;
+                let h = |d: Vec2| self.sample(map, uv + d, s.grads).x;
                 let du = (h(Vec2::new(step.x, 0.0)) - h(Vec2::new(-step.x, 0.0))) * 0.5;
                 // Image rows run down; the bitangent points up the image.
                 let dv = (h(Vec2::new(0.0, -step.y)) - h(Vec2::new(0.0, step.y))) * 0.5;
