@@ -150,6 +150,7 @@ fn anchor_lights(scene: &Scene) -> Vec<Light> {
             },
             color: Vec3::new(0.9, 0.88, 0.85),
             shadows: false,
+            range: None,
         },
         Light {
             kind: LightKind::Point {
@@ -158,6 +159,7 @@ fn anchor_lights(scene: &Scene) -> Vec<Light> {
             },
             color: Vec3::new(1.0, 0.95, 0.9),
             shadows: false,
+            range: None,
         },
     ]
 }

@@ -139,6 +139,11 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         let t0 = std::time::Instant::now();
         let scene = Scene::load(&args.scene, &opts)?;
         let load_s = t0.elapsed().as_secs_f64();
+        if !args.quiet {
+            for w in &scene.warnings {
+                eprintln!("warning: {w}");
+            }
+        }
         let frames = match &args.frames {
             Some(f) => parse_frames(f, scene.animation.frames)?,
             None => 0..scene.animation.frames,

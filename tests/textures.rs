@@ -219,7 +219,7 @@ fn tangent_and_object_space_maps_of_diablo3_agree() {
     let mut mesh = softraster::assets::obj::load(&d3.join("diablo3_pose.obj"))
         .unwrap()
         .mesh;
-    mesh.compute_tangents();
+    mesh.compute_tangents(0);
     let tangent_map = Texture::load(&d3.join("diablo3_pose_nm_tangent.tga"), false).unwrap();
     let object_map = Texture::load(&d3.join("diablo3_pose_nm.tga"), false).unwrap();
     let decode = |t: &Texture, uv: glam::Vec2| {

@@ -22,6 +22,15 @@ pub struct Mesh {
     /// Texture coordinates, image convention (v down); empty when the file
     /// has none.
     pub uvs: Vec<Vec2>,
+    /// Second texture-coordinate set (glTF TEXCOORD_1), same convention;
+    /// empty when absent.
+    pub uvs1: Vec<Vec2>,
+    /// Linear RGBA vertex colors (glTF COLOR_0), multiplying the base
+    /// color; empty when absent.
+    pub colors: Vec<glam::Vec4>,
+    /// Tangents given by the file, per vertex (glTF TANGENT): xyz and the
+    /// bitangent sign; w = 0 where none was given. Empty when none at all.
+    pub authored_tangents: Vec<glam::Vec4>,
     /// Counter-clockwise triangles (front faces).
     pub triangles: Vec<[u32; 3]>,
     pub groups: Vec<Group>,
@@ -45,17 +54,20 @@ impl Mesh {
 }
 
 impl Mesh {
-    /// MikkTSpace tangents per triangle corner, for OBJ-convention texture
-    /// coordinates (v up, so the bitangent points up the image, the way
-    /// OpenGL-style tangent-space normal maps store green). Corners whose
-    /// triangle has no usable UV area get a tangent perpendicular to the
-    /// normal instead, never NaN.
-    pub fn compute_tangents(&mut self) {
+    /// MikkTSpace tangents per triangle corner from texture-coordinate set
+    /// `set` (0 or 1), with the bitangent pointing up the image (OBJ's v
+    /// up; glTF's "+Y up" normal maps), the way OpenGL-style tangent-space
+    /// normal maps store green. Tangents the file gives (glTF TANGENT) win
+    /// over computed ones. Corners whose triangle has no usable UV area get
+    /// a tangent perpendicular to the normal instead, never NaN.
+    pub fn compute_tangents(&mut self, set: usize) {
         let n = self.triangles.len() * 3;
         self.tangents = vec![glam::Vec4::ZERO; n];
-        if self.has_uvs() {
+        let uvs = if set == 1 { &self.uvs1 } else { &self.uvs };
+        if !uvs.is_empty() {
             let mut g = MikkGeometry {
                 mesh: self,
+                uvs,
                 out: vec![glam::Vec4::ZERO; n],
             };
             mikktspace::generate_tangents(&mut g);
@@ -63,7 +75,13 @@ impl Mesh {
             self.tangents = out;
         }
         for (c, t) in self.tangents.iter_mut().enumerate() {
-            let nrm = self.normals[self.triangles[c / 3][c % 3] as usize];
+            let vi = self.triangles[c / 3][c % 3] as usize;
+            if let Some(a) = self.authored_tangents.get(vi)
+                && a.w != 0.0
+            {
+                *t = *a;
+            }
+            let nrm = self.normals[vi];
             let xyz = t.truncate();
             let ok = xyz.is_finite() && xyz.length_squared() > 1e-12 && t.w != 0.0;
             let xyz = if ok {
@@ -81,6 +99,7 @@ impl Mesh {
 
 struct MikkGeometry<'a> {
     mesh: &'a Mesh,
+    uvs: &'a [Vec2],
     out: Vec<glam::Vec4>,
 }
 
@@ -98,7 +117,7 @@ impl mikktspace::Geometry for MikkGeometry<'_> {
         self.mesh.normals[self.mesh.triangles[face][vert] as usize].to_array()
     }
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        let uv = self.mesh.uvs[self.mesh.triangles[face][vert] as usize];
+        let uv = self.uvs[self.mesh.triangles[face][vert] as usize];
         [uv.x, 1.0 - uv.y]
     }
     fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
@@ -193,10 +212,9 @@ mod tests {
                 Vec2::splat(0.5),
             ],
             triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]],
-            groups: vec![],
-            tangents: vec![],
+            ..Default::default()
         };
-        m.compute_tangents();
+        m.compute_tangents(0);
         for c in 0..6 {
             let t = m.tangents[c];
             assert!((t.truncate() - Vec3::X).length() < 1e-4, "{t}");

@@ -1,5 +1,7 @@
-//! Asset loaders: meshes and materials from OBJ/MTL, textures from images.
+//! Asset loaders: meshes and materials from OBJ/MTL and glTF, textures from
+//! images.
 
+pub mod gltf;
 pub mod mesh;
 pub mod mip;
 pub mod obj;

@@ -62,6 +62,9 @@ pub struct MtlMaterial {
     pub alpha_mode: Option<crate::scene::desc::AlphaModeDesc>,
     pub alpha_cutoff: Option<f32>,
     pub disp_scale: Option<f32>,
+    /// Scene-only: pbr parameters when this material is shaded as pbr.
+    pub metallic: Option<f32>,
+    pub roughness: Option<f32>,
     /// Made up by the loader for faces without a material (no MTL, or no
     /// `usemtl`): the renderer's defaults apply rather than MTL's.
     pub synthetic: bool,

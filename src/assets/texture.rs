@@ -16,7 +16,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use glam::{Vec2, Vec4};
+use glam::{Affine2, Vec2, Vec4};
 
 use crate::error::Error;
 use crate::scene::desc::{AddressMode, TextureFilter};
@@ -57,12 +57,29 @@ pub struct Texture {
 #[derive(Debug, Clone)]
 pub struct TextureRef {
     pub texture: std::sync::Arc<Texture>,
-    /// `-s`: scales texture coordinates.
-    pub scale: Vec2,
-    /// `-o`: offsets texture coordinates.
-    pub offset: Vec2,
-    /// Per-texture address mode (`-clamp on`), else the scene's.
-    pub address: Option<AddressMode>,
+    /// Applied to the texture coordinates before the lookup: MTL `-s` and
+    /// `-o`, glTF KHR_texture_transform.
+    pub transform: Affine2,
+    /// Per-texture address modes along u and v (MTL `-clamp on`, glTF
+    /// sampler wrapS/wrapT), else the scene's.
+    pub address: Option<Wrap>,
+    /// Texture-coordinate set (0 or 1).
+    pub texcoord: u8,
+    /// The sampler's minification filter when it asks for no mip maps
+    /// (glTF NEAREST / LINEAR): the scene's filter is lowered to it.
+    pub min_limit: Option<TextureFilter>,
+    /// The sampler magnifies with the nearest texel (glTF magFilter NEAREST).
+    pub mag_nearest: bool,
+}
+
+/// Address modes along u and v.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Wrap(pub AddressMode, pub AddressMode);
+
+impl From<AddressMode> for Wrap {
+    fn from(m: AddressMode) -> Wrap {
+        Wrap(m, m)
+    }
 }
 
 /// How to filter a lookup that carries screen-space derivatives.
@@ -155,6 +172,23 @@ impl Texture {
             .map_err(|e| Error::asset(path, None, format!("cannot open texture: {e}")))?
             .with_guessed_format()
             .map_err(|e| Error::asset(path, None, format!("cannot read texture: {e}")))?;
+        Texture::decode_image(reader, path, srgb)
+    }
+
+    /// Decodes an image held in memory (a glTF image in a buffer or a data
+    /// URI); `name` stands for it in errors.
+    pub fn from_bytes(bytes: &[u8], name: &Path, srgb: bool) -> Result<Texture, Error> {
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| Error::asset(name, None, format!("cannot read texture: {e}")))?;
+        Texture::decode_image(reader, name, srgb)
+    }
+
+    fn decode_image<R: std::io::BufRead + std::io::Seek>(
+        reader: image::ImageReader<R>,
+        path: &Path,
+        srgb: bool,
+    ) -> Result<Texture, Error> {
         let img = reader
             .decode()
             .map_err(|e| Error::asset(path, None, format!("cannot decode texture: {e}")))?;
@@ -218,14 +252,15 @@ impl Texture {
     }
 
     /// Nearest-texel lookup at texture coordinates `uv` (top-left origin).
-    pub fn sample_nearest(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
+    pub fn sample_nearest(&self, uv: Vec2, mode: impl Into<Wrap>) -> Vec4 {
+        let mode = mode.into();
         if !uv.is_finite() {
             return BORDER;
         }
         let l = &self.base;
         let x = (uv.x as f64 * l.width as f64).floor();
         let y = (uv.y as f64 * l.height as f64).floor();
-        match (address(x, l.width, mode), address(y, l.height, mode)) {
+        match (address(x, l.width, mode.0), address(y, l.height, mode.1)) {
             (Some(x), Some(y)) => self.fetch(l, x, y),
             _ => BORDER,
         }
@@ -233,13 +268,13 @@ impl Texture {
 
     /// Bilinear lookup in level 0.
     #[inline]
-    pub fn sample_bilinear(&self, uv: Vec2, mode: AddressMode) -> Vec4 {
-        self.bilinear(&self.base, uv, mode)
+    pub fn sample_bilinear(&self, uv: Vec2, mode: impl Into<Wrap>) -> Vec4 {
+        self.bilinear(&self.base, uv, mode.into())
     }
 
     /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
     #[inline]
-    pub fn bilinear(&self, l: &Level, uv: Vec2, mode: AddressMode) -> Vec4 {
+    pub fn bilinear(&self, l: &Level, uv: Vec2, mode: Wrap) -> Vec4 {
         // Fast path: all four texels inside the image, so no address mode
         // applies (the case for almost every lookup of a model's own UVs).
         let x = uv.x * l.width as f32 - 0.5;
@@ -258,7 +293,8 @@ impl Texture {
 
     /// Trilinear lookup at level of detail `lod` (clamped to the chain;
     /// level 0 only while the chain is not built).
-    pub fn sample_lod(&self, uv: Vec2, mode: AddressMode, lod: f32) -> Vec4 {
+    pub fn sample_lod(&self, uv: Vec2, mode: impl Into<Wrap>, lod: f32) -> Vec4 {
+        let mode = mode.into();
         let Some(mips) = self.mips.get().filter(|_| lod > 0.0) else {
             return self.bilinear(&self.base, uv, mode);
         };
@@ -279,7 +315,8 @@ impl Texture {
     /// read level 0; trilinear picks the level from the longer footprint
     /// axis; anisotropic takes up to `max_anisotropy` trilinear probes
     /// spread along the longer axis, at the level of the shorter one.
-    pub fn sample_grad(&self, uv: Vec2, g: Gradients, mode: AddressMode, f: Filtering) -> Vec4 {
+    pub fn sample_grad(&self, uv: Vec2, g: Gradients, mode: impl Into<Wrap>, f: Filtering) -> Vec4 {
+        let mode = mode.into();
         match f.filter {
             TextureFilter::Nearest => self.sample_nearest(uv, mode),
             TextureFilter::Bilinear => self.sample_bilinear(uv, mode),
@@ -337,7 +374,7 @@ impl Texture {
     }
 
     /// The general case: any finite coordinate, through the address mode.
-    fn bilinear_wrapped(&self, l: &Level, uv: Vec2, mode: AddressMode) -> Vec4 {
+    fn bilinear_wrapped(&self, l: &Level, uv: Vec2, mode: Wrap) -> Vec4 {
         if !uv.is_finite() {
             return BORDER;
         }
@@ -348,10 +385,13 @@ impl Texture {
         let y0 = y.floor();
         let fx = (x - x0) as f32;
         let fy = (y - y0) as f32;
-        let xs = [address(x0, l.width, mode), address(x0 + 1.0, l.width, mode)];
+        let xs = [
+            address(x0, l.width, mode.0),
+            address(x0 + 1.0, l.width, mode.0),
+        ];
         let ys = [
-            address(y0, l.height, mode),
-            address(y0 + 1.0, l.height, mode),
+            address(y0, l.height, mode.1),
+            address(y0 + 1.0, l.height, mode.1),
         ];
         let get = |xi: Option<i64>, yi: Option<i64>| match (xi, yi) {
             (Some(x), Some(y)) => self.fetch(l, x, y),
@@ -398,27 +438,45 @@ impl TextureRef {
     pub fn new(texture: std::sync::Arc<Texture>) -> TextureRef {
         TextureRef {
             texture,
-            scale: Vec2::ONE,
-            offset: Vec2::ZERO,
+            transform: Affine2::IDENTITY,
             address: None,
+            texcoord: 0,
+            min_limit: None,
+            mag_nearest: false,
         }
     }
 
-    /// Filtered lookup with derivatives (the `-s` scale applies to them).
+    /// Filtered lookup with derivatives (the transform applies to them),
+    /// with the sampler's filter limits.
     #[inline]
     pub fn sample_grad(
         &self,
         uv: Vec2,
         g: Gradients,
         default_mode: AddressMode,
-        f: Filtering,
+        mut f: Filtering,
     ) -> Vec4 {
-        let uv = uv * self.scale + self.offset;
+        let uv = self.transform.transform_point2(uv);
+        let m = self.transform.matrix2;
         let g = Gradients {
-            dx: g.dx * self.scale,
-            dy: g.dy * self.scale,
+            dx: m * g.dx,
+            dy: m * g.dy,
         };
-        let mode = self.address.unwrap_or(default_mode);
+        let mode = self.address.unwrap_or(default_mode.into());
+        if self.mag_nearest || self.min_limit.is_some() {
+            let t = &self.texture;
+            let size = Vec2::new(t.width as f32, t.height as f32);
+            let texels = (g.dx * size).length().max((g.dy * size).length());
+            if texels <= 1.0 {
+                if self.mag_nearest {
+                    return t.sample_nearest(uv, mode);
+                }
+            } else if let Some(limit) = self.min_limit
+                && (limit as u8) < (f.filter as u8)
+            {
+                f.filter = limit;
+            }
+        }
         self.texture.sample_grad(uv, g, mode, f)
     }
 }
@@ -469,7 +527,7 @@ mod tests {
             Vec2::new(0.21, 0.7),
         ] {
             let a = big.sample_bilinear(uv, AddressMode::Repeat);
-            let b = big.bilinear_wrapped(&big.base, uv, AddressMode::Repeat);
+            let b = big.bilinear_wrapped(&big.base, uv, AddressMode::Repeat.into());
             assert!((a - b).abs().max_element() < 1e-5, "{a} {b}");
         }
     }

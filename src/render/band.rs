@@ -18,7 +18,7 @@ use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::desc::ShadingMode;
 use crate::scene::material::AlphaMode;
-use crate::shade::{ShadeContext, Surface};
+use crate::shade::{ShadeContext, Surface, TexCoords};
 
 /// What every band of one frame reads.
 pub(super) struct FrameData<'a> {
@@ -59,8 +59,12 @@ impl FrameData<'_> {
                         let it = Interpolator::new(t);
                         let keep = |px: i32, py: i32| {
                             let f = it.at_pixel(px, py);
-                            let (m, uv) = self.material_uv(t, f.lambda);
-                            self.ctx.opacity(m, uv, Gradients::default()) >= cutoff
+                            let (m, uv, color) = self.material_uv(t, f.lambda);
+                            let tc = TexCoords {
+                                uv,
+                                ..Default::default()
+                            };
+                            self.ctx.opacity(m, &tc, color) >= cutoff
                         };
                         if self.reverse {
                             vis.draw_if::<true>(t, id, keep);
@@ -98,7 +102,8 @@ impl FrameData<'_> {
         for qy in (0..th).step_by(2) {
             for qx in (0..tw).step_by(2) {
                 // Derivatives of the (at most four) triangles in this quad.
-                let mut quad: [(u32, Gradients); 4] = [(NO_TRIANGLE, Gradients::default()); 4];
+                let mut quad: [(u32, [Gradients; 2]); 4] =
+                    [(NO_TRIANGLE, [Gradients::default(); 2]); 4];
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let (x, y) = (qx + dx, qy + dy);
                     if x >= tw || y >= th {
@@ -127,7 +132,7 @@ impl FrameData<'_> {
                         }
                         quad[slot].1
                     } else {
-                        Gradients::default()
+                        [Gradients::default(); 2]
                     };
                     let frag = it.at_pixel(px, py);
                     let (c, d) = self.shade(t, it, frag, px, py, g);
@@ -166,12 +171,13 @@ impl FrameData<'_> {
                 let g = if self.grads {
                     self.gradients(t, &it, (px & !1, py & !1))
                 } else {
-                    Gradients::default()
+                    [Gradients::default(); 2]
                 };
                 let frag = it.at_pixel(px, py);
                 let (c, _) = self.shade(t, &it, frag, px, py, g);
-                let (m, uv) = self.material_uv(t, frag.lambda);
-                let a = self.ctx.opacity(m, uv, g).clamp(0.0, 1.0);
+                let (m, uv, vcolor) = self.material_uv(t, frag.lambda);
+                let tc = TexCoords { uv, grads: g };
+                let a = self.ctx.opacity(m, &tc, vcolor).clamp(0.0, 1.0);
                 if !c.is_finite() {
                     return;
                 }
@@ -181,28 +187,41 @@ impl FrameData<'_> {
         }
     }
 
-    fn material_uv(&self, t: &Tri, l: Vec3) -> (&crate::scene::Material, Option<Vec2>) {
+    /// The material of `t`, its texture coordinates (both sets) and vertex
+    /// color at barycentrics `l`.
+    fn material_uv(&self, t: &Tri, l: Vec3) -> (&crate::scene::Material, [Option<Vec2>; 2], Vec4) {
         let d = self.draws[t.draw as usize];
         let model = &self.fs.scene.models[d.model];
-        let uv = model.mesh.has_uvs().then(|| {
-            let idx = model.mesh.triangles[t.prim as usize];
-            let uv = &model.mesh.uvs;
-            uv[idx[0] as usize] * l.x + uv[idx[1] as usize] * l.y + uv[idx[2] as usize] * l.z
-        });
-        (&model.materials[d.material], uv)
+        let mesh = &model.mesh;
+        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let at = |uv: &[Vec2]| {
+            (!uv.is_empty()).then(|| uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z)
+        };
+        let color = if mesh.colors.is_empty() {
+            Vec4::ONE
+        } else {
+            let c = &mesh.colors;
+            c[idx[0]] * l.x + c[idx[1]] * l.y + c[idx[2]] * l.z
+        };
+        (
+            &model.materials[d.material],
+            [at(&mesh.uvs), at(&mesh.uvs1)],
+            color,
+        )
     }
 
-    /// Texture-coordinate derivatives of `t` over the quad whose top-left
-    /// pixel is `q0`.
-    fn gradients(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
+    /// Texture-coordinate derivatives of `t` (both sets) over the quad
+    /// whose top-left pixel is `q0`.
+    fn gradients(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> [Gradients; 2] {
         let uv = |px: i32, py: i32| self.material_uv(t, it.at_pixel(px, py).lambda).1;
-        match (uv(q0.0, q0.1), uv(q0.0 + 1, q0.1), uv(q0.0, q0.1 + 1)) {
+        let (a, b, c) = (uv(q0.0, q0.1), uv(q0.0 + 1, q0.1), uv(q0.0, q0.1 + 1));
+        [0, 1].map(|k| match (a[k], b[k], c[k]) {
             (Some(a), Some(b), Some(c)) => Gradients {
                 dx: b - a,
                 dy: c - a,
             },
             _ => Gradients::default(),
-        }
+        })
     }
 
     /// Color (linear, or the data view's value) and view depth of triangle
@@ -214,7 +233,7 @@ impl FrameData<'_> {
         frag: Fragment,
         px: i32,
         py: i32,
-        grads: Gradients,
+        grads: [Gradients; 2],
     ) -> (Vec3, f32) {
         let ctx = &self.ctx;
         let mode = ctx.mode;
@@ -239,10 +258,7 @@ impl FrameData<'_> {
         };
         // Light the side the camera sees.
         let normal = if t.front { normal } else { -normal };
-        let uv = model.mesh.has_uvs().then(|| {
-            let uv = &model.mesh.uvs;
-            uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
-        });
+        let (_, uv, color) = self.material_uv(t, l);
         let tangent = (!mv.tangent.is_empty()).then(|| {
             let c = t.prim as usize * 3;
             let tt = &mv.tangent;
@@ -268,8 +284,8 @@ impl FrameData<'_> {
             position,
             normal,
             raw_normal,
-            uv,
-            grads,
+            tc: TexCoords { uv, grads },
+            color,
             tangent,
             normal_from_object: mv.normal_from_object,
             view_depth,

@@ -15,7 +15,7 @@ use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
 use crate::scene::Scene;
 use crate::scene::camera::{Camera, Projection};
-use crate::scene::desc::{DepthMode, ShadingMode, TextureFilter};
+use crate::scene::desc::{CullMode, DepthMode, ShadingMode, TextureFilter};
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::AlphaMode;
 use crate::shade::{ShadeContext, background, blinn_phong};
@@ -94,6 +94,7 @@ impl<'a> FrameSetup<'a> {
                 },
                 color: Vec3::ONE,
                 shadows: false,
+                range: None,
             }]
         } else {
             scene.lights.clone()
@@ -134,6 +135,10 @@ struct Draw {
 }
 
 const CHUNK: u32 = 2048;
+
+/// Per chunk of triangles: set-up triangles, per-band triangle lists and
+/// the largest texel density in each texture-coordinate set.
+type ChunkOut = (Vec<Tri>, Vec<Vec<u32>>, [f32; 2]);
 
 pub fn render_frame(scene: &Scene, camera: usize, frame: u32) -> Frame {
     let fs = FrameSetup::new(scene, camera, frame);
@@ -195,20 +200,25 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         s.texture_filter,
         TextureFilter::Trilinear | TextureFilter::Anisotropic
     ) && !scene.textures.is_empty();
-    let per_chunk: Vec<(Vec<Tri>, Vec<Vec<u32>>, f32)> = chunks
+    let per_chunk: Vec<ChunkOut> = chunks
         .par_iter()
         .map(|&(di, start, end)| {
             let d = draws[di];
             let mesh = &scene.models[d.model].mesh;
             let clip = &verts[d.model].clip;
+            // glTF doubleSided materials are never culled.
+            let cull = if scene.models[d.model].materials[d.material].double_sided {
+                CullMode::None
+            } else {
+                cull
+            };
             let mut tris = Vec::with_capacity((end - start) as usize);
             let density = filtered
-                && mesh.has_uvs()
                 && scene.models[d.model].materials[d.material]
                     .maps()
                     .next()
                     .is_some();
-            let mut max_density = 0.0f32;
+            let mut max_density = [0.0f32; 2];
             for prim in start..end {
                 let before = tris.len();
                 let idx = mesh.triangles[prim as usize];
@@ -229,7 +239,11 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
                 }
                 if density {
                     for t in &tris[before..] {
-                        max_density = max_density.max(uv_density(t, mesh, idx));
+                        for (set, uvs) in [&mesh.uvs, &mesh.uvs1].into_iter().enumerate() {
+                            if !uvs.is_empty() {
+                                max_density[set] = max_density[set].max(uv_density(t, uvs, idx));
+                            }
+                        }
                     }
                 }
             }
@@ -256,8 +270,10 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         let d = draws[di];
         for map in scene.models[d.model].materials[d.material].maps() {
             let t = &map.texture;
-            let texels =
-                density * t.width as f32 * t.height as f32 * (map.scale.x * map.scale.y).abs();
+            let texels = density[(map.texcoord as usize).min(1)]
+                * t.width as f32
+                * t.height as f32
+                * map.transform.matrix2.determinant().abs();
             // Footprints of half a texel and up: the level-of-detail can
             // pass 0 somewhere in such a triangle.
             if texels > 0.25 {
@@ -307,8 +323,8 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
 
 /// UV area per pixel area of a set-up triangle (texture units squared per
 /// pixel squared), from its barycentrics in the original triangle.
-fn uv_density(t: &Tri, mesh: &crate::assets::mesh::Mesh, idx: [u32; 3]) -> f32 {
-    let uv = idx.map(|i| mesh.uvs[i as usize]);
+fn uv_density(t: &Tri, uvs: &[glam::Vec2], idx: [u32; 3]) -> f32 {
+    let uv = idx.map(|i| uvs[i as usize]);
     let at = |b: Vec3| uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
     let [a, b, c] = t.bary.map(at);
     let uv_area = (b - a).perp_dot(c - a).abs();

@@ -12,14 +12,15 @@ use rayon::prelude::*;
 
 use super::animation::{Animation, Turntable};
 use super::camera::{Camera, Projection, fitted_planes};
-use super::desc::{self, Ctx, MaterialOverride, S, SceneDesc};
-use super::desc::{AlphaModeDesc, NormalSpace};
+use super::desc::{self, Ctx, S, SceneDesc};
 use super::light::{Light, LightKind};
-use super::material::{AlphaMode, Material, NormalMap};
+use super::material::NormalMap;
+use super::materials::{self, SourceMaterial};
 use super::overrides::{self, SetOverride};
 use super::{Model, OutputSettings, RenderSettings, Scene, check_pattern};
-use crate::assets::obj::{self, MapSpec, MtlMaterial};
-use crate::assets::texture::{Texture, TextureRef};
+use crate::assets::gltf::{GltfCamera, GltfProjection, ImageSource};
+use crate::assets::obj::{self, MapSpec};
+use crate::assets::texture::Texture;
 use crate::error::Error;
 
 /// Options that come from outside the scene file.
@@ -33,7 +34,6 @@ pub struct LoadOptions {
 
 const SHADOW_ISSUE: &str = "it comes with shadows, AO and EXR outputs";
 const WORKFLOW_ISSUE: &str = "it comes with anti-aliasing and GIF output";
-const GLTF_ISSUE: &str = "it comes with glTF support";
 
 impl Scene {
     /// Reads, parses, validates and loads a scene file.
@@ -100,20 +100,6 @@ fn refuse_unsupported(d: &SceneDesc, ctx: &Ctx) -> Result<(), Error> {
     }
     if let Some(g) = &o.gif {
         return Err(unsupported(ctx, g, "output.gif", WORKFLOW_ISSUE));
-    }
-    for m in &d.models {
-        let m = m.get_ref();
-        let p = m.path.get_ref().to_ascii_lowercase();
-        if p.ends_with(".gltf") || p.ends_with(".glb") {
-            return Err(unsupported(ctx, &m.path, "a glTF model", GLTF_ISSUE));
-        }
-        for (v, key) in [(&m.lights, "model.lights"), (&m.cameras, "model.cameras")] {
-            if let Some(v) = v
-                && *v.get_ref()
-            {
-                return Err(unsupported(ctx, v, key, GLTF_ISSUE));
-            }
-        }
     }
     Ok(())
 }
@@ -187,20 +173,21 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             });
         }
     }
-    let loaded: Vec<obj::ObjModel> = file_list
+    let loaded: Vec<SourceModel> = file_list
         .par_iter()
-        .map(|p| obj::load(p))
+        .map(|p| SourceModel::load(p))
         .collect::<Result<_, _>>()?;
-    let loaded: Vec<Arc<obj::ObjModel>> = loaded.into_iter().map(Arc::new).collect();
+    let mut warnings: Vec<String> = loaded.iter().flat_map(|m| m.warnings.clone()).collect();
+    let source = |md: &desc::ModelDesc| &loaded[files[&resolve(&scene_dir, md.path.get_ref())]];
 
     // Materials (with overrides), then the set of textures they need.
-    let mut model_mats: Vec<Vec<MtlMaterial>> = Vec::new();
+    let mut model_mats: Vec<Vec<SourceMaterial>> = Vec::new();
     for m in &d.models {
         let md = m.get_ref();
-        let src = &loaded[files[&resolve(&scene_dir, md.path.get_ref())]];
+        let src = source(md);
         for (name, ov) in &md.materials {
-            if !src.materials.iter().any(|mm| &mm.name == name) {
-                let names: Vec<_> = src.materials.iter().map(|m| m.name.as_str()).collect();
+            if !src.materials.iter().any(|mm| mm.name() == name) {
+                let names: Vec<_> = src.materials.iter().map(|m| m.name()).collect();
                 return Err(ctx.err(
                     ov.span(),
                     format!(
@@ -216,71 +203,66 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             .map(|mm| {
                 let mut mm = mm.clone();
                 if let Some(all) = &md.material {
-                    apply_override(&mut mm, all.get_ref(), &scene_dir, ctx)?;
+                    mm.apply_override(all.get_ref(), &scene_dir, ctx)?;
                 }
-                if let Some(one) = md.materials.get(&mm.name) {
-                    apply_override(&mut mm, one.get_ref(), &scene_dir, ctx)?;
+                if let Some(one) = md.materials.get(mm.name()) {
+                    mm.apply_override(one.get_ref(), &scene_dir, ctx)?;
                 }
                 Ok(mm)
             })
             .collect::<Result<Vec<_>, Error>>()?;
         model_mats.push(mats);
     }
-    let mut wanted: BTreeMap<(PathBuf, bool), Option<Arc<Texture>>> = BTreeMap::new();
+    // Images to decode, once per (image, sRGB), in a fixed order.
+    let mut wanted: BTreeMap<(PathBuf, bool), ImageSource> = BTreeMap::new();
     if textured {
         for (m, mats) in d.models.iter().zip(&model_mats) {
-            let src = &loaded[files[&resolve(&scene_dir, m.get_ref().path.get_ref())]];
-            if !src.mesh.has_uvs() {
+            let src = source(m.get_ref());
+            if !src.mesh.has_uvs() && src.mesh.uvs1.is_empty() {
                 continue;
             }
             for (i, mm) in mats.iter().enumerate() {
                 if !src.mesh.groups.iter().any(|g| g.material == i) {
                     continue;
                 }
-                for (k, (map, srgb)) in shading_maps(mm).into_iter().enumerate() {
-                    if normals_view && k < 6 {
-                        continue;
-                    }
-                    if let Some(map) = map {
-                        wanted.insert((map.path.clone(), srgb), None);
-                    }
+                for (img, srgb) in mm.images(normals_view) {
+                    wanted.insert((img.key().to_path_buf(), srgb), img);
                 }
             }
         }
     }
-    let keys: Vec<_> = wanted.keys().cloned().collect();
+    let keys: Vec<_> = wanted.iter().collect();
     let decoded: Vec<Arc<Texture>> = keys
         .par_iter()
         .enumerate()
-        .map(|(id, (p, srgb))| {
-            Texture::load(p, *srgb).map(|mut t| {
+        .map(|(id, ((_, srgb), img))| {
+            let t = match img {
+                ImageSource::File(p) => Texture::load(p, *srgb),
+                ImageSource::Memory { name, bytes } => Texture::from_bytes(bytes, name, *srgb),
+            };
+            t.map(|mut t| {
                 t.id = id;
                 Arc::new(t)
             })
         })
         .collect::<Result<_, _>>()?;
-    let textures = decoded.clone();
-    for (k, t) in keys.into_iter().zip(decoded) {
-        wanted.insert(k, Some(t));
-    }
-    let tex = |map: &Option<MapSpec>, srgb: bool| -> Option<TextureRef> {
-        let map = map.as_ref()?;
-        let t = wanted.get(&(map.path.clone(), srgb))?.clone()?;
-        Some(TextureRef {
-            texture: t,
-            scale: Vec2::new(map.scale[0], map.scale[1]),
-            offset: Vec2::new(map.offset[0], map.offset[1]),
-            address: map.clamp.then_some(desc::AddressMode::Clamp),
-        })
-    };
+    let by_key: BTreeMap<(PathBuf, bool), Arc<Texture>> = keys
+        .iter()
+        .map(|(k, _)| (*k).clone())
+        .zip(decoded.iter().cloned())
+        .collect();
+    let textures = decoded;
+    let lookup = |p: &Path, srgb: bool| by_key.get(&(p.to_path_buf(), srgb)).cloned();
 
     let mut models = Vec::new();
+    let mut imported_lights = Vec::new();
+    let mut imported_cameras = Vec::new();
     for (i, (m, mats)) in d.models.iter().zip(&model_mats).enumerate() {
         let md = m.get_ref();
-        let src = &loaded[files[&resolve(&scene_dir, md.path.get_ref())]];
+        let src = source(md);
         let materials = mats
             .iter()
-            .map(|mm| to_material(mm, &tex))
+            .map(|mm| materials::to_material(mm, &lookup))
             .collect::<Vec<_>>();
         let mut world = placement(md);
         if get(&md.normalize, false) {
@@ -292,12 +274,56 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         }
         let mut mesh = src.mesh.clone();
         for (gi, mm) in mats.iter().enumerate() {
-            if let Some(spec) = &mm.disp {
+            if let SourceMaterial::Mtl(mm) = mm
+                && let Some(spec) = &mm.disp
+            {
                 displace(&mut mesh, gi, spec, mm.disp_scale)?;
             }
         }
-        if materials.iter().any(|m| m.needs_tangents()) && textured {
-            mesh.compute_tangents();
+        if let Some(nm) = materials.iter().find(|m| m.needs_tangents())
+            && textured
+        {
+            let set = match &nm.normal_map {
+                Some(NormalMap::Normals { map, .. }) | Some(NormalMap::Height { map, .. }) => {
+                    map.texcoord as usize
+                }
+                None => 0,
+            };
+            mesh.compute_tangents(set);
+        }
+        for (v, key, what) in [
+            (&md.lights, "model.lights", "lights"),
+            (&md.cameras, "model.cameras", "cameras"),
+        ] {
+            if let Some(v) = v
+                && *v.get_ref()
+                && src.gltf.is_none()
+            {
+                return Err(ctx.err(
+                    v.span(),
+                    format!("{key} = true: only glTF models carry {what}; this one is OBJ"),
+                ));
+            }
+        }
+        if let Some(g) = &src.gltf {
+            if get(&md.lights, false) {
+                if g.lights.is_empty() {
+                    warnings.push(format!(
+                        "{}: model.lights = true, but the file has no KHR_lights_punctual lights",
+                        md.path.get_ref()
+                    ));
+                }
+                imported_lights.extend(g.lights.iter().map(|l| place_light(&l.light, world)));
+            }
+            if get(&md.cameras, false) {
+                if g.cameras.is_empty() {
+                    warnings.push(format!(
+                        "{}: model.cameras = true, but the file has no cameras",
+                        md.path.get_ref()
+                    ));
+                }
+                imported_cameras.extend(g.cameras.iter().map(|c| (c.clone(), world)));
+            }
         }
         models.push(Model {
             name: md
@@ -324,12 +350,13 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-6);
 
-    let lights = d
+    let mut lights = d
         .lights
         .iter()
         .map(|l| to_light(l.get_ref()))
         .collect::<Vec<_>>();
-    let cameras = build_cameras(d, ctx, center, radius)?;
+    lights.extend(imported_lights);
+    let cameras = build_cameras(d, ctx, center, radius, &imported_cameras)?;
 
     let frames = get(&d.animation.frames, 1) as u32;
     let turntable = d.animation.turntable.as_ref().map(|t| {
@@ -357,7 +384,86 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         bounds_center: center,
         bounds_radius: radius,
         textures,
+        warnings,
     })
+}
+
+/// A model file as loaded: OBJ (+ MTL) or glTF.
+struct SourceModel {
+    mesh: crate::assets::mesh::Mesh,
+    materials: Vec<SourceMaterial>,
+    /// glTF only: lights, cameras.
+    gltf: Option<crate::assets::gltf::GltfModel>,
+    warnings: Vec<String>,
+}
+
+impl SourceModel {
+    fn load(path: &Path) -> Result<SourceModel, Error> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if ext == "gltf" || ext == "glb" {
+            let mut g = crate::assets::gltf::load(path)?;
+            Ok(SourceModel {
+                mesh: std::mem::take(&mut g.mesh),
+                materials: g
+                    .materials
+                    .drain(..)
+                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                    .collect(),
+                warnings: std::mem::take(&mut g.warnings),
+                gltf: Some(g),
+            })
+        } else {
+            let o = obj::load(path)?;
+            Ok(SourceModel {
+                mesh: o.mesh,
+                materials: o
+                    .materials
+                    .into_iter()
+                    .map(|m| SourceMaterial::Mtl(Box::new(m)))
+                    .collect(),
+                gltf: None,
+                warnings: Vec::new(),
+            })
+        }
+    }
+}
+
+/// An imported light moved by its model's placement.
+fn place_light(l: &Light, world: Mat4) -> Light {
+    let dir = |d: Vec3| world.transform_vector3(d).try_normalize().unwrap_or(d);
+    let kind = match l.kind {
+        LightKind::Directional {
+            direction,
+            irradiance,
+        } => LightKind::Directional {
+            direction: dir(direction),
+            irradiance,
+        },
+        LightKind::Point {
+            position,
+            intensity,
+        } => LightKind::Point {
+            position: world.transform_point3(position),
+            intensity,
+        },
+        LightKind::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+        } => LightKind::Spot {
+            position: world.transform_point3(position),
+            direction: dir(direction),
+            intensity,
+            cos_inner,
+            cos_outer,
+        },
+    };
+    Light { kind, ..*l }
 }
 
 fn resolve(base: &Path, p: &str) -> PathBuf {
@@ -376,163 +482,6 @@ fn placement(m: &desc::ModelDesc) -> Mat4 {
         r[2].to_radians(),
     );
     Mat4::from_scale_rotation_translation(Vec3::from(s), q, t)
-}
-
-fn apply_override(
-    m: &mut MtlMaterial,
-    o: &MaterialOverride,
-    scene_dir: &Path,
-    ctx: &Ctx,
-) -> Result<(), Error> {
-    macro_rules! set {
-        ($($f:ident),*) => {$(
-            if let Some(v) = &o.$f { m.$f = Some(*v.get_ref()); }
-        )*};
-    }
-    set!(ka, kd, ks, ke, ns, ni, d);
-    if let Some(v) = &o.illum {
-        m.illum = Some(*v.get_ref() as u8);
-    }
-    let map = |v: &Option<S<String>>| -> Result<Option<MapSpec>, Error> {
-        v.as_ref()
-            .map(|s| obj::parse_map(s.get_ref(), scene_dir).map_err(|msg| ctx.err(s.span(), msg)))
-            .transpose()
-    };
-    if let Some(v) = &o.bump_scale {
-        m.bump_scale = Some(*v.get_ref());
-    }
-    if let Some(v) = &o.normal_space {
-        m.normal_space = Some(*v.get_ref());
-    }
-    if let Some(v) = &o.alpha_mode {
-        m.alpha_mode = Some(*v.get_ref());
-    }
-    if let Some(v) = &o.alpha_cutoff {
-        m.alpha_cutoff = Some(*v.get_ref());
-    }
-    if let Some(v) = &o.disp_scale {
-        m.disp_scale = Some(*v.get_ref());
-    }
-    for (slot, v) in [
-        (&mut m.map_ka, &o.map_ka),
-        (&mut m.map_kd, &o.map_kd),
-        (&mut m.map_ks, &o.map_ks),
-        (&mut m.map_ke, &o.map_ke),
-        (&mut m.map_ns, &o.map_ns),
-        (&mut m.map_d, &o.map_d),
-        (&mut m.map_bump, &o.map_bump),
-        (&mut m.norm, &o.norm),
-        (&mut m.disp, &o.disp),
-    ] {
-        if let Some(spec) = map(v)? {
-            if !spec.path.is_file() {
-                return Err(Error::asset(
-                    &spec.path,
-                    None,
-                    format!(
-                        "texture not found (from {})",
-                        ctx.location(v.as_ref().map(|s| s.span()).unwrap_or(0..0))
-                    ),
-                ));
-            }
-            *slot = Some(spec);
-        }
-    }
-    Ok(())
-}
-
-/// The maps shading reads, with whether they hold sRGB color (`disp` is
-/// read at load time, by `displace`).
-fn shading_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 8] {
-    [
-        (&m.map_ka, true),
-        (&m.map_kd, true),
-        (&m.map_ks, true),
-        (&m.map_ke, true),
-        (&m.map_ns, false),
-        (&m.map_d, false),
-        (&m.map_bump, false),
-        (&m.norm, false),
-    ]
-}
-
-fn to_material(
-    m: &MtlMaterial,
-    tex: &dyn Fn(&Option<MapSpec>, bool) -> Option<TextureRef>,
-) -> Material {
-    let d = Material::default_named(&m.name);
-    // A constant left unset but with a map is 1: the map alone decides.
-    let constant = |c: Option<[f32; 3]>, map: &Option<MapSpec>, fallback: Vec3| {
-        c.map(Vec3::from)
-            .unwrap_or(if map.is_some() { Vec3::ONE } else { fallback })
-    };
-    let map_kd = tex(&m.map_kd, true);
-    let map_d = tex(&m.map_d, false);
-    let opacity = m.d.unwrap_or(1.0);
-    let bump_scale = |spec: &Option<MapSpec>| {
-        m.bump_scale
-            .or(spec.as_ref().and_then(|s| s.bump_scale))
-            .unwrap_or(1.0)
-    };
-    let space = m.normal_space.unwrap_or(NormalSpace::Tangent);
-    let normal_map = if let Some(map) = tex(&m.norm, false) {
-        Some(NormalMap::Normals {
-            map,
-            space,
-            scale: bump_scale(&m.norm),
-        })
-    } else if let Some(map) = tex(&m.map_bump, false) {
-        // map_Bump holds either: a grey image is heights, a colored one normals.
-        let scale = bump_scale(&m.map_bump);
-        if map.texture.grey && m.normal_space.is_none() {
-            Some(NormalMap::Height { map, scale })
-        } else {
-            Some(NormalMap::Normals { map, space, scale })
-        }
-    } else {
-        None
-    };
-    // Opacity: a constant below 1 blends; an alpha channel that is (almost)
-    // all-or-nothing is a cutout, a gradual one blends.
-    let alpha_texture = map_d
-        .iter()
-        .chain(map_kd.iter())
-        .find(|t| t.texture.has_alpha);
-    let cutoff = m.alpha_cutoff.unwrap_or(0.5);
-    let alpha = match m.alpha_mode {
-        Some(AlphaModeDesc::Opaque) => AlphaMode::Opaque,
-        Some(AlphaModeDesc::Mask) => AlphaMode::Mask(cutoff),
-        Some(AlphaModeDesc::Blend) => AlphaMode::Blend,
-        None if opacity < 1.0 => AlphaMode::Blend,
-        None => match alpha_texture {
-            Some(t) if t.texture.binary_alpha >= 0.9 => AlphaMode::Mask(cutoff),
-            Some(_) => AlphaMode::Blend,
-            // A grey map_d without alpha channel: its red channel.
-            None if map_d.is_some() => AlphaMode::Blend,
-            None => AlphaMode::Opaque,
-        },
-    };
-    Material {
-        name: m.name.clone(),
-        ka: m
-            .ka
-            .map(Vec3::from)
-            .or(m.map_ka.as_ref().map(|_| Vec3::ONE)),
-        kd: constant(m.kd, &m.map_kd, d.kd),
-        ks: constant(m.ks, &m.map_ks, if m.synthetic { d.ks } else { Vec3::ZERO }),
-        ke: constant(m.ke, &m.map_ke, Vec3::ZERO),
-        ns: m.ns.unwrap_or(d.ns),
-        illum: m.illum.unwrap_or(2),
-        map_ka: tex(&m.map_ka, true),
-        map_kd,
-        map_ks: tex(&m.map_ks, true),
-        map_ke: tex(&m.map_ke, true),
-        map_ns: tex(&m.map_ns, false),
-        d: opacity,
-        map_d,
-        normal_map,
-        alpha,
-    }
 }
 
 /// Displacement at load time: every vertex of material `group_material`'s
@@ -625,16 +574,21 @@ fn to_light(l: &desc::LightDesc) -> Light {
         kind,
         color,
         shadows: get(&l.shadows, false),
+        range: None,
     }
 }
 
+/// The scene's cameras, then those imported from glTF files (named by the
+/// file, made unique with a suffix); the default framing camera only when
+/// there are neither.
 fn build_cameras(
     d: &SceneDesc,
     ctx: &Ctx,
     center: Vec3,
     radius: f32,
+    imported: &[(GltfCamera, Mat4)],
 ) -> Result<Vec<Camera>, Error> {
-    if d.cameras.is_empty() {
+    if d.cameras.is_empty() && imported.is_empty() {
         return Ok(vec![Camera::framing("camera".into(), center, radius, 45.0)]);
     }
     let mut cams: Vec<Camera> = Vec::new();
@@ -701,6 +655,49 @@ fn build_cameras(
             target,
             up,
             projection,
+            near,
+            far,
+        });
+    }
+    for (g, world) in imported {
+        let eye = world.transform_point3(g.eye);
+        let forward = world
+            .transform_vector3(g.forward)
+            .try_normalize()
+            .unwrap_or(Vec3::NEG_Z);
+        let up = world
+            .transform_vector3(g.up)
+            .try_normalize()
+            .unwrap_or(Vec3::Y);
+        let up = if forward.cross(up).length() < 1e-6 {
+            forward.any_orthonormal_vector()
+        } else {
+            up
+        };
+        // A target straight ahead, as far as the models' center.
+        let dist = (center - eye).dot(forward).max(radius * 1e-3).max(1e-6);
+        // The model's scale applies to the planes too.
+        let s = world.transform_vector3(g.forward).length().max(1e-20);
+        let (_, fit_far) = fitted_planes((center - eye).length(), radius);
+        let near = (g.near * s).max(1e-6);
+        let far = g.far.map(|f| f * s).unwrap_or(fit_far).max(near * 2.0);
+        let mut name = g.name.clone();
+        let mut k = 1;
+        while cams.iter().any(|c| c.name == name) {
+            k += 1;
+            name = format!("{}_{k}", g.name);
+        }
+        cams.push(Camera {
+            name,
+            eye,
+            target: eye + forward * dist,
+            up,
+            projection: match g.projection {
+                GltfProjection::Perspective { fov_y } => Projection::Perspective { fov_y },
+                GltfProjection::Orthographic { height } => {
+                    Projection::Orthographic { height: height * s }
+                }
+            },
             near,
             far,
         });

@@ -59,8 +59,12 @@ pub enum Background {
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadingMode {
+    /// Each material in its file's model: Blinn-Phong for MTL, pbr for glTF.
     #[default]
+    Auto,
     BlinnPhong,
+    /// glTF 2.0 metallic-roughness (appendix B BRDF) for every material.
+    Pbr,
     Flat,
     Gouraud,
     Unlit,
@@ -134,7 +138,7 @@ pub enum Tonemap {
     Aces,
 }
 
-/// `[render]`. Defaults: blinn-phong, msaa 1, bilinear, anisotropy 16,
+/// `[render]`. Defaults: auto shading, msaa 1, trilinear, anisotropy 16,
 /// repeat, back-face culling, reverse-Z, pcf (for lights that cast shadows),
 /// 2048 shadow maps, AO off, clamp tone mapping, exposure 0.
 #[derive(Debug, Deserialize, Default)]
@@ -226,6 +230,10 @@ pub struct MaterialOverride {
     /// Extension: world units per unit of `disp` height (default 1, or the
     /// MTL's `-mm` gain).
     pub disp_scale: Option<S<f32>>,
+    /// Extension (pbr shading): metallic factor in [0, 1].
+    pub metallic: Option<S<f32>>,
+    /// Extension (pbr shading): perceptual roughness in [0, 1].
+    pub roughness: Option<S<f32>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -495,6 +503,8 @@ fn validate_override(c: &Ctx, o: &MaterialOverride) -> Result<(), Error> {
     c.int_range(&o.illum, "illum", 0, 10)?;
     c.finite(&o.bump_scale, "bump_scale")?;
     c.float_range(&o.alpha_cutoff, "alpha_cutoff", 0.0, 1.0)?;
+    c.float_range(&o.metallic, "metallic", 0.0, 1.0)?;
+    c.float_range(&o.roughness, "roughness", 0.0, 1.0)?;
     c.finite(&o.disp_scale, "disp_scale")?;
     Ok(())
 }

@@ -25,6 +25,10 @@ pub struct Light {
     pub kind: LightKind,
     pub color: Vec3,
     pub shadows: bool,
+    /// Point and spot: distance beyond which the light has no effect, with
+    /// the KHR_lights_punctual smooth window clamp(1 - (r/range)^4, 0, 1)^2
+    /// on the inverse square law. None: unlimited.
+    pub range: Option<f32>,
 }
 
 /// What one light delivers to a shaded point.
@@ -61,7 +65,7 @@ impl Light {
                 let l = d / r2.sqrt();
                 Some(Incidence {
                     l,
-                    e: self.color * (intensity / r2),
+                    e: self.color * (intensity * self.window(r2) / r2),
                 })
             }
             LightKind::Spot {
@@ -83,9 +87,23 @@ impl Light {
                 }
                 Some(Incidence {
                     l,
-                    e: self.color * (intensity * f / r2),
+                    e: self.color * (intensity * f * self.window(r2) / r2),
                 })
             }
+        }
+    }
+}
+
+impl Light {
+    #[inline]
+    fn window(&self, r2: f32) -> f32 {
+        match self.range {
+            Some(range) if range > 0.0 => {
+                let q = r2 / (range * range);
+                let w = (1.0 - q * q).clamp(0.0, 1.0);
+                w * w
+            }
+            _ => 1.0,
         }
     }
 }
@@ -115,10 +133,20 @@ mod tests {
             },
             color: Vec3::ONE,
             shadows: false,
+            range: None,
         };
         let i = l.incidence(Vec3::ZERO).unwrap();
         assert!((i.e.x - 2.0).abs() < 1e-6);
         assert!((i.l - Vec3::Y).length() < 1e-6);
+        // A range window: (1 - (2/4)^4)^2 at half the range, 0 beyond it.
+        let ranged = Light {
+            range: Some(4.0),
+            ..l
+        };
+        let w = (1.0f32 - 0.0625).powi(2);
+        assert!((ranged.incidence(Vec3::ZERO).unwrap().e.x - 2.0 * w).abs() < 1e-6);
+        let far = ranged.incidence(Vec3::new(0.0, -3.0, 0.0)).unwrap();
+        assert_eq!(far.e.x, 0.0);
     }
 
     #[test]

@@ -1,5 +1,8 @@
-//! Blinn-Phong materials as the renderer uses them: MTL values, scene
-//! overrides applied, textures resolved.
+//! Materials as the renderer uses them: MTL or glTF values, scene overrides
+//! applied, textures resolved. Every material carries both a Blinn-Phong and
+//! a metallic-roughness (pbr) description, one of them native (the file's)
+//! and the other derived by the documented mapping, so that any
+//! `render.shading` can draw any model.
 
 use glam::Vec3;
 
@@ -34,6 +37,63 @@ pub enum NormalMap {
     Height { map: TextureRef, scale: f32 },
 }
 
+/// Which shading model a material's file describes (`shading = "auto"`
+/// uses it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Native {
+    BlinnPhong,
+    Pbr,
+}
+
+/// glTF 2.0 metallic-roughness parameters (factors times textures).
+#[derive(Debug, Clone)]
+pub struct Pbr {
+    /// Linear RGBA base color factor.
+    pub base_color: glam::Vec4,
+    /// sRGB RGBA.
+    pub base_color_map: Option<TextureRef>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Linear; roughness in green, metallic in blue.
+    pub metallic_roughness_map: Option<TextureRef>,
+    /// Linear; occlusion in red, applied to the ambient term.
+    pub occlusion_map: Option<TextureRef>,
+    pub occlusion_strength: f32,
+    /// Linear RGB, KHR_materials_emissive_strength folded in.
+    pub emissive: Vec3,
+    /// sRGB.
+    pub emissive_map: Option<TextureRef>,
+}
+
+impl Pbr {
+    /// The glTF defaults: white, fully metallic, fully rough.
+    pub fn gltf_default() -> Pbr {
+        Pbr {
+            base_color: glam::Vec4::ONE,
+            base_color_map: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_map: None,
+            occlusion_map: None,
+            occlusion_strength: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_map: None,
+        }
+    }
+}
+
+/// Blinn-Phong exponent <-> GGX roughness: Ns = 2 / alpha^2 - 2 with
+/// alpha = roughness^2 (the lobes match near their peak).
+pub fn ns_from_roughness(roughness: f32) -> f32 {
+    let a = (roughness * roughness).max(1e-3);
+    (2.0 / (a * a) - 2.0).clamp(1.0, 10_000.0)
+}
+
+pub fn roughness_from_ns(ns: f32) -> f32 {
+    let a = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
+    a.sqrt().clamp(0.0, 1.0)
+}
+
 /// Defaults for a model without an MTL: grey diffuse 0.8, a faint specular
 /// 0.2 with exponent 32, illum 2. A constant that the MTL leaves unset but
 /// whose map is given is 1 (the map alone decides).
@@ -59,6 +119,11 @@ pub struct Material {
     pub map_d: Option<TextureRef>,
     pub normal_map: Option<NormalMap>,
     pub alpha: AlphaMode,
+    /// Metallic-roughness description (native for glTF, derived for MTL).
+    pub pbr: Pbr,
+    pub native: Native,
+    /// glTF doubleSided: never culled, whatever `render.cull` says.
+    pub double_sided: bool,
 }
 
 impl Material {
@@ -80,6 +145,14 @@ impl Material {
             map_d: None,
             normal_map: None,
             alpha: AlphaMode::Opaque,
+            pbr: Pbr {
+                base_color: Vec3::splat(0.8).extend(1.0),
+                metallic: 0.0,
+                roughness: roughness_from_ns(32.0),
+                ..Pbr::gltf_default()
+            },
+            native: Native::BlinnPhong,
+            double_sided: false,
         }
     }
 }
@@ -103,6 +176,7 @@ impl Material {
             Some(NormalMap::Normals { map, .. }) | Some(NormalMap::Height { map, .. }) => Some(map),
             None => None,
         };
+        let p = &self.pbr;
         [
             self.map_ka.as_ref(),
             self.map_kd.as_ref(),
@@ -111,6 +185,10 @@ impl Material {
             self.map_ns.as_ref(),
             self.map_d.as_ref(),
             nm,
+            p.base_color_map.as_ref(),
+            p.metallic_roughness_map.as_ref(),
+            p.occlusion_map.as_ref(),
+            p.emissive_map.as_ref(),
         ]
         .into_iter()
         .flatten()

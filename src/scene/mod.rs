@@ -1,5 +1,6 @@
 //! From a scene file to a loaded `Scene`: `desc` (the TOML as data),
-//! `overrides` (`--set`), `build` (resolve paths, load assets, defaults).
+//! `overrides` (`--set`), `build` (resolve paths, load assets, defaults),
+//! `materials` (file materials to renderer materials).
 
 pub mod animation;
 pub mod build;
@@ -7,6 +8,7 @@ pub mod camera;
 pub mod desc;
 pub mod light;
 pub mod material;
+pub mod materials;
 pub mod overrides;
 
 use std::path::PathBuf;
@@ -73,6 +75,9 @@ pub struct Scene {
     pub bounds_radius: f32,
     /// Every decoded texture; `Texture::id` indexes this list.
     pub textures: Vec<Arc<crate::assets::texture::Texture>>,
+    /// What loading ignored (optional glTF extensions, line primitives...),
+    /// for the command line to show.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {

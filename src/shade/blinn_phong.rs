@@ -111,6 +111,7 @@ mod tests {
             },
             color: Vec3::ONE,
             shadows: false,
+            range: None,
         }];
         let (p, n, v) = (Vec3::ZERO, Vec3::Y, Vec3::Y);
         let amb = Vec3::splat(0.1);

@@ -2,15 +2,17 @@
 //! Shading reads the scene (materials, lights) and never writes to it.
 
 pub mod blinn_phong;
+pub mod pbr;
 pub mod tonemap;
 
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
 use crate::assets::texture::{Filtering, Gradients, TextureRef};
 use crate::scene::desc::{AddressMode, ShadingMode, TextureFilter};
-use crate::scene::material::{NormalMap, NormalSpace};
+use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::{Light, Material};
 use blinn_phong::SurfaceColor;
+use pbr::PbrColor;
 
 /// Everything about the frame that shading needs, fixed for the frame.
 pub struct ShadeContext<'a> {
@@ -31,6 +33,24 @@ pub struct ShadeContext<'a> {
     pub depth_range: (f32, f32),
 }
 
+/// Texture coordinates of a point in both sets (None where the mesh has
+/// none), with their screen-space derivatives.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TexCoords {
+    pub uv: [Option<Vec2>; 2],
+    pub grads: [Gradients; 2],
+}
+
+impl TexCoords {
+    /// Set 0 only.
+    pub fn single(uv: Option<Vec2>, grads: Gradients) -> TexCoords {
+        TexCoords {
+            uv: [uv, None],
+            grads: [grads, Gradients::default()],
+        }
+    }
+}
+
 /// A visible point, interpolated.
 pub struct Surface<'a> {
     pub material: &'a Material,
@@ -39,9 +59,10 @@ pub struct Surface<'a> {
     pub normal: Vec3,
     /// Interpolated vertex normal as stored (for the `normals` view).
     pub raw_normal: Vec3,
-    pub uv: Option<Vec2>,
-    /// Texture-coordinate derivatives along screen x and y.
-    pub grads: Gradients,
+    /// Texture coordinates and their derivatives along screen x and y.
+    pub tc: TexCoords,
+    /// Linear RGBA vertex color (1 without one).
+    pub color: Vec4,
     /// Interpolated world-space tangent and bitangent sign (tangent-space
     /// normal and bump maps).
     pub tangent: Option<Vec4>,
@@ -81,56 +102,104 @@ impl ShadeContext<'_> {
                 Vec3::splat(0.04).lerp(Vec3::ONE, a)
             }
             ShadingMode::Unlit => {
-                let c = self.surface_color(s.material, s.uv, s.grads);
-                c.kd + c.ke
+                if s.material.native == Native::Pbr {
+                    let c = self.pbr_color(s);
+                    c.base + c.emissive
+                } else {
+                    let c = self.surface_color(s.material, &s.tc, s.color);
+                    c.kd + c.ke
+                }
             }
             ShadingMode::Gouraud => {
-                let c = self.surface_color(s.material, s.uv, s.grads);
+                let c = self.surface_color(s.material, &s.tc, s.color);
                 let (d, sp) = s.vertex_light.unwrap_or((Vec3::ZERO, Vec3::ZERO));
                 blinn_phong::combine(&c, self.ambient, d, sp)
             }
-            ShadingMode::BlinnPhong => {
-                let c = self.surface_color(s.material, s.uv, s.grads);
+            ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
+            ShadingMode::Pbr => self.shade_pbr(s),
+            ShadingMode::BlinnPhong | ShadingMode::Auto => {
+                let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 let n = self.mapped_normal(s);
                 blinn_phong::radiance(s.position, n, v, &c, self.ambient, self.lights)
             }
             ShadingMode::Flat => {
-                let c = self.surface_color(s.material, s.uv, s.grads);
+                let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 blinn_phong::radiance(s.position, s.normal, v, &c, self.ambient, self.lights)
             }
         }
     }
 
-    /// A filtered lookup of `t` at the surface's coordinates.
+    /// Metallic-roughness shading of a point.
+    fn shade_pbr(&self, s: &Surface) -> Vec3 {
+        let c = self.pbr_color(s);
+        let v = self.view_vector(s.position);
+        let n = self.mapped_normal(s);
+        pbr::radiance(s.position, n, v, &c, self.ambient, self.lights)
+    }
+
+    /// The material's metallic-roughness factors times its maps.
+    pub fn pbr_color(&self, s: &Surface) -> PbrColor {
+        let p = &s.material.pbr;
+        let tc = &s.tc;
+        let get = |t: &Option<TextureRef>| t.as_ref().and_then(|t| self.sample(t, tc));
+        let base = p.base_color.truncate()
+            * get(&p.base_color_map).map_or(Vec3::ONE, |c| c.truncate())
+            * s.color.truncate();
+        let (roughness, metallic) = match get(&p.metallic_roughness_map) {
+            Some(mr) => (p.roughness * mr.y, p.metallic * mr.z),
+            None => (p.roughness, p.metallic),
+        };
+        let occlusion = match get(&p.occlusion_map) {
+            Some(o) => 1.0 + p.occlusion_strength * (o.x - 1.0),
+            None => 1.0,
+        };
+        let emissive = if p.emissive == Vec3::ZERO {
+            Vec3::ZERO
+        } else {
+            p.emissive * get(&p.emissive_map).map_or(Vec3::ONE, |c| c.truncate())
+        };
+        PbrColor {
+            base,
+            metallic: metallic.clamp(0.0, 1.0),
+            roughness: roughness.clamp(0.0, 1.0),
+            occlusion,
+            emissive,
+        }
+    }
+
+    /// A filtered lookup of `t` at the point's coordinates in its set (None
+    /// where the mesh has no such set).
     #[inline]
-    fn sample(&self, t: &TextureRef, uv: Vec2, g: Gradients) -> Vec4 {
+    fn sample(&self, t: &TextureRef, tc: &TexCoords) -> Option<Vec4> {
+        let set = (t.texcoord as usize).min(1);
+        let uv = tc.uv[set]?;
         let f = Filtering {
             filter: self.filter,
             max_anisotropy: self.max_anisotropy,
             mips: self.mips.get(t.texture.id).copied().unwrap_or(false),
         };
-        t.sample_grad(uv, g, self.address, f)
+        Some(t.sample_grad(uv, tc.grads[set], self.address, f))
     }
 
-    /// The material's constants times its texture maps at `uv`.
+    /// The material's constants times its texture maps (and the vertex
+    /// color) at the point.
     #[inline]
-    pub fn surface_color(&self, m: &Material, uv: Option<Vec2>, g: Gradients) -> SurfaceColor {
+    pub fn surface_color(&self, m: &Material, tc: &TexCoords, color: Vec4) -> SurfaceColor {
         let sample = |t: &Option<TextureRef>| -> Vec3 {
-            match (t, uv) {
-                (Some(t), Some(uv)) => self.sample(t, uv, g).truncate(),
-                _ => Vec3::ONE,
-            }
+            t.as_ref()
+                .and_then(|t| self.sample(t, tc))
+                .map_or(Vec3::ONE, |c| c.truncate())
         };
-        let kd = m.kd * sample(&m.map_kd);
+        let kd = m.kd * sample(&m.map_kd) * color.truncate();
         let ka = match m.ka {
             Some(ka) => ka * sample(&m.map_ka),
             None => kd,
         };
-        let ns = match (&m.map_ns, uv) {
-            (Some(t), Some(uv)) => m.ns * self.sample(t, uv, g).x,
-            _ => m.ns,
+        let ns = match m.map_ns.as_ref().and_then(|t| self.sample(t, tc)) {
+            Some(c) => m.ns * c.x,
+            None => m.ns,
         };
         SurfaceColor {
             ka,
@@ -150,29 +219,31 @@ impl ShadeContext<'_> {
         }
     }
 
-    /// Opacity at the point: d times map_d (its alpha, or red without
-    /// alpha) times the alpha of map_Kd.
-    pub fn opacity(&self, m: &Material, uv: Option<Vec2>, g: Gradients) -> f32 {
-        let mut a = m.d;
-        if let Some(uv) = uv {
-            if let Some(t) = &m.map_d {
-                let c = self.sample(t, uv, g);
-                a *= if t.texture.has_alpha { c.w } else { c.x };
-            }
-            if let Some(t) = &m.map_kd
-                && t.texture.has_alpha
-            {
-                a *= self.sample(t, uv, g).w;
-            }
+    /// Opacity at the point: d (glTF: the base color's alpha) times map_d
+    /// (its alpha, or red without alpha) times the alpha of map_Kd (glTF:
+    /// of the base color texture) times the vertex color's alpha.
+    pub fn opacity(&self, m: &Material, tc: &TexCoords, color: Vec4) -> f32 {
+        let mut a = m.d * color.w;
+        if let Some(t) = &m.map_d
+            && let Some(c) = self.sample(t, tc)
+        {
+            a *= if t.texture.has_alpha { c.w } else { c.x };
+        }
+        if let Some(t) = &m.map_kd
+            && t.texture.has_alpha
+            && let Some(c) = self.sample(t, tc)
+        {
+            a *= c.w;
         }
         a
     }
 
     /// The shading normal with the material's normal or bump map applied.
     pub fn mapped_normal(&self, s: &Surface) -> Vec3 {
-        let (Some(map), Some(uv)) = (&s.material.normal_map, s.uv) else {
+        let Some(map) = &s.material.normal_map else {
             return s.normal;
         };
+        let tc = &s.tc;
         let n = s.normal;
         let frame = |t: Vec4| {
             let tt = (t.truncate() - n * n.dot(t.truncate()))
@@ -187,7 +258,10 @@ impl ShadeContext<'_> {
                 space: NormalSpace::Tangent,
                 scale,
             } => {
-                let c = self.sample(map, uv, s.grads).truncate() * 2.0 - Vec3::ONE;
+                let Some(c) = self.sample(map, tc) else {
+                    return n;
+                };
+                let c = c.truncate() * 2.0 - Vec3::ONE;
                 let Some(t) = s.tangent else { return n };
                 let (tt, b) = frame(t);
                 tt * (c.x * scale) + b * (c.y * scale) + n * c.z
@@ -197,7 +271,10 @@ impl ShadeContext<'_> {
                 space: NormalSpace::Object,
                 ..
             } => {
-                let c = self.sample(map, uv, s.grads).truncate() * 2.0 - Vec3::ONE;
+                let Some(c) = self.sample(map, tc) else {
+                    return n;
+                };
+                let c = c.truncate() * 2.0 - Vec3::ONE;
                 let w = s.normal_from_object * c;
                 // Back faces are lit on their flipped side.
                 if s.normal.dot(s.raw_normal) < 0.0 {
@@ -208,16 +285,23 @@ impl ShadeContext<'_> {
             }
             NormalMap::Height { map, scale } => {
                 let Some(t) = s.tangent else { return n };
+                let set = (map.texcoord as usize).min(1);
+                let Some(uv) = tc.uv[set] else { return n };
+                let g = tc.grads[set];
                 let (tt, b) = frame(t);
                 let tex = &map.texture;
-                let size = Vec2::new(tex.width as f32, tex.height as f32) * map.scale;
+                let m2 = map.transform.matrix2;
+                let size = Vec2::new(tex.width as f32, tex.height as f32)
+                    * Vec2::new(m2.x_axis.length(), m2.y_axis.length());
                 // Central differences across one pixel footprint (at least
                 // one texel), each sample filtered at the footprint's level.
-                let texels = (s.grads.dx * size)
-                    .length()
-                    .max((s.grads.dy * size).length());
+                let texels = (g.dx * size).length().max((g.dy * size).length());
                 let step = texels.max(1.0) / size;
-                let h = |d: Vec2| self.sample(map, uv + d, s.grads).x;
+                let h = |d: Vec2| {
+                    let mut at = *tc;
+                    at.uv[set] = Some(uv + d);
+                    self.sample(map, &at).map_or(0.0, |c| c.x)
+                };
                 let du = (h(Vec2::new(step.x, 0.0)) - h(Vec2::new(-step.x, 0.0))) * 0.5;
                 // Image rows run down; the bitangent points up the image.
                 let dv = (h(Vec2::new(0.0, -step.y)) - h(Vec2::new(0.0, step.y))) * 0.5;

@@ -1,0 +1,957 @@
+//! glTF 2.0 through the gltf crate: `.gltf` with external or data-URI
+//! buffers and images, and `.glb`. Every node of the default scene is
+//! flattened into one mesh in the scene's space (its composed TRS or matrix
+//! applied to positions, normals and tangents; mirroring nodes flip the
+//! winding), one group per primitive. Triangles, strips and fans, indexed
+//! or not. glTF's texture coordinates already have the image's top-left
+//! origin, so they are stored as they are (OBJ's are flipped on load).
+//!
+//! What the crate leaves to us, and is checked here so that bad files give
+//! an error instead of a panic or garbage: buffers (GLB chunk, data URIs,
+//! files next to the model) and their lengths, accessor ranges, indices
+//! within the primitive's vertices, and the required extensions.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use base64::Engine;
+use glam::{Affine2, Mat2, Mat3, Mat4, Vec2, Vec3, Vec4};
+use gltf::mesh::Mode;
+
+use super::mesh::{Group, Mesh};
+use super::texture::Wrap;
+use crate::error::Error;
+use crate::scene::desc::{AddressMode, AlphaModeDesc, TextureFilter};
+use crate::scene::light::{Light, LightKind};
+
+/// Extensions that change how softraster draws a file; a file that
+/// requires any other one is refused.
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+];
+
+/// Where an image's bytes are.
+#[derive(Debug, Clone)]
+pub enum ImageSource {
+    File(PathBuf),
+    /// In a buffer or a data URI; `name` (`model.glb#image3`) stands for it.
+    Memory {
+        name: PathBuf,
+        bytes: Arc<[u8]>,
+    },
+}
+
+impl ImageSource {
+    /// The path that names (and caches) the image.
+    pub fn key(&self) -> &Path {
+        match self {
+            ImageSource::File(p) => p,
+            ImageSource::Memory { name, .. } => name,
+        }
+    }
+}
+
+/// A texture reference of a material: image, sampler, coordinates.
+#[derive(Debug, Clone)]
+pub struct TexInfo {
+    pub image: ImageSource,
+    pub texcoord: u8,
+    /// KHR_texture_transform (identity without it).
+    pub transform: Affine2,
+    pub wrap: Wrap,
+    pub min_limit: Option<TextureFilter>,
+    pub mag_nearest: bool,
+}
+
+/// A glTF metallic-roughness material as the file states it.
+#[derive(Debug, Clone)]
+pub struct GltfMaterial {
+    pub name: String,
+    pub base_color: Vec4,
+    pub base_color_tex: Option<TexInfo>,
+    pub metallic: f32,
+    pub roughness: f32,
+    pub metallic_roughness_tex: Option<TexInfo>,
+    pub normal_tex: Option<TexInfo>,
+    pub normal_scale: f32,
+    pub occlusion_tex: Option<TexInfo>,
+    pub occlusion_strength: f32,
+    /// emissiveFactor times KHR_materials_emissive_strength.
+    pub emissive: Vec3,
+    pub emissive_tex: Option<TexInfo>,
+    pub alpha_mode: AlphaModeDesc,
+    pub alpha_cutoff: f32,
+    pub double_sided: bool,
+}
+
+impl GltfMaterial {
+    /// The material of primitives without one (glTF's default).
+    fn default_material() -> GltfMaterial {
+        GltfMaterial {
+            name: "default".into(),
+            base_color: Vec4::ONE,
+            base_color_tex: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_tex: None,
+            normal_tex: None,
+            normal_scale: 1.0,
+            occlusion_tex: None,
+            occlusion_strength: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_tex: None,
+            alpha_mode: AlphaModeDesc::Opaque,
+            alpha_cutoff: 0.5,
+            double_sided: false,
+        }
+    }
+
+    /// Every texture with whether it holds sRGB color.
+    pub fn textures(&self) -> impl Iterator<Item = (&TexInfo, bool)> {
+        [
+            (self.base_color_tex.as_ref(), true),
+            (self.metallic_roughness_tex.as_ref(), false),
+            (self.normal_tex.as_ref(), false),
+            (self.occlusion_tex.as_ref(), false),
+            (self.emissive_tex.as_ref(), true),
+        ]
+        .into_iter()
+        .filter_map(|(t, srgb)| t.map(|t| (t, srgb)))
+    }
+}
+
+/// A KHR_lights_punctual light placed by its node (in the file's space).
+#[derive(Debug, Clone)]
+pub struct GltfLight {
+    pub name: String,
+    pub light: Light,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GltfProjection {
+    /// Vertical field of view in degrees.
+    Perspective { fov_y: f32 },
+    /// Full height of the view volume.
+    Orthographic { height: f32 },
+}
+
+/// A camera placed by its node: it looks down the node's -Z, up +Y.
+#[derive(Debug, Clone)]
+pub struct GltfCamera {
+    pub name: String,
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub up: Vec3,
+    pub projection: GltfProjection,
+    pub near: f32,
+    /// None: infinite (perspective without zfar).
+    pub far: Option<f32>,
+}
+
+#[derive(Debug)]
+pub struct GltfModel {
+    pub mesh: Mesh,
+    /// Indexed by `Group::material`; a default material is appended when a
+    /// primitive has none.
+    pub materials: Vec<GltfMaterial>,
+    pub lights: Vec<GltfLight>,
+    pub cameras: Vec<GltfCamera>,
+    /// Things ignored on the way (optional extensions, point and line
+    /// primitives), for the user to see.
+    pub warnings: Vec<String>,
+}
+
+pub fn load(path: &Path) -> Result<GltfModel, Error> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
+    let err = |msg: String| Error::asset(path, None, msg);
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| err(format!("malformed glTF: {e}")))?;
+    let doc = &gltf.document;
+    let mut warnings = Vec::new();
+    for ext in doc.extensions_required() {
+        if !SUPPORTED_EXTENSIONS.contains(&ext) {
+            return Err(err(format!(
+                "the file requires the glTF extension `{ext}`, which softraster does not support (it supports {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            )));
+        }
+    }
+    for ext in doc.extensions_used() {
+        if !SUPPORTED_EXTENSIONS.contains(&ext) && !doc.extensions_required().any(|r| r == ext) {
+            warnings.push(format!(
+                "{}: uses the optional glTF extension `{ext}`, which softraster ignores",
+                path.display()
+            ));
+        }
+    }
+    validate(doc).map_err(err)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let buffers = load_buffers(doc, gltf.blob.as_deref(), dir, path)?;
+    check_accessors(doc, &buffers).map_err(err)?;
+    let images = image_sources(doc, &buffers, dir, path).map_err(err)?;
+
+    let mut materials: Vec<GltfMaterial> = doc
+        .materials()
+        .map(|m| material(&m, &images, &mut warnings, path))
+        .collect();
+    let mut b = Builder {
+        mesh: Mesh::default(),
+        any_uv: [false; 2],
+        any_color: false,
+        any_tangent: false,
+        default_material: None,
+        skipped_modes: BTreeSet::new(),
+    };
+    let mut lights = Vec::new();
+    let mut cameras = Vec::new();
+
+    // Nodes of the default scene (or the first; without scenes, every root).
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let children: BTreeSet<usize> = doc
+                .nodes()
+                .flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>())
+                .collect();
+            doc.nodes()
+                .filter(|n| !children.contains(&n.index()))
+                .collect()
+        }
+    };
+    let mut seen = vec![false; doc.nodes().count()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY))
+        .collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(err(format!(
+                "node {} is reached twice in the scene's hierarchy (a cycle, or a node with two parents)",
+                node.index()
+            )));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(err(format!(
+                "node {}: its transform is not finite",
+                node.index()
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let mat = match prim.material().index() {
+                    Some(i) => i,
+                    None => *b.default_material.get_or_insert_with(|| {
+                        materials.push(GltfMaterial::default_material());
+                        materials.len() - 1
+                    }),
+                };
+                b.add_primitive(&prim, &buffers, world, mat).map_err(|m| {
+                    err(format!(
+                        "mesh {} primitive {}: {m}",
+                        mesh.index(),
+                        prim.index()
+                    ))
+                })?;
+            }
+        }
+        if let Some(l) = node.light() {
+            lights.push(light(&l, &node, world));
+        }
+        if let Some(c) = node.camera() {
+            cameras.push(camera(&c, &node, world, cameras.len()));
+        }
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, world));
+        }
+    }
+    for mode in &b.skipped_modes {
+        warnings.push(format!(
+            "{}: primitives of mode {mode} are not drawn (softraster draws triangles, strips and fans)",
+            path.display()
+        ));
+    }
+    let mut mesh = b.finish();
+    mesh.groups.retain(|g| !g.triangles.is_empty());
+    Ok(GltfModel {
+        mesh,
+        materials,
+        lights,
+        cameras,
+        warnings,
+    })
+}
+
+fn validate(doc: &gltf::Document) -> Result<(), String> {
+    use gltf::json::validation::Validate;
+    let root = doc.as_json();
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, e| {
+        errors.push(format!("{}: {e}", path()))
+    });
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(format!("invalid glTF: {}", errors[0])),
+        n => Err(format!("invalid glTF: {} (and {} more)", errors[0], n - 1)),
+    }
+}
+
+fn load_buffers(
+    doc: &gltf::Document,
+    blob: Option<&[u8]>,
+    dir: &Path,
+    path: &Path,
+) -> Result<Vec<Vec<u8>>, Error> {
+    let mut out = Vec::new();
+    for b in doc.buffers() {
+        let i = b.index();
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => blob.map(<[u8]>::to_vec).ok_or_else(|| {
+                Error::asset(
+                    path,
+                    None,
+                    format!(
+                        "buffer {i} refers to the GLB binary chunk, which the file does not have"
+                    ),
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
+                Some(d) => d.map_err(|m| Error::asset(path, None, format!("buffer {i}: {m}")))?,
+                None => {
+                    let file = dir.join(percent_decode(uri));
+                    std::fs::read(&file).map_err(|e| {
+                        Error::asset(
+                            &file,
+                            None,
+                            format!("cannot read buffer {i} of {}: {e}", path.display()),
+                        )
+                    })?
+                }
+            },
+        };
+        if data.len() < b.length() {
+            return Err(Error::asset(
+                path,
+                None,
+                format!(
+                    "buffer {i} holds {} bytes but declares {} (truncated file?)",
+                    data.len(),
+                    b.length()
+                ),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// `data:[mime];base64,...`: Some(decoded) for a data URI, None otherwise.
+fn data_uri(uri: &str) -> Option<Result<Vec<u8>, String>> {
+    let rest = uri.strip_prefix("data:")?;
+    let Some((_, payload)) = rest.split_once(";base64,") else {
+        return Some(Err("data URIs must be base64-encoded".into()));
+    };
+    Some(
+        base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("bad base64 data URI: {e}")),
+    )
+}
+
+fn percent_decode(uri: &str) -> String {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && i + 2 < b.len()
+            && let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2]))
+        {
+            let v = (h * 16 + l) as u8;
+            out.push(v);
+            i += 3;
+            continue;
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Every accessor lies within its buffer view and buffer, has at least one
+/// element, and a stride no smaller than its element (the crate assumes
+/// all three).
+fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(), String> {
+    for v in doc.views() {
+        let len = buffers[v.buffer().index()].len();
+        if v.offset()
+            .checked_add(v.length())
+            .is_none_or(|end| end > len)
+        {
+            return Err(format!(
+                "buffer view {} (bytes {}..{}) lies outside buffer {} ({len} bytes)",
+                v.index(),
+                v.offset(),
+                v.offset().saturating_add(v.length()),
+                v.buffer().index()
+            ));
+        }
+    }
+    for a in doc.accessors() {
+        let i = a.index();
+        if a.count() == 0 {
+            return Err(format!("accessor {i} has no elements"));
+        }
+        if a.sparse().is_some() {
+            continue;
+        }
+        let Some(view) = a.view() else { continue };
+        let size = a.size();
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(format!(
+                "accessor {i}: its buffer view's stride {stride} is smaller than an element ({size} bytes)"
+            ));
+        }
+        let end = (a.count() - 1)
+            .checked_mul(stride)
+            .and_then(|x| x.checked_add(a.offset() + size));
+        if end.is_none_or(|end| end > view.length()) {
+            return Err(format!(
+                "accessor {i} ({} elements from byte {}) runs past the end of buffer view {} ({} bytes)",
+                a.count(),
+                a.offset(),
+                view.index(),
+                view.length()
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn image_sources(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    dir: &Path,
+    path: &Path,
+) -> Result<Vec<ImageSource>, String> {
+    let name = |i: usize| PathBuf::from(format!("{}#image{i}", path.display()));
+    doc.images()
+        .map(|img| {
+            let i = img.index();
+            Ok(match img.source() {
+                gltf::image::Source::View { view, .. } => {
+                    let b = &buffers[view.buffer().index()];
+                    let bytes = &b[view.offset()..view.offset() + view.length()];
+                    ImageSource::Memory {
+                        name: name(i),
+                        bytes: bytes.into(),
+                    }
+                }
+                gltf::image::Source::Uri { uri, .. } => match data_uri(uri) {
+                    Some(d) => ImageSource::Memory {
+                        name: name(i),
+                        bytes: d.map_err(|m| format!("image {i}: {m}"))?.into(),
+                    },
+                    None => ImageSource::File(dir.join(percent_decode(uri))),
+                },
+            })
+        })
+        .collect()
+}
+
+/// KHR_texture_transform as an affine map of texture coordinates:
+/// translate * rotate * scale, the rotation as implementations and the
+/// sample models have it (u' = cos u + sin v, v' = -sin u + cos v: the
+/// image turns clockwise on screen for a positive angle). Also returns its
+/// texCoord override.
+fn texture_transform(ext: Option<&gltf::json::Value>) -> (Affine2, Option<u32>) {
+    let Some(v) = ext else {
+        return (Affine2::IDENTITY, None);
+    };
+    let pair = |k: &str, d: Vec2| -> Vec2 {
+        v.get(k)
+            .and_then(|a| a.as_array())
+            .filter(|a| a.len() == 2)
+            .and_then(|a| Some(Vec2::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32)))
+            .unwrap_or(d)
+    };
+    let offset = pair("offset", Vec2::ZERO);
+    let scale = pair("scale", Vec2::ONE);
+    let r = v.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0) as f32;
+    let (s, c) = r.sin_cos();
+    let rot = Mat2::from_cols(Vec2::new(c, -s), Vec2::new(s, c));
+    let m = Affine2::from_mat2_translation(rot * Mat2::from_diagonal(scale), offset);
+    let tc = v.get("texCoord").and_then(|t| t.as_u64()).map(|t| t as u32);
+    (m, tc)
+}
+
+fn tex_info(
+    texture: gltf::Texture,
+    tex_coord: u32,
+    transform: Option<&gltf::json::Value>,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<TexInfo> {
+    let image = images.get(texture.source().index())?.clone();
+    let (transform, tc) = texture_transform(transform);
+    let set = tc.unwrap_or(tex_coord);
+    let texcoord = if set > 1 {
+        warnings.push(format!(
+            "{}: texture {} reads TEXCOORD_{set}; softraster reads sets 0 and 1 and uses 0",
+            path.display(),
+            texture.index()
+        ));
+        0
+    } else {
+        set as u8
+    };
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let sampler = texture.sampler();
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => AddressMode::Clamp,
+        WrappingMode::MirroredRepeat => AddressMode::Mirror,
+        WrappingMode::Repeat => AddressMode::Repeat,
+    };
+    let min_limit = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => Some(TextureFilter::Nearest),
+        Some(MinFilter::Linear) => Some(TextureFilter::Bilinear),
+        _ => None,
+    };
+    Some(TexInfo {
+        image,
+        texcoord,
+        transform,
+        wrap: Wrap(wrap(sampler.wrap_s()), wrap(sampler.wrap_t())),
+        min_limit,
+        mag_nearest: sampler.mag_filter() == Some(MagFilter::Nearest),
+    })
+}
+
+fn material(
+    m: &gltf::Material,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> GltfMaterial {
+    const TT: &str = "KHR_texture_transform";
+    let pbr = m.pbr_metallic_roughness();
+    let info = |i: Option<gltf::texture::Info>, w: &mut Vec<String>| {
+        i.and_then(|i| {
+            tex_info(
+                i.texture(),
+                i.tex_coord(),
+                i.extension_value(TT),
+                images,
+                w,
+                path,
+            )
+        })
+    };
+    let base_color_tex = info(pbr.base_color_texture(), warnings);
+    let metallic_roughness_tex = info(pbr.metallic_roughness_texture(), warnings);
+    let emissive_tex = info(m.emissive_texture(), warnings);
+    let normal = m.normal_texture();
+    let normal_tex = normal.as_ref().and_then(|n| {
+        tex_info(
+            n.texture(),
+            n.tex_coord(),
+            n.extension_value(TT),
+            images,
+            warnings,
+            path,
+        )
+    });
+    let occlusion = m.occlusion_texture();
+    let occlusion_tex = occlusion.as_ref().and_then(|o| {
+        tex_info(
+            o.texture(),
+            o.tex_coord(),
+            o.extension_value(TT),
+            images,
+            warnings,
+            path,
+        )
+    });
+    GltfMaterial {
+        name: m
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("material{}", m.index().unwrap_or(0))),
+        base_color: Vec4::from(pbr.base_color_factor()),
+        base_color_tex,
+        metallic: pbr.metallic_factor(),
+        roughness: pbr.roughness_factor(),
+        metallic_roughness_tex,
+        normal_tex,
+        normal_scale: normal.as_ref().map(|n| n.scale()).unwrap_or(1.0),
+        occlusion_tex,
+        occlusion_strength: occlusion.as_ref().map(|o| o.strength()).unwrap_or(1.0),
+        emissive: Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
+        emissive_tex,
+        alpha_mode: match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaModeDesc::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaModeDesc::Mask,
+            gltf::material::AlphaMode::Blend => AlphaModeDesc::Blend,
+        },
+        alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
+        double_sided: m.double_sided(),
+    }
+}
+
+fn light(l: &gltf::khr_lights_punctual::Light, node: &gltf::Node, world: Mat4) -> GltfLight {
+    use gltf::khr_lights_punctual::Kind;
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world
+        .transform_vector3(Vec3::NEG_Z)
+        .try_normalize()
+        .unwrap_or(Vec3::NEG_Z);
+    let intensity = l.intensity();
+    let kind = match l.kind() {
+        Kind::Directional => LightKind::Directional {
+            direction,
+            irradiance: intensity,
+        },
+        Kind::Point => LightKind::Point {
+            position,
+            intensity,
+        },
+        Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => LightKind::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner: inner_cone_angle.cos(),
+            cos_outer: outer_cone_angle.cos(),
+        },
+    };
+    GltfLight {
+        name: l
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("light{}", l.index())),
+        light: Light {
+            kind,
+            color: Vec3::from(l.color()),
+            shadows: false,
+            range: l.range(),
+        },
+    }
+}
+
+fn camera(c: &gltf::Camera, node: &gltf::Node, world: Mat4, n: usize) -> GltfCamera {
+    let eye = world.transform_point3(Vec3::ZERO);
+    let forward = world
+        .transform_vector3(Vec3::NEG_Z)
+        .try_normalize()
+        .unwrap_or(Vec3::NEG_Z);
+    let up = world
+        .transform_vector3(Vec3::Y)
+        .try_normalize()
+        .unwrap_or(Vec3::Y);
+    let (projection, near, far) = match c.projection() {
+        gltf::camera::Projection::Perspective(p) => (
+            GltfProjection::Perspective {
+                fov_y: p.yfov().to_degrees(),
+            },
+            p.znear(),
+            p.zfar(),
+        ),
+        gltf::camera::Projection::Orthographic(o) => (
+            GltfProjection::Orthographic {
+                height: 2.0 * o.ymag().abs(),
+            },
+            o.znear(),
+            Some(o.zfar()),
+        ),
+    };
+    GltfCamera {
+        name: c
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("gltf_camera{n}")),
+        eye,
+        forward,
+        up,
+        projection,
+        near,
+        far,
+    }
+}
+
+/// Triangle corner indices of a primitive's index list, per its mode.
+pub fn triangulate(mode: Mode, idx: &[u32]) -> Option<Vec<[u32; 3]>> {
+    let n = idx.len();
+    Some(match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        // p_i = (v_i, v_{i+1+i%2}, v_{i+2-i%2}): every other one reversed,
+        // so all keep the first one's winding.
+        Mode::TriangleStrip => (0..n.saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [idx[i], idx[i + 1], idx[i + 2]]
+                } else {
+                    [idx[i], idx[i + 2], idx[i + 1]]
+                }
+            })
+            .collect(),
+        // p_i = (v_{i+1}, v_{i+2}, v_0)
+        Mode::TriangleFan => (0..n.saturating_sub(2))
+            .map(|i| [idx[i + 1], idx[i + 2], idx[0]])
+            .collect(),
+        _ => return None,
+    })
+}
+
+struct Builder {
+    mesh: Mesh,
+    any_uv: [bool; 2],
+    any_color: bool,
+    any_tangent: bool,
+    default_material: Option<usize>,
+    skipped_modes: BTreeSet<String>,
+}
+
+impl Builder {
+    fn add_primitive(
+        &mut self,
+        prim: &gltf::Primitive,
+        buffers: &[Vec<u8>],
+        world: Mat4,
+        material: usize,
+    ) -> Result<(), String> {
+        let mode = prim.mode();
+        if matches!(
+            mode,
+            Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
+        ) {
+            self.skipped_modes.insert(format!("{mode:?}"));
+            return Ok(());
+        }
+        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| {
+                if prim.get(&gltf::Semantic::Positions).is_none() {
+                    "it has no POSITION attribute".to_string()
+                } else {
+                    unreadable("POSITION")
+                }
+            })?
+            .map(Vec3::from)
+            .collect();
+        let n = positions.len();
+        let same_len = |what: &str, len: usize| {
+            if len == n {
+                Ok(())
+            } else {
+                Err(format!("{what} has {len} elements but POSITION has {n}"))
+            }
+        };
+        let normals: Option<Vec<Vec3>> = match reader.read_normals() {
+            Some(r) => Some(r.map(Vec3::from).collect()),
+            None if prim.get(&gltf::Semantic::Normals).is_some() => {
+                return Err(unreadable("NORMAL"));
+            }
+            None => None,
+        };
+        let tangents: Option<Vec<Vec4>> =
+            reader.read_tangents().map(|r| r.map(Vec4::from).collect());
+        let uv: [Option<Vec<Vec2>>; 2] = [0, 1].map(|s| {
+            reader
+                .read_tex_coords(s)
+                .map(|r| r.into_f32().map(Vec2::from).collect())
+        });
+        let colors: Option<Vec<Vec4>> = reader
+            .read_colors(0)
+            .map(|r| r.into_rgba_f32().map(Vec4::from).collect());
+        if let Some(v) = &normals {
+            same_len("NORMAL", v.len())?;
+        }
+        if let Some(v) = &tangents {
+            same_len("TANGENT", v.len())?;
+        }
+        for (s, v) in uv.iter().enumerate() {
+            if let Some(v) = v {
+                same_len(&format!("TEXCOORD_{s}"), v.len())?;
+            }
+        }
+        if let Some(v) = &colors {
+            same_len("COLOR_0", v.len())?;
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(r) => r.into_u32().collect(),
+            None if prim.indices().is_some() => return Err(unreadable("indices")),
+            None => (0..n as u32).collect(),
+        };
+        if let Some((k, &bad)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= n) {
+            return Err(format!(
+                "index {k} is {bad}, out of range: the primitive has {n} vertices"
+            ));
+        }
+        let Some(mut tris) = triangulate(mode, &indices) else {
+            return Ok(());
+        };
+        let m3 = Mat3::from_mat4(world);
+        let mirrored = m3.determinant() < 0.0;
+        let normal_m = m3.inverse().transpose();
+
+        // Without normals glTF asks for flat shading: every corner its own
+        // vertex with the face normal, and any tangents ignored.
+        let (order, face_normals): (Vec<u32>, Option<Vec<Vec3>>) = if normals.is_some() {
+            ((0..n as u32).collect(), None)
+        } else {
+            let order: Vec<u32> = tris.iter().flatten().copied().collect();
+            let fn_: Vec<Vec3> = tris
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| positions[i as usize]);
+                    (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y)
+                })
+                .collect();
+            tris = (0..tris.len() as u32)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect();
+            (order, Some(fn_))
+        };
+        let base = self.mesh.positions.len() as u32;
+        let m = &mut self.mesh;
+        for (k, &src) in order.iter().enumerate() {
+            let s = src as usize;
+            m.positions.push(world.transform_point3(positions[s]));
+            let nrm = match (&normals, &face_normals) {
+                (Some(nv), _) => nv[s],
+                (None, Some(f)) => f[k / 3],
+                _ => Vec3::Y,
+            };
+            m.normals
+                .push((normal_m * nrm).try_normalize().unwrap_or(Vec3::Y));
+            for (list, set) in [&mut m.uvs, &mut m.uvs1].into_iter().zip(&uv) {
+                list.push(set.as_ref().map(|v| v[s]).unwrap_or(Vec2::ZERO));
+            }
+            m.colors
+                .push(colors.as_ref().map(|c| c[s]).unwrap_or(Vec4::ONE));
+            let t = match (&tangents, &face_normals) {
+                (Some(t), None) => {
+                    let t = t[s];
+                    let xyz = (m3 * t.truncate()).try_normalize();
+                    match xyz {
+                        Some(v) if t.w != 0.0 => {
+                            let w = if t.w < 0.0 { -1.0 } else { 1.0 };
+                            v.extend(if mirrored { -w } else { w })
+                        }
+                        _ => Vec4::ZERO,
+                    }
+                }
+                _ => Vec4::ZERO,
+            };
+            m.authored_tangents.push(t);
+        }
+        self.any_uv[0] |= uv[0].is_some();
+        self.any_uv[1] |= uv[1].is_some();
+        self.any_color |= colors.is_some();
+        self.any_tangent |= tangents.is_some() && face_normals.is_none();
+        let first = m.triangles.len() as u32;
+        for t in tris {
+            let [a, b, c] = t.map(|i| i + base);
+            m.triangles
+                .push(if mirrored { [a, c, b] } else { [a, b, c] });
+        }
+        let end = m.triangles.len() as u32;
+        m.groups.push(Group {
+            triangles: first..end,
+            material,
+        });
+        Ok(())
+    }
+
+    fn finish(self) -> Mesh {
+        let mut m = self.mesh;
+        if !self.any_uv[0] {
+            m.uvs.clear();
+        }
+        if !self.any_uv[1] {
+            m.uvs1.clear();
+        }
+        if !self.any_color {
+            m.colors.clear();
+        }
+        if !self.any_tangent {
+            m.authored_tangents.clear();
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_the_winding() {
+        let idx = [0, 1, 2, 3, 4];
+        assert_eq!(
+            triangulate(Mode::TriangleStrip, &idx).unwrap(),
+            vec![[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+        );
+        assert_eq!(
+            triangulate(Mode::TriangleFan, &idx).unwrap(),
+            vec![[1, 2, 0], [2, 3, 0], [3, 4, 0]]
+        );
+        assert_eq!(
+            triangulate(Mode::Triangles, &[0, 1, 2, 3]).unwrap(),
+            vec![[0, 1, 2]]
+        );
+        assert!(triangulate(Mode::Lines, &idx).is_none());
+        assert!(
+            triangulate(Mode::TriangleStrip, &[0, 1])
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn texture_transform_matches_the_spec_example() {
+        // KHR_texture_transform's example: the lower-left quadrant of the
+        // image, rotated (offset [0, 1], rotation pi/2, scale 0.5).
+        let v: gltf::json::Value = gltf::json::deserialize::from_str(
+            r#"{"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5], "texCoord": 1}"#,
+        )
+        .unwrap();
+        let (m, tc) = texture_transform(Some(&v));
+        assert_eq!(tc, Some(1));
+        let corners = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE].map(|p| m.transform_point2(p));
+        for c in corners {
+            assert!(c.x > -1e-6 && c.x < 0.5 + 1e-6, "{c}");
+            assert!(c.y > 0.5 - 1e-6 && c.y < 1.0 + 1e-6, "{c}");
+        }
+        // u runs up the image: (1, 0) -> (0, 0.5).
+        assert!((corners[1] - Vec2::new(0.0, 0.5)).length() < 1e-6);
+    }
+
+    #[test]
+    fn data_uris_and_percent_escapes() {
+        assert_eq!(
+            data_uri("data:application/octet-stream;base64,AAEC")
+                .unwrap()
+                .unwrap(),
+            vec![0, 1, 2]
+        );
+        assert!(data_uri("data:text/plain,abc").unwrap().is_err());
+        assert!(data_uri("model.bin").is_none());
+        assert_eq!(percent_decode("a%20b.bin"), "a b.bin");
+        assert_eq!(percent_decode("100%"), "100%");
+    }
+}
