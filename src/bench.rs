@@ -23,7 +23,8 @@ pub struct BenchArgs {
     /// The shared model directory.
     #[arg(long, default_value = "../shared/assets")]
     pub assets: PathBuf,
-    /// Which workloads: diablo3, nefertiti, or all.
+    /// Which workloads: diablo3, nefertiti, flighthelmet (glTF, pbr),
+    /// diablo3-4k, diablo3-4k-aniso, filters, or all (the first three).
     #[arg(long, default_value = "all")]
     pub case: String,
     #[arg(long, default_value_t = 72)]
@@ -82,6 +83,13 @@ fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<Strin
              kd = [0.8, 0.8, 0.8]\nks = [0.5, 0.5, 0.5]\nns = 32.0\n",
             p(assets.join("common/nefertiti.obj"))?
         ),
+        // glTF with pbr materials (base color, normal, occlusion-roughness-
+        // metallic maps, 512x512), trilinear like the 4k case.
+        "flighthelmet" => format!(
+            "{}[[model]]\npath = \"{}\"\n",
+            common.replace("\"bilinear\"", "\"trilinear\""),
+            p(assets.join("gltf/FlightHelmet/FlightHelmet.gltf"))?
+        ),
         "diablo3-4k" | "diablo3-4k-aniso" => {
             let dir = resampled_diablo3(&d3)?;
             let filter = if case.ends_with("aniso") {
@@ -100,7 +108,7 @@ fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<Strin
         }
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, diablo3-4k, diablo3-4k-aniso, filters or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters or all"
             )));
         }
     })
@@ -229,7 +237,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         return Ok(());
     }
     let cases: Vec<&str> = match args.case.as_str() {
-        "all" => vec!["diablo3", "nefertiti"],
+        "all" => vec!["diablo3", "nefertiti", "flighthelmet"],
         c => vec![c],
     };
     let mut builder = rayon::ThreadPoolBuilder::new();

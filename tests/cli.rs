@@ -239,3 +239,108 @@ fn committed_showcase_assets_are_what_the_generator_makes() {
         );
     }
 }
+
+#[test]
+fn bad_gltf_files_exit_2_with_a_clear_message() {
+    let dir = common::scratch("bad_gltf");
+    let tri = common::Prim {
+        positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        indices: vec![0, 1, 2],
+        ..Default::default()
+    };
+    let nodes = r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]"#;
+    let scene = |model: &str| write(&dir, "s.toml", &format!("[[model]]\npath = \"{model}\"\n"));
+
+    // A .glb cut short.
+    let glb = common::glb(&tri, "", nodes);
+    std::fs::write(dir.join("cut.glb"), &glb[..glb.len() - 20]).unwrap();
+    let err = exit_2(&scene("cut.glb"), &dir);
+    assert!(
+        err.contains("cut.glb") && err.contains("truncated .glb"),
+        "{err}"
+    );
+    // The whole one renders.
+    std::fs::write(dir.join("whole.glb"), &glb).unwrap();
+    let (code, err) = run(&[
+        "render",
+        scene("whole.glb").to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+
+    // A buffer file that is not there.
+    let (text, _) = common::gltf_text(&tri, "", nodes, Some("missing.bin"));
+    write(&dir, "nobuf.gltf", &text);
+    let err = exit_2(&scene("nobuf.gltf"), &dir);
+    assert!(
+        err.contains("missing.bin") && err.contains("buffer 0"),
+        "{err}"
+    );
+
+    // An index past the vertices.
+    let bad = common::Prim {
+        indices: vec![0, 1, 7],
+        ..tri.clone()
+    };
+    let (text, _) = common::gltf_text(&bad, "", nodes, None);
+    write(&dir, "index.gltf", &text);
+    let err = exit_2(&scene("index.gltf"), &dir);
+    assert!(
+        err.contains("index.gltf") && err.contains("index 2 is 7") && err.contains("3 vertices"),
+        "{err}"
+    );
+
+    // A required extension softraster does not have.
+    let (text, _) = common::gltf_text(
+        &tri,
+        "",
+        &format!(
+            r#"{nodes}, "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"]"#
+        ),
+        None,
+    );
+    write(&dir, "draco.gltf", &text);
+    let err = exit_2(&scene("draco.gltf"), &dir);
+    assert!(
+        err.contains("requires the glTF extension `KHR_draco_mesh_compression`"),
+        "{err}"
+    );
+
+    // An optional one is a warning, and the file renders.
+    let (text, _) = common::gltf_text(
+        &tri,
+        "",
+        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_clearcoat"]"#),
+        None,
+    );
+    write(&dir, "clearcoat.gltf", &text);
+    let (code, err) = run(&[
+        "render",
+        scene("clearcoat.gltf").to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning:")
+            && err.contains("`KHR_materials_clearcoat`")
+            && err.contains("ignores"),
+        "{err}"
+    );
+
+    // An accessor reaching past its buffer view.
+    let (text, _) = common::gltf_text(&tri, "", nodes, None);
+    let text = text.replacen(
+        r#""count": 3, "type": "VEC3""#,
+        r#""count": 30, "type": "VEC3""#,
+        1,
+    );
+    write(&dir, "short.gltf", &text);
+    let err = exit_2(&scene("short.gltf"), &dir);
+    assert!(
+        err.contains("accessor 0") && err.contains("runs past"),
+        "{err}"
+    );
+}

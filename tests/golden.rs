@@ -127,6 +127,12 @@ fn spot_triangulated_and_quads() {
 }
 
 #[test]
+fn gltf_flight_helmet_and_cornell_box() {
+    real("flight_helmet");
+    real("cornell_box");
+}
+
+#[test]
 fn bunny_nefertiti_teapot() {
     real("bunny");
     real("nefertiti");

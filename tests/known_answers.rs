@@ -382,3 +382,52 @@ fn a_camera_inside_a_box_sees_walls_everywhere_without_nan() {
     let lit = f.color.iter().filter(|c| c.x > 0.0).count();
     assert!(lit > 64 * 64 / 2);
 }
+
+#[test]
+fn pbr_plane_under_a_point_light_matches_appendix_b_by_hand() {
+    // The MTL plane shaded as pbr: base color = Kd, metallic 0, roughness 1
+    // (alpha 1: D = 1/pi, Vis = 1 / ((n.l + 1)(n.v + 1))), no ambient.
+    let dir = common::scratch("pbr_plane");
+    let scene = common::scene_in(
+        &dir,
+        "[output]\nwidth = 80\nheight = 60\n[render]\nshading = \"pbr\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+         [[model]]\npath = \"quad.obj\"\nscale = 10.0\n[model.material]\nkd = [0.5, 0.25, 0.125]\nmetallic = 0.0\nroughness = 1.0\n\
+         [[light]]\nkind = \"point\"\nposition = [0.3, 2.0, -0.5]\nintensity = 7.0\n\
+         [[camera]]\neye = [0.0, 3.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 60.0\n",
+        &[("quad.obj", QUAD_OBJ)],
+    );
+    let f = render_frame(&scene, 0, 0);
+    let cam = &scene.cameras[0];
+    let world_from_view = cam.view_from_world().inverse();
+    let light = Vec3::new(0.3, 2.0, -0.5);
+    let base = Vec3::new(0.5, 0.25, 0.125);
+    let pi = std::f32::consts::PI;
+    let mut checked = 0;
+    for py in 0..60 {
+        for px in 0..80 {
+            let i = (py * 80 + px) as usize;
+            if !f.depth[i].is_finite() {
+                continue;
+            }
+            let d = world_from_view.transform_vector3(common::view_ray(px, py, 80, 60, 60.0));
+            let p = cam.eye + d * (-cam.eye.y / d.y);
+            let to_l = light - p;
+            let l = to_l.normalize();
+            let v = (cam.eye - p).normalize();
+            let h = (l + v).normalize();
+            let (ndl, ndv) = (l.y, v.y);
+            let fresnel = 0.04 + 0.96 * (1.0 - v.dot(h)).powi(5);
+            let spec = fresnel / pi / ((ndl + 1.0) * (ndv + 1.0));
+            let f_r = base * (1.0 - fresnel) / pi + Vec3::splat(spec);
+            let want = f_r * (7.0 / to_l.length_squared()) * ndl;
+            let got = f.color[i].truncate();
+            let err = (got - want).abs().max_element();
+            assert!(
+                err < 1e-3 * want.max_element(),
+                "({px},{py}): {got} vs {want}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 2000, "{checked}");
+}

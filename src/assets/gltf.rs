@@ -168,6 +168,15 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
     let bytes = std::fs::read(path)
         .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
     let err = |msg: String| Error::asset(path, None, msg);
+    if bytes.starts_with(b"glTF") && bytes.len() >= 12 {
+        let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        if declared > bytes.len() {
+            return Err(err(format!(
+                "truncated .glb: its header declares {declared} bytes, the file has {}",
+                bytes.len()
+            )));
+        }
+    }
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| err(format!("malformed glTF: {e}")))?;
     let doc = &gltf.document;
@@ -471,31 +480,60 @@ fn image_sources(
 /// sample models have it (u' = cos u + sin v, v' = -sin u + cos v: the
 /// image turns clockwise on screen for a positive angle). Also returns its
 /// texCoord override.
-fn texture_transform(ext: Option<&gltf::json::Value>) -> (Affine2, Option<u32>) {
-    let Some(v) = ext else {
+fn texture_transform(t: Option<Transform>) -> (Affine2, Option<u32>) {
+    let Some(t) = t else {
         return (Affine2::IDENTITY, None);
     };
-    let pair = |k: &str, d: Vec2| -> Vec2 {
-        v.get(k)
-            .and_then(|a| a.as_array())
-            .filter(|a| a.len() == 2)
-            .and_then(|a| Some(Vec2::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32)))
-            .unwrap_or(d)
-    };
-    let offset = pair("offset", Vec2::ZERO);
-    let scale = pair("scale", Vec2::ONE);
-    let r = v.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0) as f32;
-    let (s, c) = r.sin_cos();
+    let (s, c) = t.rotation.sin_cos();
     let rot = Mat2::from_cols(Vec2::new(c, -s), Vec2::new(s, c));
-    let m = Affine2::from_mat2_translation(rot * Mat2::from_diagonal(scale), offset);
-    let tc = v.get("texCoord").and_then(|t| t.as_u64()).map(|t| t as u32);
-    (m, tc)
+    let m = Affine2::from_mat2_translation(rot * Mat2::from_diagonal(t.scale), t.offset);
+    (m, t.tex_coord)
+}
+
+/// KHR_texture_transform's values.
+#[derive(Debug, Clone, Copy)]
+struct Transform {
+    offset: Vec2,
+    rotation: f32,
+    scale: Vec2,
+    tex_coord: Option<u32>,
+}
+
+impl Transform {
+    /// From a textureInfo (the crate parses the extension there).
+    fn of_info(i: &gltf::texture::Info) -> Option<Transform> {
+        i.texture_transform().map(|t| Transform {
+            offset: Vec2::from(t.offset()),
+            rotation: t.rotation(),
+            scale: Vec2::from(t.scale()),
+            tex_coord: t.tex_coord(),
+        })
+    }
+
+    /// From the raw extension object (normal and occlusion textures, where
+    /// the crate leaves it as JSON).
+    fn of_json(v: Option<&gltf::json::Value>) -> Option<Transform> {
+        let v = v?;
+        let pair = |k: &str, d: Vec2| -> Vec2 {
+            v.get(k)
+                .and_then(|a| a.as_array())
+                .filter(|a| a.len() == 2)
+                .and_then(|a| Some(Vec2::new(a[0].as_f64()? as f32, a[1].as_f64()? as f32)))
+                .unwrap_or(d)
+        };
+        Some(Transform {
+            offset: pair("offset", Vec2::ZERO),
+            rotation: v.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0) as f32,
+            scale: pair("scale", Vec2::ONE),
+            tex_coord: v.get("texCoord").and_then(|t| t.as_u64()).map(|t| t as u32),
+        })
+    }
 }
 
 fn tex_info(
     texture: gltf::Texture,
     tex_coord: u32,
-    transform: Option<&gltf::json::Value>,
+    transform: Option<Transform>,
     images: &[ImageSource],
     warnings: &mut Vec<String>,
     path: &Path,
@@ -548,7 +586,7 @@ fn material(
             tex_info(
                 i.texture(),
                 i.tex_coord(),
-                i.extension_value(TT),
+                Transform::of_info(&i),
                 images,
                 w,
                 path,
@@ -563,7 +601,7 @@ fn material(
         tex_info(
             n.texture(),
             n.tex_coord(),
-            n.extension_value(TT),
+            Transform::of_json(n.extension_value(TT)),
             images,
             warnings,
             path,
@@ -574,7 +612,7 @@ fn material(
         tex_info(
             o.texture(),
             o.tex_coord(),
-            o.extension_value(TT),
+            Transform::of_json(o.extension_value(TT)),
             images,
             warnings,
             path,
@@ -930,7 +968,7 @@ mod tests {
             r#"{"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5], "texCoord": 1}"#,
         )
         .unwrap();
-        let (m, tc) = texture_transform(Some(&v));
+        let (m, tc) = texture_transform(Transform::of_json(Some(&v)));
         assert_eq!(tc, Some(1));
         let corners = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE].map(|p| m.transform_point2(p));
         for c in corners {

@@ -44,3 +44,175 @@ pub fn view_ray(px: u32, py: u32, w: u32, h: u32, fov: f32) -> glam::Vec3 {
     let y = (1.0 - (py as f32 + 0.5) / h as f32 * 2.0) * t;
     glam::Vec3::new(x, y, -1.0)
 }
+
+/// One glTF primitive's data, written by `gltf_text` / `glb`.
+#[derive(Default, Clone)]
+pub struct Prim {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub uv0: Vec<[f32; 2]>,
+    pub uv1: Vec<[f32; 2]>,
+    pub indices: Vec<u32>,
+}
+
+/// The binary buffer of `p` and its "accessors"/"bufferViews" JSON and
+/// the primitive's "attributes"/"indices" JSON.
+fn gltf_parts(p: &Prim) -> (Vec<u8>, String, String) {
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut attrs = Vec::new();
+    let mut add = |name: &str, data: Vec<u8>, count: usize, ty: &str, comp: u32, minmax: String| {
+        views.push(format!(
+            r#"{{"buffer": 0, "byteOffset": {}, "byteLength": {}}}"#,
+            bin.len(),
+            data.len()
+        ));
+        bin.extend(data);
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        accessors.push(format!(
+            r#"{{"bufferView": {}, "componentType": {comp}, "count": {count}, "type": "{ty}"{minmax}}}"#,
+            views.len() - 1
+        ));
+        attrs.push(format!(r#""{name}": {}"#, accessors.len() - 1));
+    };
+    let f32s = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+    for q in &p.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    let mm = format!(r#", "min": {lo:?}, "max": {hi:?}"#);
+    let n = p.positions.len();
+    add("POSITION", f32s(&p.positions.concat()), n, "VEC3", 5126, mm);
+    if !p.normals.is_empty() {
+        add(
+            "NORMAL",
+            f32s(&p.normals.concat()),
+            n,
+            "VEC3",
+            5126,
+            String::new(),
+        );
+    }
+    if !p.uv0.is_empty() {
+        add(
+            "TEXCOORD_0",
+            f32s(&p.uv0.concat()),
+            n,
+            "VEC2",
+            5126,
+            String::new(),
+        );
+    }
+    if !p.uv1.is_empty() {
+        add(
+            "TEXCOORD_1",
+            f32s(&p.uv1.concat()),
+            n,
+            "VEC2",
+            5126,
+            String::new(),
+        );
+    }
+    if !p.indices.is_empty() {
+        let data = p.indices.iter().flat_map(|x| x.to_le_bytes()).collect();
+        add(
+            "INDICES",
+            data,
+            p.indices.len(),
+            "SCALAR",
+            5125,
+            String::new(),
+        );
+    }
+    let mut prim_attrs: Vec<String> = attrs.clone();
+    let indices = if !p.indices.is_empty() {
+        let last = prim_attrs.pop().unwrap();
+        format!(r#", "indices": {}"#, last.rsplit(' ').next().unwrap())
+    } else {
+        String::new()
+    };
+    let tables = format!(
+        r#""accessors": [{}], "bufferViews": [{}]"#,
+        accessors.join(", "),
+        views.join(", ")
+    );
+    let prim = format!(r#""attributes": {{{}}}{indices}"#, prim_attrs.join(", "));
+    (bin, tables, prim)
+}
+
+/// A .gltf document for one primitive (mesh 0; `prim_extra` is added to
+/// the primitive, e.g. `, "material": 0`), `body` the remaining top-level
+/// fields (nodes, scenes, materials...), and the buffer at `uri` (None: a
+/// base64 data URI). Returns the text and the buffer's bytes.
+pub fn gltf_text(p: &Prim, prim_extra: &str, body: &str, uri: Option<&str>) -> (String, Vec<u8>) {
+    use base64::Engine;
+    let (bin, tables, prim) = gltf_parts(p);
+    let uri = match uri {
+        Some(u) => u.to_string(),
+        None => format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&bin)
+        ),
+    };
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "buffers": [{{"uri": "{uri}", "byteLength": {}}}], {tables}, "meshes": [{{"primitives": [{{{prim}{prim_extra}}}]}}], {body}}}"#,
+        bin.len()
+    );
+    (text, bin)
+}
+
+/// The same as a binary .glb (the buffer in the BIN chunk).
+pub fn glb(p: &Prim, prim_extra: &str, body: &str) -> Vec<u8> {
+    let (bin, tables, prim) = gltf_parts(p);
+    let mut json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "buffers": [{{"byteLength": {}}}], {tables}, "meshes": [{{"primitives": [{{{prim}{prim_extra}}}]}}], {body}}}"#,
+        bin.len()
+    )
+    .into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+/// A unit cube (side 1, centered), 24 vertices with face normals and UVs.
+pub fn cube() -> Prim {
+    let mut p = Prim::default();
+    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
+        ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
+        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
+        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+    ];
+    for (n, u, v) in faces {
+        let base = p.positions.len() as u32;
+        for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            p.positions
+                .push([0, 1, 2].map(|k| 0.5 * (n[k] + a * u[k] + b * v[k])));
+            p.normals.push(n);
+            p.uv0.push([(a + 1.0) * 0.5, (1.0 - b) * 0.5]);
+        }
+        p.indices
+            .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    p
+}

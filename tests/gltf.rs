@@ -1,0 +1,385 @@
+//! glTF end to end: the same mesh written as OBJ and as glTF (with a node
+//! transform) renders to the same pixels; nested TRS nodes place a cube
+//! where the composed matrix says; mirrored nodes keep their front faces;
+//! samplers, texture coordinate sets and KHR_texture_transform pick the
+//! texels they should; imported lights and cameras land where their nodes
+//! put them.
+
+mod common;
+
+use common::{Prim, cube, gltf_text};
+use glam::{Mat4, Quat, Vec3};
+use softraster::output::resolve;
+use softraster::render::render_frame;
+use softraster::scene::Scene;
+use softraster::scene::camera::Projection;
+use softraster::scene::light::LightKind;
+
+/// A 4x4 RGBA PNG: red, green / blue, yellow quadrants (top-left origin),
+/// so that a flipped or rotated lookup shows.
+fn quadrant_png() -> Vec<u8> {
+    let mut img = image::RgbaImage::new(4, 4);
+    for y in 0..4 {
+        for x in 0..4 {
+            let c = match (x < 2, y < 2) {
+                (true, true) => [255, 0, 0, 255],
+                (false, true) => [0, 255, 0, 255],
+                (true, false) => [0, 0, 255, 255],
+                (false, false) => [255, 255, 0, 255],
+            };
+            img.put_pixel(x, y, image::Rgba(c));
+        }
+    }
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// A pyramid over a square base, UVs across it (glTF convention), indexed.
+fn pyramid() -> Prim {
+    let apex = [0.0, 0.75, 0.0];
+    let base = [
+        [-0.5, 0.0, 0.5],
+        [0.5, 0.0, 0.5],
+        [0.5, 0.0, -0.5],
+        [-0.5, 0.0, -0.5],
+    ];
+    let mut p = Prim::default();
+    for k in 0..4 {
+        let (a, b) = (base[k], base[(k + 1) % 4]);
+        let n = (Vec3::from(b) - Vec3::from(a))
+            .cross(Vec3::from(apex) - Vec3::from(a))
+            .normalize()
+            .to_array();
+        let i = p.positions.len() as u32;
+        p.positions.extend([a, b, apex]);
+        p.normals.extend([n; 3]);
+        p.uv0.extend(
+            [[0.0, 1.0], [1.0, 1.0], [0.5, 0.0]]
+                .map(|[u, v]| [u * 0.5 + 0.25 * (k % 2) as f32, v * 0.75]),
+        );
+        p.indices.extend([i, i + 1, i + 2]);
+    }
+    p
+}
+
+/// The node transform used by the OBJ-vs-glTF test: exact in binary
+/// floating point (a quarter turn about Y, scale 2, dyadic translation).
+fn node_matrix() -> Mat4 {
+    Mat4::from_cols_array(&[
+        0.0, 0.0, -2.0, 0.0, //
+        0.0, 2.0, 0.0, 0.0, //
+        2.0, 0.0, 0.0, 0.0, //
+        0.25, -0.5, 0.125, 1.0,
+    ])
+}
+
+fn obj_text(p: &Prim, m: Mat4) -> String {
+    let mut s = String::from("mtllib m.mtl\nusemtl tex\n");
+    let n3 = glam::Mat3::from_mat4(m).inverse().transpose();
+    for q in &p.positions {
+        let w = m.transform_point3(Vec3::from(*q));
+        s += &format!("v {} {} {}\n", w.x, w.y, w.z);
+    }
+    for n in &p.normals {
+        let w = (n3 * Vec3::from(*n)).normalize();
+        s += &format!("vn {} {} {}\n", w.x, w.y, w.z);
+    }
+    for t in &p.uv0 {
+        // OBJ's v runs up.
+        s += &format!("vt {} {}\n", t[0], 1.0 - t[1]);
+    }
+    for t in p.indices.chunks(3) {
+        let c = |i: u32| format!("{0}/{0}/{0}", i + 1);
+        s += &format!("f {} {} {}\n", c(t[0]), c(t[1]), c(t[2]));
+    }
+    s
+}
+
+#[test]
+fn the_same_mesh_as_obj_and_as_gltf_renders_the_same_pixels() {
+    let dir = common::scratch("gltf_vs_obj");
+    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
+    let p = pyramid();
+    let m = node_matrix();
+    std::fs::write(dir.join("p.obj"), obj_text(&p, m)).unwrap();
+    // Ns 1 and Ks 0.04 are what a rough (1) dielectric maps to.
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl tex\nKd 1 1 1\nKs 0.04 0.04 0.04\nNs 1\nmap_Kd tex.png\n",
+    )
+    .unwrap();
+    let cols = m.to_cols_array();
+    let (text, _) = gltf_text(
+        &p,
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0, "matrix": {cols:?}}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "materials": [{{"name": "tex", "pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0, "roughnessFactor": 1}}}}],
+            "textures": [{{"source": 0}}], "images": [{{"uri": "tex.png"}}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("p.gltf"), text).unwrap();
+    let scene = |model: &str, shading: &str| {
+        format!(
+            "[output]\nwidth = 96\nheight = 80\n[render]\nshading = \"{shading}\"\ntexture_filter = \"nearest\"\n\
+             [[model]]\npath = \"{model}\"\n\
+             [[light]]\nkind = \"point\"\nposition = [2.0, 3.0, 2.5]\nintensity = 20.0\n\
+             [[camera]]\neye = [2.0, 1.5, 3.0]\ntarget = [0.25, 0.2, 0.125]\n"
+        )
+    };
+    for shading in ["unlit", "normals", "blinn-phong"] {
+        let obj = common::scene_in(&dir, &scene("p.obj", shading), &[]);
+        let gltf = common::scene_in(&dir, &scene("p.gltf", shading), &[]);
+        let a = resolve(&render_frame(&obj, 0, 0), &obj.settings);
+        let b = resolve(&render_frame(&gltf, 0, 0), &gltf.settings);
+        let covered = a.data.chunks(3).filter(|c| c != &[0, 0, 0]).count();
+        assert!(
+            covered > 1500,
+            "{shading}: the pyramid covers {covered} pixels"
+        );
+        let differing = a
+            .data
+            .chunks(3)
+            .zip(b.data.chunks(3))
+            .filter(|(x, y)| x != y)
+            .count();
+        assert_eq!(differing, 0, "{shading}: {differing} pixels differ");
+    }
+    // (OBJ's v is flipped on load, glTF's is not: equal pixels mean both
+    // read the image the same way up.)
+    let g = common::scene_in(&dir, &scene("p.gltf", "unlit"), &[]);
+    assert!(g.warnings.is_empty(), "{:?}", g.warnings);
+}
+
+fn trs(t: [f32; 3], r: Quat, s: f32) -> Mat4 {
+    Mat4::from_scale_rotation_translation(Vec3::splat(s), r, Vec3::from(t))
+}
+
+#[test]
+fn nested_trs_nodes_place_a_cube_by_the_composed_matrix() {
+    let dir = common::scratch("gltf_nested");
+    let parent_r = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let child_r = Quat::from_rotation_x(0.6);
+    let (text, _) = gltf_text(
+        &cube(),
+        "",
+        &format!(
+            r#""nodes": [
+                {{"children": [1], "translation": [1.0, 2.0, 3.0], "rotation": {:?}, "scale": [2.0, 2.0, 2.0]}},
+                {{"mesh": 0, "translation": [0.5, 0.0, 0.0], "rotation": {:?}, "scale": [0.5, 0.5, 0.5]}}
+            ], "scenes": [{{"nodes": [0]}}], "scene": 0"#,
+            parent_r.to_array(),
+            child_r.to_array()
+        ),
+        None,
+    );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+    let scene = common::scene_in(&dir, "[[model]]\npath = \"c.gltf\"\n", &[]);
+    let m = &scene.models[0];
+    assert_eq!(m.world_from_object, Mat4::IDENTITY);
+    let want = trs([1.0, 2.0, 3.0], parent_r, 2.0) * trs([0.5, 0.0, 0.0], child_r, 0.5);
+    let c = cube();
+    assert_eq!(m.mesh.positions.len(), c.positions.len());
+    for (got, p) in m.mesh.positions.iter().zip(&c.positions) {
+        let w = want.transform_point3(Vec3::from(*p));
+        assert!((*got - w).length() < 1e-5, "{got} vs {w}");
+    }
+    // The composed center is (1, 3, 3): the parent's quarter turn about Z
+    // takes the child's +x offset of 0.5 (times 2) to +y.
+    let (lo, hi) = m.mesh.bounds();
+    assert!(((lo + hi) * 0.5 - Vec3::new(1.0, 3.0, 3.0)).length() < 1e-5);
+    for n in &m.mesh.normals {
+        assert!((n.length() - 1.0).abs() < 1e-5);
+    }
+}
+
+#[test]
+fn a_mirroring_node_keeps_front_faces_outward() {
+    let dir = common::scratch("gltf_mirror");
+    let coverage = |scale: &str| {
+        let (text, _) = gltf_text(
+            &cube(),
+            "",
+            &format!(
+                r#""nodes": [{{"mesh": 0, "scale": {scale}, "rotation": [0.2, 0.3, 0.1, 0.927]}}], "scenes": [{{"nodes": [0]}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join("m.gltf"), text).unwrap();
+        let s = common::scene_in(
+            &dir,
+            "[output]\nwidth = 64\nheight = 64\n[render]\nshading = \"normals\"\n[[model]]\npath = \"m.gltf\"\n\
+             [[camera]]\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n",
+            &[],
+        );
+        let f = render_frame(&s, 0, 0);
+        f.depth.iter().filter(|d| d.is_finite()).count()
+    };
+    let plain = coverage("[1.0, 1.0, 1.0]");
+    let mirrored = coverage("[-1.0, 1.0, 1.0]");
+    assert!(plain > 500, "{plain}");
+    // Back-face culling would leave only the inside faces, or nothing.
+    assert!(
+        (plain as i64 - mirrored as i64).abs() < 40,
+        "{plain} vs {mirrored}"
+    );
+}
+
+#[test]
+fn texcoord_sets_samplers_and_texture_transform_pick_the_right_texels() {
+    let dir = common::scratch("gltf_sampler");
+    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
+    // A square facing +z; TEXCOORD_0 is all zeros, TEXCOORD_1 spans the
+    // image; the transform shifts u by half the image, so the square's
+    // right half reads past the edge, where CLAMP_TO_EDGE holds the last
+    // column (REPEAT would show red and blue there).
+    let p = Prim {
+        positions: vec![
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ],
+        normals: vec![[0.0, 0.0, 1.0]; 4],
+        uv0: vec![[0.0, 0.0]; 4],
+        uv1: vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    let (text, _) = gltf_text(
+        &p,
+        r#", "material": 0"#,
+        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0,
+            "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.0], "texCoord": 1}}}}}],
+        "extensionsUsed": ["KHR_texture_transform"],
+        "textures": [{"source": 0, "sampler": 0}], "images": [{"uri": "tex.png"}],
+        "samplers": [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]"#,
+        None,
+    );
+    std::fs::write(dir.join("q.gltf"), text).unwrap();
+    let s = common::scene_in(
+        &dir,
+        "[output]\nwidth = 40\nheight = 40\n[render]\nshading = \"unlit\"\ntexture_filter = \"anisotropic\"\n\
+         [[model]]\npath = \"q.gltf\"\n\
+         [[camera]]\nprojection = \"orthographic\"\nheight = 2.0\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n",
+        &[],
+    );
+    let f = render_frame(&s, 0, 0);
+    let at = |x: usize, y: usize| f.color[y * 40 + x].truncate();
+    // Green on top, yellow below, everywhere; nearest (the sampler's
+    // filters win over the scene's anisotropic): pure colors.
+    let green = Vec3::new(0.0, 1.0, 0.0);
+    let yellow = Vec3::new(1.0, 1.0, 0.0);
+    for (x, y, want) in [
+        (5, 5, green),
+        (15, 5, green),
+        (5, 35, yellow),
+        (35, 5, green),
+        (35, 35, yellow),
+    ] {
+        assert!(
+            (at(x, y) - want).abs().max_element() < 1e-6,
+            "({x},{y}): {} vs {want}",
+            at(x, y)
+        );
+    }
+}
+
+#[test]
+fn imported_lights_and_cameras_follow_their_nodes() {
+    let dir = common::scratch("gltf_lights");
+    let (text, _) = gltf_text(
+        &cube(),
+        "",
+        r#""nodes": [
+            {"mesh": 0},
+            {"translation": [0.0, 0.0, 4.0], "children": [2, 3]},
+            {"camera": 0, "name": "front"},
+            {"translation": [1.0, 2.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"rotation": [-0.7071068, 0.0, 0.0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": 1}}}
+        ], "scenes": [{"nodes": [0, 1, 4]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1, "zfar": 50.0}}],
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": 30.0, "range": 10.0, "color": [1.0, 0.5, 0.25]},
+            {"type": "directional", "intensity": 2.0}
+        ]}}"#,
+        None,
+    );
+    std::fs::write(dir.join("l.gltf"), text).unwrap();
+    let s = common::scene_in(
+        &dir,
+        "[[model]]\npath = \"l.gltf\"\nlights = true\ncameras = true\ntranslate = [0.0, 1.0, 0.0]\n",
+        &[],
+    );
+    assert_eq!(s.lights.len(), 2);
+    match s.lights[0].kind {
+        LightKind::Point {
+            position,
+            intensity,
+        } => {
+            // Node chain (0, 0, 4) + (1, 2, 0), then the model's translate.
+            assert!(
+                (position - Vec3::new(1.0, 3.0, 4.0)).length() < 1e-5,
+                "{position}"
+            );
+            assert_eq!(intensity, 30.0);
+        }
+        k => panic!("{k:?}"),
+    }
+    assert_eq!(s.lights[0].range, Some(10.0));
+    assert_eq!(s.lights[0].color, Vec3::new(1.0, 0.5, 0.25));
+    match s.lights[1].kind {
+        // -Z turned a quarter about -X: pointing down.
+        LightKind::Directional {
+            direction,
+            irradiance,
+        } => {
+            assert!((direction - Vec3::NEG_Y).length() < 1e-5, "{direction}");
+            assert_eq!(irradiance, 2.0);
+        }
+        k => panic!("{k:?}"),
+    }
+    assert_eq!(
+        s.cameras.len(),
+        1,
+        "the imported camera replaces the default"
+    );
+    let c = &s.cameras[0];
+    assert_eq!(c.name, "front");
+    assert!(
+        (c.eye - Vec3::new(0.0, 1.0, 4.0)).length() < 1e-5,
+        "{}",
+        c.eye
+    );
+    assert!((c.forward() - Vec3::NEG_Z).length() < 1e-5);
+    assert_eq!(
+        c.projection,
+        Projection::Perspective {
+            fov_y: 0.5f32.to_degrees()
+        }
+    );
+    assert_eq!((c.near, c.far), (0.1, 50.0));
+    // It renders from there: the cube fills the middle of the frame.
+    let f = render_frame(&s, 0, 0);
+    let w = f.width as usize;
+    let mid = f.depth[(f.height as usize / 2) * w + w / 2];
+    assert!((mid - 3.5).abs() < 1e-3, "{mid}");
+}
+
+#[test]
+fn an_obj_model_cannot_import_lights() {
+    let dir = common::scratch("gltf_obj_lights");
+    std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, "[[model]]\npath = \"t.obj\"\nlights = true\n").unwrap();
+    let e = Scene::load(&path, &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("scene.toml:3:10") && e.contains("only glTF"),
+        "{e}"
+    );
+}
