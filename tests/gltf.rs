@@ -246,6 +246,7 @@ fn texcoord_sets_samplers_and_texture_transform_pick_the_right_texels() {
         uv0: vec![[0.0, 0.0]; 4],
         uv1: vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]],
         indices: vec![0, 1, 2, 0, 2, 3],
+        ..Default::default()
     };
     let (text, _) = gltf_text(
         &p,
@@ -382,4 +383,98 @@ fn an_obj_model_cannot_import_lights() {
         e.contains("scene.toml:3:10") && e.contains("only glTF"),
         "{e}"
     );
+}
+
+#[test]
+fn strips_fans_and_unindexed_primitives_with_flat_normals_and_vertex_colors() {
+    // One square four ways: indexed triangles, an unindexed strip, an
+    // indexed fan, and an unindexed triangle list; no NORMAL (flat normals,
+    // +z here), COLOR_0 red at the bottom, blue at the top.
+    let dir = common::scratch("gltf_modes");
+    let corners = [
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let color = |p: &[f32; 3]| {
+        let t = (p[1] + 1.0) * 0.5;
+        [1.0 - t, 0.0, t, 1.0]
+    };
+    let prim = |order: &[usize], indices: Vec<u32>| {
+        let positions: Vec<[f32; 3]> = order.iter().map(|&i| corners[i]).collect();
+        Prim {
+            colors: positions.iter().map(color).collect(),
+            positions,
+            indices,
+            ..Default::default()
+        }
+    };
+    let variants = [
+        ("triangles", prim(&[0, 1, 2, 3], vec![0, 1, 2, 0, 2, 3]), 4),
+        ("strip", prim(&[0, 1, 3, 2], vec![]), 5),
+        ("fan", prim(&[0, 1, 2, 3], vec![0, 1, 2, 3]), 6),
+        ("list", prim(&[0, 1, 2, 0, 2, 3], vec![]), 4),
+    ];
+    let mut frames = Vec::new();
+    for (name, p, mode) in variants {
+        let (text, _) = gltf_text(
+            &p,
+            &format!(r#", "mode": {mode}"#),
+            r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]"#,
+            None,
+        );
+        std::fs::write(dir.join(format!("{name}.gltf")), text).unwrap();
+        let mut out = Vec::new();
+        for shading in ["unlit", "normals"] {
+            let s = common::scene_in(
+                &dir,
+                &format!(
+                    "[output]\nwidth = 32\nheight = 32\n[render]\nshading = \"{shading}\"\n[[model]]\npath = \"{name}.gltf\"\n\
+                     [[camera]]\nprojection = \"orthographic\"\nheight = 2.5\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n"
+                ),
+                &[],
+            );
+            out.push(render_frame(&s, 0, 0));
+        }
+        frames.push((name, out));
+    }
+    let (_, first) = &frames[0];
+    let unlit = &first[0];
+    let covered = unlit.depth.iter().filter(|d| d.is_finite()).count();
+    assert!(covered > 500, "{covered}");
+    // Vertex colors: red at the bottom row of the square, blue at the top,
+    // blended between (the default material is white, metallic, rough).
+    let at = |f: &softraster::render::Frame, x: usize, y: usize| f.color[y * 32 + x].truncate();
+    assert!(
+        at(unlit, 16, 27).x > 0.85 && at(unlit, 16, 27).z < 0.15,
+        "{}",
+        at(unlit, 16, 27)
+    );
+    assert!(
+        at(unlit, 16, 5).z > 0.85 && at(unlit, 16, 5).x < 0.15,
+        "{}",
+        at(unlit, 16, 5)
+    );
+    // Flat normals: +z everywhere, shown as (0.5, 0.5, 1).
+    let n = at(&first[1], 16, 16);
+    assert!(
+        (n - Vec3::new(0.5, 0.5, 1.0)).abs().max_element() < 1e-5,
+        "{n}"
+    );
+    // The same square, split along either diagonal: equal up to rounding.
+    for (name, f) in &frames[1..] {
+        for k in 0..2 {
+            let worst = f[k]
+                .color
+                .iter()
+                .zip(&first[k].color)
+                .map(|(a, b)| (*a - *b).abs().max_element())
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst < 1e-5,
+                "{name}: differs from the indexed list by {worst}"
+            );
+        }
+    }
 }

@@ -396,8 +396,14 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
     // specular color at normal incidence (0.04 for dielectrics, the base
     // color for metals) as Ks, the exponent whose lobe matches the GGX
     // roughness as Ns. The metallic-roughness and occlusion maps have no
-    // Blinn-Phong counterpart and are not read.
-    let m = g.metallic;
+    // Blinn-Phong counterpart and are not read; with a metallic-roughness
+    // map the factor only scales the map (often 1 over a mostly dielectric
+    // map), so such materials are taken as dielectrics.
+    let m = if g.metallic_roughness_tex.is_some() {
+        0.0
+    } else {
+        g.metallic
+    };
     Material {
         name: g.name.clone(),
         ka: None,

@@ -52,6 +52,8 @@ pub struct Prim {
     pub normals: Vec<[f32; 3]>,
     pub uv0: Vec<[f32; 2]>,
     pub uv1: Vec<[f32; 2]>,
+    /// Linear RGBA (COLOR_0).
+    pub colors: Vec<[f32; 4]>,
     pub indices: Vec<u32>,
 }
 
@@ -115,6 +117,16 @@ fn gltf_parts(p: &Prim) -> (Vec<u8>, String, String) {
             f32s(&p.uv1.concat()),
             n,
             "VEC2",
+            5126,
+            String::new(),
+        );
+    }
+    if !p.colors.is_empty() {
+        add(
+            "COLOR_0",
+            f32s(&p.colors.concat()),
+            n,
+            "VEC4",
             5126,
             String::new(),
         );
