@@ -15,11 +15,14 @@ pub struct ObjText {
     pub text: String,
 }
 
-struct Builder {
-    v: Vec<[f32; 3]>,
-    vt: Vec<[f32; 2]>,
-    vn: Vec<[f32; 3]>,
-    f: Vec<[usize; 3]>,
+/// A procedural mesh: one position, OBJ-convention uv (v up) and normal per
+/// vertex; counter-clockwise triangles with 1-based indices (as OBJ writes
+/// them).
+pub struct Builder {
+    pub v: Vec<[f32; 3]>,
+    pub vt: Vec<[f32; 2]>,
+    pub vn: Vec<[f32; 3]>,
+    pub f: Vec<[usize; 3]>,
 }
 
 impl Builder {
@@ -66,7 +69,7 @@ impl Builder {
         }
     }
 
-    fn finish(self, name: &str, mtllib: &str, material: &str) -> ObjText {
+    pub fn to_obj(self, name: &str, mtllib: &str, material: &str) -> ObjText {
         let mut t = String::new();
         let _ = writeln!(
             t,
@@ -91,7 +94,7 @@ impl Builder {
 }
 
 /// UV sphere of radius `r`: u around +Y, v from the south pole up.
-pub fn sphere(r: f32, cols: usize, rows: usize) -> Builder2 {
+pub fn sphere(r: f32, cols: usize, rows: usize) -> Builder {
     let mut b = Builder::new();
     b.grid(cols, rows, [2.0, 1.0], |u, v| {
         let phi = u * TAU;
@@ -103,11 +106,11 @@ pub fn sphere(r: f32, cols: usize, rows: usize) -> Builder2 {
         ];
         ([n[0] * r, n[1] * r, n[2] * r], n)
     });
-    Builder2(b)
+    b
 }
 
 /// Torus around +Y with major radius `big` and tube radius `small`.
-pub fn torus(big: f32, small: f32, cols: usize, rows: usize) -> Builder2 {
+pub fn torus(big: f32, small: f32, cols: usize, rows: usize) -> Builder {
     let mut b = Builder::new();
     b.grid(cols, rows, [8.0, 2.0], |u, v| {
         let a = u * TAU;
@@ -124,11 +127,11 @@ pub fn torus(big: f32, small: f32, cols: usize, rows: usize) -> Builder2 {
             n,
         )
     });
-    Builder2(b)
+    b
 }
 
 /// Square in the XZ plane at height `y`, facing +Y, UVs repeating `tiles` times.
-pub fn ground(half: f32, y: f32, tiles: f32) -> Builder2 {
+pub fn ground(half: f32, y: f32, tiles: f32) -> Builder {
     let mut b = Builder::new();
     b.grid(1, 1, [tiles, tiles], |u, v| {
         (
@@ -136,11 +139,11 @@ pub fn ground(half: f32, y: f32, tiles: f32) -> Builder2 {
             [0.0, 1.0, 0.0],
         )
     });
-    Builder2(b)
+    b
 }
 
 /// An axis-aligned cube of half-size `h` centered at `c`, faces facing out.
-pub fn cube(c: [f32; 3], h: f32) -> Builder2 {
+pub fn cube(c: [f32; 3], h: f32) -> Builder {
     let mut b = Builder::new();
     let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
         ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
@@ -161,16 +164,7 @@ pub fn cube(c: [f32; 3], h: f32) -> Builder2 {
             (p, n)
         });
     }
-    Builder2(b)
-}
-
-/// Opaque wrapper so callers cannot poke the builder's internals.
-pub struct Builder2(Builder);
-
-impl Builder2 {
-    pub fn to_obj(self, name: &str, mtllib: &str, material: &str) -> ObjText {
-        self.0.finish(name, mtllib, material)
-    }
+    b
 }
 
 /// Two-color checkerboard, `cells` cells across, sRGB bytes.

@@ -215,15 +215,24 @@ fn a_mirroring_node_keeps_front_faces_outward() {
             &[],
         );
         let f = render_frame(&s, 0, 0);
-        f.depth.iter().filter(|d| d.is_finite()).count()
+        let d: Vec<f32> = f.depth.iter().copied().filter(|d| d.is_finite()).collect();
+        (d.len(), d.iter().sum::<f32>() / d.len().max(1) as f32)
     };
-    let plain = coverage("[1.0, 1.0, 1.0]");
-    let mirrored = coverage("[-1.0, 1.0, 1.0]");
+    let (plain, plain_depth) = coverage("[1.0, 1.0, 1.0]");
+    let (mirrored, mirrored_depth) = coverage("[-1.0, 1.0, 1.0]");
     assert!(plain > 500, "{plain}");
-    // Back-face culling would leave only the inside faces, or nothing.
+    // The camera sits on the mirror plane, so the mirrored cube's image is
+    // the plain one's mirror image: same coverage, same depths. Were the
+    // winding not flipped, culling would keep the far faces (mean depth
+    // beyond the center at 3) or nothing.
     assert!(
         (plain as i64 - mirrored as i64).abs() < 40,
         "{plain} vs {mirrored}"
+    );
+    assert!(plain_depth < 3.0, "{plain_depth}");
+    assert!(
+        (plain_depth - mirrored_depth).abs() < 0.01,
+        "{plain_depth} vs {mirrored_depth}"
     );
 }
 

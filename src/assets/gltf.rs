@@ -430,7 +430,8 @@ fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(), Stri
         }
         let end = (a.count() - 1)
             .checked_mul(stride)
-            .and_then(|x| x.checked_add(a.offset() + size));
+            .and_then(|x| x.checked_add(a.offset()))
+            .and_then(|x| x.checked_add(size));
         if end.is_none_or(|end| end > view.length()) {
             return Err(format!(
                 "accessor {i} ({} elements from byte {}) runs past the end of buffer view {} ({} bytes)",

@@ -313,7 +313,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                         md.path.get_ref()
                     ));
                 }
-                imported_lights.extend(g.lights.iter().map(|l| place_light(&l.light, world)));
+                imported_lights.extend(g.lights.iter().map(|l| l.light.transformed(world)));
             }
             if get(&md.cameras, false) {
                 if g.cameras.is_empty() {
@@ -429,41 +429,6 @@ impl SourceModel {
             })
         }
     }
-}
-
-/// An imported light moved by its model's placement.
-fn place_light(l: &Light, world: Mat4) -> Light {
-    let dir = |d: Vec3| world.transform_vector3(d).try_normalize().unwrap_or(d);
-    let kind = match l.kind {
-        LightKind::Directional {
-            direction,
-            irradiance,
-        } => LightKind::Directional {
-            direction: dir(direction),
-            irradiance,
-        },
-        LightKind::Point {
-            position,
-            intensity,
-        } => LightKind::Point {
-            position: world.transform_point3(position),
-            intensity,
-        },
-        LightKind::Spot {
-            position,
-            direction,
-            intensity,
-            cos_inner,
-            cos_outer,
-        } => LightKind::Spot {
-            position: world.transform_point3(position),
-            direction: dir(direction),
-            intensity,
-            cos_inner,
-            cos_outer,
-        },
-    };
-    Light { kind, ..*l }
 }
 
 fn resolve(base: &Path, p: &str) -> PathBuf {

@@ -1,6 +1,6 @@
 //! Lights in world space and the irradiance they deliver to a point.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightKind {
@@ -95,6 +95,42 @@ impl Light {
 }
 
 impl Light {
+    /// The light moved by `m` (positions as points, directions as unit
+    /// vectors; intensities unchanged).
+    pub fn transformed(&self, m: Mat4) -> Light {
+        let dir = |d: Vec3| m.transform_vector3(d).try_normalize().unwrap_or(d);
+        let kind = match self.kind {
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => LightKind::Directional {
+                direction: dir(direction),
+                irradiance,
+            },
+            LightKind::Point {
+                position,
+                intensity,
+            } => LightKind::Point {
+                position: m.transform_point3(position),
+                intensity,
+            },
+            LightKind::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => LightKind::Spot {
+                position: m.transform_point3(position),
+                direction: dir(direction),
+                intensity,
+                cos_inner,
+                cos_outer,
+            },
+        };
+        Light { kind, ..*self }
+    }
+
     #[inline]
     fn window(&self, r2: f32) -> f32 {
         match self.range {
@@ -106,6 +142,17 @@ impl Light {
             _ => 1.0,
         }
     }
+}
+
+/// The lights that reach a point with unit normal `n` from its front side:
+/// for each, the unit direction to it and the irradiance E * (n.l).
+#[inline]
+pub fn lit(lights: &[Light], p: Vec3, n: Vec3) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
+    lights.iter().filter_map(move |light| {
+        let inc = light.incidence(p)?;
+        let ndl = n.dot(inc.l);
+        (ndl > 0.0).then(|| (inc.l, inc.e * ndl))
+    })
 }
 
 /// KHR_lights_punctual: t = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1),

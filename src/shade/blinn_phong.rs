@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use crate::scene::Light;
+use crate::scene::light::lit;
 
 /// A material evaluated at one point (constants times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -34,18 +35,10 @@ pub fn light_sums(
 ) -> (Vec3, Vec3) {
     let mut diffuse = Vec3::ZERO;
     let mut spec = Vec3::ZERO;
-    for light in lights {
-        let Some(inc) = light.incidence(p) else {
-            continue;
-        };
-        let ndl = n.dot(inc.l);
-        if ndl <= 0.0 {
-            continue;
-        }
-        let e = inc.e * ndl;
+    for (l, e) in lit(lights, p, n) {
         diffuse += e;
         if specular {
-            let h = (inc.l + v).normalize_or_zero();
+            let h = (l + v).normalize_or_zero();
             let ndh = n.dot(h).max(0.0);
             if ndh > 0.0 {
                 spec += e * ndh.powf(ns);

@@ -25,6 +25,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::scene::Light;
+use crate::scene::light::lit;
 
 /// A material evaluated at one point (factors times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -114,15 +115,8 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 #[inline]
 pub fn radiance(p: Vec3, n: Vec3, v: Vec3, c: &PbrColor, ambient: Vec3, lights: &[Light]) -> Vec3 {
     let mut out = c.emissive;
-    for light in lights {
-        let Some(inc) = light.incidence(p) else {
-            continue;
-        };
-        let ndl = n.dot(inc.l);
-        if ndl <= 0.0 {
-            continue;
-        }
-        out += inc.e * ndl * brdf(n, v, inc.l, c);
+    for (l, e) in lit(lights, p, n) {
+        out += e * brdf(n, v, l, c);
     }
     if ambient != Vec3::ZERO {
         let spec = specular_albedo(c.f0(), c.roughness, n.dot(v).abs());

@@ -204,27 +204,15 @@ pub fn glb(p: &Prim, prim_extra: &str, body: &str) -> Vec<u8> {
     out
 }
 
-/// A unit cube (side 1, centered), 24 vertices with face normals and UVs.
+/// A unit cube (side 1, centered), 24 vertices with face normals and UVs
+/// (the showcase's procedural cube, its v turned to glTF's top-left origin).
 pub fn cube() -> Prim {
-    let mut p = Prim::default();
-    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
-        ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
-        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
-        ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
-        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
-        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
-        ([0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
-    ];
-    for (n, u, v) in faces {
-        let base = p.positions.len() as u32;
-        for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-            p.positions
-                .push([0, 1, 2].map(|k| 0.5 * (n[k] + a * u[k] + b * v[k])));
-            p.normals.push(n);
-            p.uv0.push([(a + 1.0) * 0.5, (1.0 - b) * 0.5]);
-        }
-        p.indices
-            .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    let b = softraster::procedural::cube([0.0; 3], 0.5);
+    Prim {
+        positions: b.v,
+        normals: b.vn,
+        uv0: b.vt.iter().map(|t| [t[0], 1.0 - t[1]]).collect(),
+        indices: b.f.iter().flatten().map(|&i| i as u32 - 1).collect(),
+        ..Default::default()
     }
-    p
 }
