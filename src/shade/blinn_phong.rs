@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use crate::scene::Light;
-use crate::scene::light::lit;
+use crate::scene::light::for_each_lit;
 
 /// A material evaluated at one point (constants times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -35,7 +35,7 @@ pub fn light_sums(
 ) -> (Vec3, Vec3) {
     let mut diffuse = Vec3::ZERO;
     let mut spec = Vec3::ZERO;
-    for (l, e) in lit(lights, p, n) {
+    for_each_lit(lights, p, n, |l, e| {
         diffuse += e;
         if specular {
             let h = (l + v).normalize_or_zero();
@@ -44,7 +44,7 @@ pub fn light_sums(
                 spec += e * ndh.powf(ns);
             }
         }
-    }
+    });
     (diffuse, spec)
 }
 

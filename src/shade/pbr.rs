@@ -25,7 +25,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::scene::Light;
-use crate::scene::light::lit;
+use crate::scene::light::for_each_lit;
 
 /// A material evaluated at one point (factors times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -115,9 +115,7 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 #[inline]
 pub fn radiance(p: Vec3, n: Vec3, v: Vec3, c: &PbrColor, ambient: Vec3, lights: &[Light]) -> Vec3 {
     let mut out = c.emissive;
-    for (l, e) in lit(lights, p, n) {
-        out += e * brdf(n, v, l, c);
-    }
+    for_each_lit(lights, p, n, |l, e| out += e * brdf(n, v, l, c));
     if ambient != Vec3::ZERO {
         let spec = specular_albedo(c.f0(), c.roughness, n.dot(v).abs());
         out += ambient * c.occlusion * (c.c_diff() * (Vec3::ONE - spec) + spec);
