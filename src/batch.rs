@@ -30,6 +30,30 @@ pub struct FrameDone {
     pub render_seconds: f64,
 }
 
+/// One file of a frame, ready to write.
+enum Output {
+    Png(PathBuf, Image8),
+    /// Path, width, height, channel name, values.
+    Exr(PathBuf, u32, u32, &'static str, Vec<f32>),
+}
+
+impl Output {
+    fn path(&self) -> &std::path::Path {
+        match self {
+            Output::Png(p, _) | Output::Exr(p, ..) => p,
+        }
+    }
+
+    fn write(&self) -> Result<(), Error> {
+        match self {
+            Output::Png(p, img) => output::png::write(p, img),
+            Output::Exr(p, w, h, channel, values) => {
+                output::exr::write_channel(p, *w, *h, channel, values)
+            }
+        }
+    }
+}
+
 impl RenderJob {
     pub fn total(&self) -> usize {
         self.frames.len() * self.cameras.len()
@@ -38,14 +62,14 @@ impl RenderJob {
     /// Renders and writes everything; calls `on_done` as frames land.
     pub fn run(&self, mut on_done: impl FnMut(&FrameDone)) -> Result<(), Error> {
         let scene = &self.scene;
-        let (to_writer, writer_rx) = mpsc::sync_channel::<(FrameDone, Option<Image8>)>(2);
+        let (to_writer, writer_rx) = mpsc::sync_channel::<(FrameDone, Vec<Output>)>(2);
         let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
         let writer = std::thread::spawn(move || {
-            for (done, img) in writer_rx {
-                let r = match (&img, done.files.first()) {
-                    (Some(img), Some(path)) => output::png::write(path, img).map(|_| done),
-                    _ => Ok(done),
-                };
+            for (done, outputs) in writer_rx {
+                let r = outputs
+                    .iter()
+                    .try_for_each(Output::write)
+                    .map(|_| done);
                 let failed = r.is_err();
                 if done_tx.send(r).is_err() || failed {
                     break;
@@ -73,27 +97,34 @@ impl RenderJob {
                 let name = &scene.cameras[cam].name;
                 let t0 = Instant::now();
                 render_into(&FrameSetup::new(scene, cam, frame), &mut buffer);
-                let img = scene
-                    .output
-                    .color
-                    .then(|| output::resolve(&buffer, &scene.settings));
-                let render_seconds = t0.elapsed().as_secs_f64();
-                let mut files = Vec::new();
-                if img.is_some() {
-                    files.push(
-                        scene
-                            .output
-                            .dir
-                            .join(format!("{}.png", scene.file_stem(name, frame))),
-                    );
+                let stem = scene.file_stem(name, frame);
+                let file = |suffix: &str| scene.output.dir.join(format!("{stem}{suffix}"));
+                let (width, height) = (buffer.width, buffer.height);
+                let mut outputs = Vec::new();
+                if scene.output.color {
+                    let img = output::resolve(&buffer, &scene.settings);
+                    outputs.push(Output::Png(file(".png"), img));
                 }
+                if scene.output.depth {
+                    let z = buffer.depth.clone();
+                    outputs.push(Output::Exr(file("_depth.exr"), width, height, "Z", z));
+                }
+                if scene.output.ao {
+                    let ao = if buffer.ao.is_empty() {
+                        vec![1.0; buffer.depth.len()]
+                    } else {
+                        buffer.ao.clone()
+                    };
+                    outputs.push(Output::Exr(file("_ao.exr"), width, height, "AO", ao));
+                }
+                let render_seconds = t0.elapsed().as_secs_f64();
                 let done = FrameDone {
                     frame,
                     camera: name.clone(),
-                    files,
+                    files: outputs.iter().map(|o| o.path().to_path_buf()).collect(),
                     render_seconds,
                 };
-                if to_writer.send((done, img)).is_err() {
+                if to_writer.send((done, outputs)).is_err() {
                     break 'frames;
                 }
                 if let Err(e) = drain(false, &mut on_done) {

@@ -12,6 +12,7 @@ pub mod error;
 pub mod output;
 pub mod procedural;
 pub mod raster;
+pub mod raytrace;
 pub mod render;
 pub mod scene;
 pub mod shade;

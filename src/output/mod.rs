@@ -4,6 +4,7 @@
 //! half-written frame under the final name.
 
 pub mod compare;
+pub mod exr;
 pub mod png;
 
 use std::io::Write;

@@ -18,6 +18,7 @@ use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::desc::ShadingMode;
 use crate::scene::material::AlphaMode;
+use crate::shade::ao::GPixel;
 use crate::shade::{ShadeContext, Surface, TexCoords};
 
 /// What every band of one frame reads.
@@ -36,17 +37,16 @@ pub(super) struct FrameData<'a> {
 }
 
 impl FrameData<'_> {
-    /// Renders band `ti` (pixels `rect`) into its rows of the frame.
-    /// `bins`: per setup chunk, its per-band triangle lists and the index of
-    /// its first triangle.
-    pub fn render_band(
+    /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
+    /// alpha-tested triangle per pixel, and the blended triangles to
+    /// composite over them. `bins`: per setup chunk, its per-band triangle
+    /// lists and the index of its first triangle.
+    pub fn visibility(
         &self,
         rect: TileRect,
         ti: usize,
         bins: &[(&[Vec<u32>], u32)],
-        color: &mut [Vec4],
-        depth: &mut [f32],
-    ) {
+    ) -> (Visibility, Vec<u32>) {
         let mut vis = Visibility::new(rect, self.reverse);
         let mut blended = Vec::new();
         for (b, off) in bins {
@@ -76,9 +76,55 @@ impl FrameData<'_> {
                 }
             }
         }
-        self.shade_visible(&vis, color, depth);
+        (vis, blended)
+    }
+
+    /// Shades a band's visible pixels into its rows of the frame, then
+    /// composites its blended triangles. `ao`: the band's ambient
+    /// occlusion per pixel, when the scene asks for it.
+    pub fn shade_band(
+        &self,
+        vis: &Visibility,
+        blended: Vec<u32>,
+        ao: Option<&[f32]>,
+        color: &mut [Vec4],
+        depth: &mut [f32],
+    ) {
+        self.shade_visible(vis, ao, color, depth);
         if !blended.is_empty() {
-            self.blend(&vis, blended, color);
+            self.blend(vis, blended, color);
+        }
+    }
+
+    /// The geometry buffer of a band: view depth, interpolated normal and
+    /// geometric normal (both facing the camera) and position per pixel;
+    /// depth +inf where nothing is visible.
+    pub fn gbuffer(&self, vis: &Visibility, out: &mut [GPixel]) {
+        let rect = vis.rect;
+        let tw = rect.width();
+        let mut current = NO_TRIANGLE;
+        let mut it: Option<Interpolator> = None;
+        for (i, g) in out.iter_mut().enumerate() {
+            let id = vis.id[i];
+            if id == NO_TRIANGLE {
+                *g = GPixel::EMPTY;
+                continue;
+            }
+            let t = &self.tris[id as usize];
+            if id != current || it.is_none() {
+                current = id;
+                it = Some(Interpolator::new(t));
+            }
+            let Some(it) = &it else { continue };
+            let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
+            let frag = it.at_pixel(px, py);
+            let p = self.point(t, frag);
+            *g = GPixel {
+                depth: p.view_depth,
+                position: p.position,
+                normal: p.normal,
+                geo_normal: p.geo_normal,
+            };
         }
     }
 
@@ -92,7 +138,13 @@ impl FrameData<'_> {
     }
 
     /// Shades every visible pixel once, quad by quad.
-    fn shade_visible(&self, vis: &Visibility, color: &mut [Vec4], depth: &mut [f32]) {
+    fn shade_visible(
+        &self,
+        vis: &Visibility,
+        ao: Option<&[f32]>,
+        color: &mut [Vec4],
+        depth: &mut [f32],
+    ) {
         let rect = vis.rect;
         let (tw, th) = (rect.width(), rect.height());
         color.fill(self.bg);
@@ -135,7 +187,8 @@ impl FrameData<'_> {
                         [Gradients::default(); 2]
                     };
                     let frag = it.at_pixel(px, py);
-                    let (c, d) = self.shade(t, it, frag, px, py, g);
+                    let occlusion = ao.map_or(1.0, |a| a[i]);
+                    let (c, d) = self.shade(t, it, frag, px, py, g, occlusion);
                     // A NaN from degenerate input must not poison the frame.
                     color[i] = if c.is_finite() {
                         c.extend(1.0)
@@ -174,7 +227,7 @@ impl FrameData<'_> {
                     [Gradients::default(); 2]
                 };
                 let frag = it.at_pixel(px, py);
-                let (c, _) = self.shade(t, &it, frag, px, py, g);
+                let (c, _) = self.shade(t, &it, frag, px, py, g, 1.0);
                 let (m, uv, vcolor) = self.material_uv(t, frag.lambda);
                 let tc = TexCoords { uv, grads: g };
                 let a = self.ctx.opacity(m, &tc, vcolor).clamp(0.0, 1.0);
@@ -234,6 +287,7 @@ impl FrameData<'_> {
         px: i32,
         py: i32,
         grads: [Gradients; 2],
+        ao: f32,
     ) -> (Vec3, f32) {
         let ctx = &self.ctx;
         let mode = ctx.mode;
@@ -242,22 +296,18 @@ impl FrameData<'_> {
         let mv = &self.verts[d.model];
         let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
         let l = frag.lambda;
-        let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
-        let position = lerp3(&mv.world);
-        let raw_normal = lerp3(&mv.normal);
-        let view_depth = if ctx.orthographic {
-            (position - ctx.eye).dot(ctx.forward)
-        } else {
-            frag.w
-        };
+        let Point {
+            position,
+            raw_normal,
+            normal,
+            geo_normal,
+            view_depth,
+        } = self.point(t, frag);
         let normal = if mode == ShadingMode::Flat {
-            let [a, b, c] = idx.map(|k| mv.world[k]);
-            (b - a).cross(c - a).normalize_or(raw_normal)
+            geo_normal
         } else {
-            raw_normal.normalize_or(Vec3::Y)
+            normal
         };
-        // Light the side the camera sees.
-        let normal = if t.front { normal } else { -normal };
         let (_, uv, color) = self.material_uv(t, l);
         let tangent = (!mv.tangent.is_empty()).then(|| {
             let c = t.prim as usize * 3;
@@ -291,9 +341,58 @@ impl FrameData<'_> {
             view_depth,
             vertex_light,
             edge_distance,
+            geo_normal,
+            ao,
         };
         (ctx.shade(&surface), view_depth)
     }
+
+    /// Position, normals and view depth of triangle `t` at a fragment.
+    #[inline]
+    fn point(&self, t: &Tri, frag: Fragment) -> Point {
+        let ctx = &self.ctx;
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let mv = &self.verts[d.model];
+        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
+        let l = frag.lambda;
+        let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
+        let position = lerp3(&mv.world);
+        let raw_normal = lerp3(&mv.normal);
+        let view_depth = if ctx.orthographic {
+            (position - ctx.eye).dot(ctx.forward)
+        } else {
+            frag.w
+        };
+        // Light the side the camera sees.
+        let n = raw_normal.normalize_or(Vec3::Y);
+        let normal = if t.front { n } else { -n };
+        let [a, b, c] = idx.map(|k| mv.world[k]);
+        let g = (b - a).cross(c - a).normalize_or(normal);
+        let geo_normal = if g.dot(ctx.view_vector(position)) < 0.0 {
+            -g
+        } else {
+            g
+        };
+        Point {
+            position,
+            raw_normal,
+            normal,
+            geo_normal,
+            view_depth,
+        }
+    }
+}
+
+/// A surface point as the rasterizer sees it.
+struct Point {
+    position: Vec3,
+    raw_normal: Vec3,
+    /// Interpolated unit normal, on the side the camera sees.
+    normal: Vec3,
+    /// The triangle's plane normal, on the side the camera sees.
+    geo_normal: Vec3,
+    view_depth: f32,
 }
 
 /// Screen-space distance (pixels) from the pixel center to the nearest edge

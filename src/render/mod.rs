@@ -15,12 +15,16 @@ use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
 use crate::scene::Scene;
 use crate::scene::camera::{Camera, Projection};
-use crate::scene::desc::{CullMode, DepthMode, ShadingMode, TextureFilter};
+use crate::raytrace::Tracer;
+use crate::scene::desc::{AoMethod, CullMode, DepthMode, ShadingMode, TextureFilter};
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::AlphaMode;
+use crate::shade::ao::{self, AoView};
+use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, background, blinn_phong};
 
 mod band;
+mod shadow_pass;
 
 /// A rendered frame in linear space, before tone mapping.
 #[derive(Debug, Clone)]
@@ -34,6 +38,9 @@ pub struct Frame {
     /// Distance along the view axis at the pixel center; +inf where nothing
     /// was drawn.
     pub depth: Vec<f32>,
+    /// Ambient occlusion at the pixel center (1: unoccluded, and where
+    /// nothing was drawn); empty unless the scene selects an AO method.
+    pub ao: Vec<f32>,
 }
 
 impl Frame {
@@ -44,6 +51,7 @@ impl Frame {
             height,
             color: vec![Vec4::ZERO; n],
             depth: vec![f32::INFINITY; n],
+            ao: Vec::new(),
         }
     }
 
@@ -162,13 +170,19 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         height: s.height,
     };
 
-    // Vertex stage.
-    let verts: Vec<ModelVertices> = scene
+    // Vertex stage, then the shadow pass over the placed vertices.
+    let mut verts: Vec<ModelVertices> = scene
         .models
         .iter()
         .zip(&fs.world_from_object)
         .map(|(m, world)| vertex_stage(fs, m, *world))
         .collect();
+    let shadows = shadow_pass::shadows(fs, &verts);
+    if s.shading == ShadingMode::Gouraud {
+        for (m, mv) in scene.models.iter().zip(&mut verts) {
+            mv.light = vertex_light(fs, m, mv, &shadows);
+        }
+    }
 
     // Draw list: one draw per model and material group, in file order.
     let mut draws = Vec::new();
@@ -287,7 +301,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         .filter(|t| mips[t.id])
         .for_each(|t| t.ensure_mips());
 
-    let ctx = shade_context(fs, &mips);
+    let ctx = shade_context(fs, &mips, &shadows);
     let alpha: Vec<AlphaMode> = draws
         .iter()
         .map(|d| scene.models[d.model].materials[d.material].alpha)
@@ -311,13 +325,50 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
     // Each band owns its rows of the frame: visibility, then shading
     // straight into the frame buffer.
     let band = (grid.tile_w * grid.tile_h) as usize;
+    if s.ao.method == AoMethod::Off {
+        frame.ao.clear();
+        frame
+            .color
+            .par_chunks_mut(band)
+            .zip(frame.depth.par_chunks_mut(band))
+            .enumerate()
+            .for_each(|(ti, (color, depth))| {
+                let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
+                data.shade_band(&vis, blended, None, color, depth);
+            });
+        return;
+    }
+    // With ambient occlusion: visibility and the geometry buffer of every
+    // band, the AO of the whole frame, then shading.
+    let mut gbuf = vec![ao::GPixel::EMPTY; frame.color.len()];
+    let visible: Vec<_> = gbuf
+        .par_chunks_mut(band)
+        .enumerate()
+        .map(|(ti, g)| {
+            let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
+            data.gbuffer(&vis, g);
+            (vis, blended)
+        })
+        .collect();
+    let view = AoView::new(&fs.camera, s.width, s.height);
+    frame.ao = match s.ao.method {
+        AoMethod::Raytraced => {
+            let tracer = Tracer::new(scene, &fs.world_from_object);
+            ao::raytraced(&tracer, &gbuf, s.width, s.ao.samples, s.ao.radius)
+        }
+        _ => {
+            let radius = s.ao.radius.unwrap_or(scene.bounds_radius * 0.2);
+            ao::ssao(&gbuf, &view, radius, s.ao.samples)
+        }
+    };
     frame
         .color
         .par_chunks_mut(band)
         .zip(frame.depth.par_chunks_mut(band))
-        .enumerate()
-        .for_each(|(ti, (color, depth))| {
-            data.render_band(grid.rect(ti), ti, &bins, color, depth);
+        .zip(frame.ao.par_chunks(band))
+        .zip(visible)
+        .for_each(|(((color, depth), ao), (vis, blended))| {
+            data.shade_band(&vis, blended, Some(ao), color, depth);
         });
 }
 
@@ -363,29 +414,6 @@ fn vertex_stage(
                 cl[i] = fs.clip_from_world * p.extend(1.0);
             }
         });
-    let mut light = Vec::new();
-    if fs.scene.settings.shading == ShadingMode::Gouraud {
-        // Each vertex lit with the exponent of a material that uses it.
-        let mut ns = vec![32.0f32; n];
-        let mut spec = vec![false; n];
-        for g in &mesh.groups {
-            let mat = &m.materials[g.material];
-            for t in &mesh.triangles[g.triangles.start as usize..g.triangles.end as usize] {
-                for &i in t {
-                    ns[i as usize] = mat.ns;
-                    spec[i as usize] = mat.illum >= 2;
-                }
-            }
-        }
-        let ctx = shade_context(fs, &[]);
-        light = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let v = ctx.view_vector(world[i]);
-                blinn_phong::light_sums(world[i], normal[i], v, ns[i], spec[i], &fs.lights)
-            })
-            .collect();
-    }
     // Tangents follow the surface (not the inverse transpose); a mirroring
     // transform flips the bitangent.
     let m3 = Mat3::from_mat4(world_from_object);
@@ -399,13 +427,50 @@ fn vertex_stage(
         world,
         normal,
         clip,
-        light,
+        light: Vec::new(),
         tangent,
         normal_from_object,
     }
 }
 
-fn shade_context<'a>(fs: &'a FrameSetup, mips: &'a [bool]) -> ShadeContext<'a> {
+/// Gouraud: per-vertex (diffuse, specular) light sums, each vertex lit with
+/// the exponent of a material that uses it and shadowed at the vertex.
+fn vertex_light(
+    fs: &FrameSetup,
+    m: &crate::scene::Model,
+    mv: &ModelVertices,
+    shadows: &Shadows,
+) -> Vec<(Vec3, Vec3)> {
+    let mesh = &m.mesh;
+    let n = mesh.positions.len();
+    let mut ns = vec![32.0f32; n];
+    let mut spec = vec![false; n];
+    for g in &mesh.groups {
+        let mat = &m.materials[g.material];
+        for t in &mesh.triangles[g.triangles.start as usize..g.triangles.end as usize] {
+            for &i in t {
+                ns[i as usize] = mat.ns;
+                spec[i as usize] = mat.illum >= 2;
+            }
+        }
+    }
+    let ctx = shade_context(fs, &[], shadows);
+    (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let (p, nn) = (mv.world[i], mv.normal[i]);
+            let v = ctx.view_vector(p);
+            let shadow = |k: usize, l: Vec3| shadows.visibility(k, p, nn, l);
+            blinn_phong::light_sums(p, nn, v, ns[i], spec[i], &fs.lights, &shadow)
+        })
+        .collect()
+}
+
+fn shade_context<'a>(
+    fs: &'a FrameSetup,
+    mips: &'a [bool],
+    shadows: &'a Shadows<'a>,
+) -> ShadeContext<'a> {
     let s = &fs.scene.settings;
     let cam = &fs.camera;
     let forward = cam.forward();
@@ -425,5 +490,6 @@ fn shade_context<'a>(fs: &'a FrameSetup, mips: &'a [bool]) -> ShadeContext<'a> {
         address: s.address,
         mips,
         depth_range: (lo, hi),
+        shadows,
     }
 }

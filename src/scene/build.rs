@@ -32,7 +32,6 @@ pub struct LoadOptions {
     pub out_dir: Option<PathBuf>,
 }
 
-const SHADOW_ISSUE: &str = "it comes with shadows, AO and EXR outputs";
 const WORKFLOW_ISSUE: &str = "it comes with anti-aliasing and GIF output";
 
 impl Scene {
@@ -78,30 +77,50 @@ fn refuse_unsupported(d: &SceneDesc, ctx: &Ctx) -> Result<(), Error> {
     {
         return Err(unsupported(ctx, m, "render.msaa > 1", WORKFLOW_ISSUE));
     }
-    if let Some(ao) = &r.ao
-        && get(&ao.get_ref().method, desc::AoMethod::Off) != desc::AoMethod::Off
-    {
-        return Err(unsupported(ctx, ao, "render.ao", SHADOW_ISSUE));
-    }
-    for l in &d.lights {
-        if let Some(s) = &l.get_ref().shadows
-            && *s.get_ref()
-        {
-            return Err(unsupported(ctx, s, "light.shadows = true", SHADOW_ISSUE));
-        }
-    }
     let o = &d.output;
-    for (v, key) in [(&o.depth, "output.depth"), (&o.ao, "output.ao")] {
-        if let Some(v) = v
-            && *v.get_ref()
-        {
-            return Err(unsupported(ctx, v, key, SHADOW_ISSUE));
-        }
-    }
     if let Some(g) = &o.gif {
         return Err(unsupported(ctx, g, "output.gif", WORKFLOW_ISSUE));
     }
     Ok(())
+}
+
+fn shadow_bias(r: &desc::RenderDesc) -> super::ShadowBias {
+    let d = super::ShadowBias::default();
+    match &r.shadow_bias {
+        Some(b) => {
+            let b = b.get_ref();
+            super::ShadowBias {
+                constant: get(&b.constant, d.constant),
+                slope: get(&b.slope, d.slope),
+                normal: get(&b.normal, d.normal),
+            }
+        }
+        None => d,
+    }
+}
+
+fn ao_settings(r: &desc::RenderDesc) -> super::AoSettings {
+    let (method, radius, samples) = match &r.ao {
+        Some(a) => {
+            let a = a.get_ref();
+            (
+                get(&a.method, desc::AoMethod::Off),
+                a.radius.as_ref().map(|r| *r.get_ref()),
+                a.samples.as_ref().map(|s| *s.get_ref() as u32),
+            )
+        }
+        None => (desc::AoMethod::Off, None, None),
+    };
+    let default_samples = if method == desc::AoMethod::Raytraced {
+        64
+    } else {
+        16
+    };
+    super::AoSettings {
+        method,
+        radius,
+        samples: samples.unwrap_or(default_samples),
+    }
 }
 
 fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
@@ -127,7 +146,20 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         exposure: get(&r.exposure, 0.0),
         background: get(&o.background, desc::Background::Color([0.0; 3])),
         ambient: Vec3::from(get(&d.ambient.color, [0.03; 3])),
+        shadows: get(&r.shadows, Default::default()),
+        shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
+        shadow_bias: shadow_bias(r),
+        ao: ao_settings(r),
     };
+    if let Some(v) = &o.ao
+        && *v.get_ref()
+        && settings.ao.method == desc::AoMethod::Off
+    {
+        return Err(ctx.err(
+            v.span(),
+            "output.ao = true needs render.ao with method = \"ssao\" or \"raytraced\"",
+        ));
+    }
     let name = get(&o.name, "{camera}_{frame:04}".to_string());
     if let Err(msg) = check_pattern(&name) {
         let span = o.name.as_ref().map(|n| n.span()).unwrap_or(0..0);
@@ -142,6 +174,8 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         dir,
         name,
         color: get(&o.color, true),
+        depth: get(&o.depth, false),
+        ao: get(&o.ao, false),
     };
 
     // Models: each file parsed once, even if several [[model]] use it.

@@ -153,9 +153,20 @@ pub struct RenderDesc {
     pub depth: Option<S<DepthMode>>,
     pub shadows: Option<S<ShadowMethod>>,
     pub shadow_map_size: Option<S<i64>>,
+    /// Extension: shadow-map bias in texels.
+    pub shadow_bias: Option<S<ShadowBiasDesc>>,
     pub ao: Option<S<AoDesc>>,
     pub tonemap: Option<S<Tonemap>>,
     pub exposure: Option<S<f32>>,
+}
+
+/// `render.shadow_bias` (extension), in shadow-map texels at the receiver.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowBiasDesc {
+    pub constant: Option<S<f32>>,
+    pub slope: Option<S<f32>>,
+    pub normal: Option<S<f32>>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -444,6 +455,16 @@ impl SceneDesc {
             let ao = ao.get_ref();
             c.float_range(&ao.radius, "render.ao.radius", f32::MIN_POSITIVE, 1e9)?;
             c.int_range(&ao.samples, "render.ao.samples", 1, 4096)?;
+        }
+        if let Some(b) = &r.shadow_bias {
+            let b = b.get_ref();
+            for (v, key) in [
+                (&b.constant, "render.shadow_bias.constant"),
+                (&b.slope, "render.shadow_bias.slope"),
+                (&b.normal, "render.shadow_bias.normal"),
+            ] {
+                c.float_range(v, key, 0.0, 1000.0)?;
+            }
         }
         if let Some(a) = &self.ambient.color {
             c.color(a.span(), a.get_ref(), "ambient.color")?;

@@ -146,19 +146,35 @@ impl Light {
 
 /// Calls `f(l, e)` for each light that reaches a point with unit normal `n`
 /// from its front side: the unit direction to it and the irradiance
-/// E * (n.l). (A callback rather than an iterator: the iterator version
-/// did not inline and cost 12% of a frame.)
+/// E * (n.l) times `shadow(i, l)`, the fraction of light `i` that is not
+/// blocked (asked only of lights with `shadows = true`). (A callback rather
+/// than an iterator: the iterator version did not inline and cost 12% of a
+/// frame.)
 #[inline(always)]
-pub fn for_each_lit(lights: &[Light], p: Vec3, n: Vec3, mut f: impl FnMut(Vec3, Vec3)) {
-    for light in lights {
+pub fn for_each_lit(
+    lights: &[Light],
+    shadow: &impl Fn(usize, Vec3) -> f32,
+    p: Vec3,
+    n: Vec3,
+    mut f: impl FnMut(Vec3, Vec3),
+) {
+    for (i, light) in lights.iter().enumerate() {
         let Some(inc) = light.incidence(p) else {
             continue;
         };
         let ndl = n.dot(inc.l);
         if ndl > 0.0 {
-            f(inc.l, inc.e * ndl);
+            let s = if light.shadows { shadow(i, inc.l) } else { 1.0 };
+            if s > 0.0 {
+                f(inc.l, inc.e * (ndl * s));
+            }
         }
     }
+}
+
+/// The `shadow` argument of `for_each_lit` when nothing casts shadows.
+pub fn unshadowed(_: usize, _: Vec3) -> f32 {
+    1.0
 }
 
 /// KHR_lights_punctual: t = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1),

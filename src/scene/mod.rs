@@ -19,7 +19,10 @@ use glam::{Mat4, Vec3};
 use crate::assets::mesh::Mesh;
 pub use animation::Animation;
 pub use camera::Camera;
-use desc::{AddressMode, Background, CullMode, DepthMode, ShadingMode, TextureFilter, Tonemap};
+use desc::{
+    AddressMode, AoMethod, Background, CullMode, DepthMode, ShadingMode, ShadowMethod,
+    TextureFilter, Tonemap,
+};
 pub use light::Light;
 pub use material::Material;
 
@@ -38,6 +41,47 @@ pub struct RenderSettings {
     pub exposure: f32,
     pub background: Background,
     pub ambient: Vec3,
+    /// How lights with `shadows = true` cast them (default pcf).
+    pub shadows: ShadowMethod,
+    /// Shadow map size in texels, per side (default 2048).
+    pub shadow_map_size: u32,
+    pub shadow_bias: ShadowBias,
+    pub ao: AoSettings,
+}
+
+/// Shadow-map bias, in texels of the map at the receiver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowBias {
+    /// Depth bias (default 1).
+    pub constant: f32,
+    /// Depth bias times the tangent of the angle between normal and light
+    /// (default 1; the tangent is capped at 10).
+    pub slope: f32,
+    /// Lookup point moved along the geometric normal, times the sine of
+    /// the angle between normal and light (default 1).
+    pub normal: f32,
+}
+
+impl Default for ShadowBias {
+    fn default() -> ShadowBias {
+        ShadowBias {
+            constant: 1.0,
+            slope: 1.0,
+            normal: 1.0,
+        }
+    }
+}
+
+/// `render.ao`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AoSettings {
+    pub method: AoMethod,
+    /// Occluders within this distance count; None (raytraced only): rays of
+    /// unbounded length. SSAO without a radius uses a fifth of the scene's
+    /// bounding radius.
+    pub radius: Option<f32>,
+    /// Rays per pixel (raytraced) or depth-buffer reads per pixel (ssao).
+    pub samples: u32,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +91,10 @@ pub struct OutputSettings {
     /// pads with zeros).
     pub name: String,
     pub color: bool,
+    /// `<name>_depth.exr`, channel `Z`.
+    pub depth: bool,
+    /// `<name>_ao.exr`, channel `AO`.
+    pub ao: bool,
 }
 
 #[derive(Debug, Clone)]

@@ -9,6 +9,8 @@ use glam::Vec3;
 
 use crate::scene::Light;
 use crate::scene::light::for_each_lit;
+#[cfg(test)]
+use crate::scene::light::unshadowed;
 
 /// A material evaluated at one point (constants times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -32,10 +34,11 @@ pub fn light_sums(
     ns: f32,
     specular: bool,
     lights: &[Light],
+    shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> (Vec3, Vec3) {
     let mut diffuse = Vec3::ZERO;
     let mut spec = Vec3::ZERO;
-    for_each_lit(lights, p, n, |l, e| {
+    for_each_lit(lights, shadow, p, n, |l, e| {
         diffuse += e;
         if specular {
             let h = (l + v).normalize_or_zero();
@@ -57,11 +60,12 @@ pub fn radiance(
     s: &SurfaceColor,
     ambient: Vec3,
     lights: &[Light],
+    shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> Vec3 {
     if s.illum == 0 {
         return s.kd;
     }
-    let (diffuse, spec) = light_sums(p, n, v, s.ns, s.illum >= 2, lights);
+    let (diffuse, spec) = light_sums(p, n, v, s.ns, s.illum >= 2, lights, shadow);
     combine(s, ambient, diffuse, spec)
 }
 
@@ -109,19 +113,19 @@ mod tests {
         let (p, n, v) = (Vec3::ZERO, Vec3::Y, Vec3::Y);
         let amb = Vec3::splat(0.1);
         // E = 4/4 = 1, n.l = 1, n.h = 1
-        let l2 = radiance(p, n, v, &surface(2), amb, &lights);
+        let l2 = radiance(p, n, v, &surface(2), amb, &lights, &unshadowed);
         assert!(
             (l2 - Vec3::new(0.1 + 0.1 + 0.5 + 0.25, 0.1 + 0.5 + 0.25, 0.1 + 0.5 + 0.25)).length()
                 < 1e-6
         );
-        let l1 = radiance(p, n, v, &surface(1), amb, &lights);
+        let l1 = radiance(p, n, v, &surface(1), amb, &lights, &unshadowed);
         assert!((l1 - Vec3::new(0.7, 0.6, 0.6)).length() < 1e-6);
         assert_eq!(
-            radiance(p, n, v, &surface(0), amb, &lights),
+            radiance(p, n, v, &surface(0), amb, &lights, &unshadowed),
             Vec3::splat(0.5)
         );
         // A light below the surface adds nothing.
-        let below = radiance(p, -n, v, &surface(2), amb, &lights);
+        let below = radiance(p, -n, v, &surface(2), amb, &lights, &unshadowed);
         assert!((below - Vec3::new(0.2, 0.1, 0.1)).length() < 1e-6);
     }
 }

@@ -1,8 +1,10 @@
 //! Shading: what color a visible surface point gets, per `render.shading`.
 //! Shading reads the scene (materials, lights) and never writes to it.
 
+pub mod ao;
 pub mod blinn_phong;
 pub mod pbr;
+pub mod shadow;
 pub mod tonemap;
 
 use glam::{Mat3, Vec2, Vec3, Vec4};
@@ -31,6 +33,8 @@ pub struct ShadeContext<'a> {
     pub mips: &'a [bool],
     /// View-depth range mapped to white..black by the `depth` view.
     pub depth_range: (f32, f32),
+    /// This frame's shadow maps or ray tracer.
+    pub shadows: &'a shadow::Shadows<'a>,
 }
 
 /// Texture coordinates of a point in both sets (None where the mesh has
@@ -74,6 +78,12 @@ pub struct Surface<'a> {
     pub vertex_light: Option<(Vec3, Vec3)>,
     /// Wireframe: distance to the nearest edge of the triangle, in pixels.
     pub edge_distance: f32,
+    /// Unit normal of the triangle's plane, on the side the camera sees
+    /// (shadow lookups and their bias).
+    pub geo_normal: Vec3,
+    /// Ambient occlusion at the point (1: unoccluded), multiplying the
+    /// ambient term.
+    pub ao: f32,
 }
 
 impl ShadeContext<'_> {
@@ -113,7 +123,7 @@ impl ShadeContext<'_> {
             ShadingMode::Gouraud => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let (d, sp) = s.vertex_light.unwrap_or((Vec3::ZERO, Vec3::ZERO));
-                blinn_phong::combine(&c, self.ambient, d, sp)
+                blinn_phong::combine(&c, self.ambient * s.ao, d, sp)
             }
             ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
             ShadingMode::Pbr => self.shade_pbr(s),
@@ -121,12 +131,14 @@ impl ShadeContext<'_> {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 let n = self.mapped_normal(s);
-                blinn_phong::radiance(s.position, n, v, &c, self.ambient, self.lights)
+                let ambient = self.ambient * s.ao;
+                blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
             }
             ShadingMode::Flat => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
-                blinn_phong::radiance(s.position, s.normal, v, &c, self.ambient, self.lights)
+                let (n, ambient) = (s.normal, self.ambient * s.ao);
+                blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
             }
         }
     }
@@ -136,7 +148,14 @@ impl ShadeContext<'_> {
         let c = self.pbr_color(s);
         let v = self.view_vector(s.position);
         let n = self.mapped_normal(s);
-        pbr::radiance(s.position, n, v, &c, self.ambient, self.lights)
+        let ambient = self.ambient * s.ao;
+        pbr::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
+    }
+
+    /// Light `i`'s shadow at the surface point, towards unit `l`.
+    #[inline(always)]
+    fn shadow<'s>(&'s self, s: &'s Surface) -> impl Fn(usize, Vec3) -> f32 + 's {
+        move |i, l| self.shadows.visibility(i, s.position, s.geo_normal, l)
     }
 
     /// The material's metallic-roughness factors times its maps.

@@ -113,9 +113,17 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 
 /// Outgoing radiance at `p` towards `v`.
 #[inline]
-pub fn radiance(p: Vec3, n: Vec3, v: Vec3, c: &PbrColor, ambient: Vec3, lights: &[Light]) -> Vec3 {
+pub fn radiance(
+    p: Vec3,
+    n: Vec3,
+    v: Vec3,
+    c: &PbrColor,
+    ambient: Vec3,
+    lights: &[Light],
+    shadow: &impl Fn(usize, Vec3) -> f32,
+) -> Vec3 {
     let mut out = c.emissive;
-    for_each_lit(lights, p, n, |l, e| out += e * brdf(n, v, l, c));
+    for_each_lit(lights, shadow, p, n, |l, e| out += e * brdf(n, v, l, c));
     if ambient != Vec3::ZERO {
         let spec = specular_albedo(c.f0(), c.roughness, n.dot(v).abs());
         out += ambient * c.occlusion * (c.c_diff() * (Vec3::ONE - spec) + spec);
@@ -126,6 +134,7 @@ pub fn radiance(p: Vec3, n: Vec3, v: Vec3, c: &PbrColor, ambient: Vec3, lights: 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::light::unshadowed;
 
     fn dielectric(base: f32, roughness: f32) -> PbrColor {
         PbrColor {
@@ -231,7 +240,7 @@ mod tests {
     #[test]
     fn uniform_ambient_is_conserved_for_a_white_dielectric() {
         let c = dielectric(1.0, 0.7);
-        let l = radiance(Vec3::ZERO, Vec3::Z, Vec3::Z, &c, Vec3::splat(0.5), &[]);
+        let l = radiance(Vec3::ZERO, Vec3::Z, Vec3::Z, &c, Vec3::splat(0.5), &[], &unshadowed);
         assert!((l - Vec3::splat(0.5)).abs().max_element() < 1e-5, "{l}");
         // Occlusion scales it.
         let occluded = PbrColor {
@@ -245,6 +254,7 @@ mod tests {
             &occluded,
             Vec3::splat(0.5),
             &[],
+            &unshadowed,
         );
         assert!((l - Vec3::splat(0.25)).abs().max_element() < 1e-5, "{l}");
         // The fit's specular albedo stays within [0, 1].

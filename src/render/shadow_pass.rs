@@ -1,0 +1,275 @@
+//! The shadow pass of one frame: for each light with `shadows = true`, a
+//! depth map rendered from the light over this frame's geometry (the
+//! models as turned for this frame), or, for `render.shadows = "raytraced"`,
+//! the scene's BVH. No pass at all when no light casts shadows.
+//!
+//! Fitting: a directional light's orthographic map covers the bounds of all
+//! vertices in light space; a spot light's perspective map covers its outer
+//! cone; a point light gets six 90-degree faces. Every map is padded by two
+//! texels so the PCF footprint at its border reads real depths. Shadow maps
+//! draw both faces of every triangle, with opaque depth (alpha-tested and
+//! blended materials cast full shadows).
+
+use glam::{Mat4, Vec3, Vec4};
+use rayon::prelude::*;
+
+use super::{FrameSetup, ModelVertices};
+use crate::raster::bin::{TileGrid, bin};
+use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
+use crate::raster::coverage::raster_triangle;
+use crate::raster::setup::{Tri, Viewport, setup};
+use crate::raytrace::Tracer;
+use crate::scene::desc::{CullMode, ShadowMethod};
+use crate::scene::light::LightKind;
+use crate::shade::shadow::{Filter, LightShadow, MapProjection, ShadowMap, Shadows};
+
+const CHUNK: usize = 4096;
+
+/// One model's world-space vertices and triangles this frame.
+struct Geo<'g> {
+    world: &'g [Vec3],
+    triangles: &'g [[u32; 3]],
+}
+
+pub(super) fn shadows<'a>(fs: &FrameSetup<'a>, mv: &[ModelVertices]) -> Shadows<'a> {
+    let s = &fs.scene.settings;
+    if s.shadows == ShadowMethod::Off || !fs.lights.iter().any(|l| l.shadows) {
+        return Shadows::none();
+    }
+    let filter = if s.shadows == ShadowMethod::Hard {
+        Filter::Hard
+    } else {
+        Filter::Pcf
+    };
+    let mut out = Shadows {
+        lights: Vec::with_capacity(fs.lights.len()),
+        filter,
+        bias: s.shadow_bias,
+        tracer: None,
+    };
+    if s.shadows == ShadowMethod::Raytraced {
+        out.tracer = Some(Tracer::new(fs.scene, &fs.world_from_object));
+    }
+    let size = s.shadow_map_size;
+    let verts: Vec<Geo> = mv
+        .iter()
+        .zip(&fs.scene.models)
+        .map(|(v, m)| Geo {
+            world: &v.world,
+            triangles: &m.mesh.triangles,
+        })
+        .collect();
+    let verts = verts.as_slice();
+    for light in &fs.lights {
+        let ls = if !light.shadows {
+            LightShadow::None
+        } else if s.shadows == ShadowMethod::Raytraced {
+            LightShadow::Ray {
+                position: match light.kind {
+                    LightKind::Directional { .. } => None,
+                    LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                        Some(position)
+                    }
+                },
+            }
+        } else {
+            match light.kind {
+                LightKind::Directional { direction, .. } => directional(verts, direction, size),
+                LightKind::Spot {
+                    position,
+                    direction,
+                    cos_outer,
+                    ..
+                } => spot(verts, position, direction, cos_outer, size),
+                LightKind::Point { position, .. } => point(verts, position, size),
+            }
+        };
+        out.lights.push(ls);
+    }
+    out
+}
+
+/// A view matrix at `eye` looking along `dir` (unit).
+fn look(eye: Vec3, dir: Vec3) -> Mat4 {
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let s = dir.cross(up).normalize();
+    let u = s.cross(dir);
+    Mat4::from_cols(
+        Vec4::new(s.x, u.x, -dir.x, 0.0),
+        Vec4::new(s.y, u.y, -dir.y, 0.0),
+        Vec4::new(s.z, u.z, -dir.z, 0.0),
+        Vec4::new(-s.dot(eye), -u.dot(eye), dir.dot(eye), 1.0),
+    )
+}
+
+fn directional(verts: &[Geo], direction: Vec3, size: u32) -> LightShadow {
+    let view = look(Vec3::ZERO, direction);
+    let (lo, hi) = verts
+        .par_iter()
+        .flat_map(|m| m.world.par_iter())
+        .map(|p| {
+            let q = view.transform_point3(*p);
+            (q, q)
+        })
+        .reduce(
+            || (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    if !(lo.is_finite() && hi.is_finite()) {
+        return LightShadow::None;
+    }
+    let ext = (hi - lo).max(Vec3::splat(1e-6));
+    let pad = ext.x.max(ext.y) * 2.0 / size as f32;
+    // Square texels: the longer side sets the texel size.
+    let side = ext.x.max(ext.y) + 2.0 * pad;
+    let (cx, cy) = ((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5);
+    let dz = ext.z * 0.01 + pad;
+    let projection = MapProjection::Ortho {
+        x0: cx - side * 0.5,
+        x1: cx + side * 0.5,
+        y0: cy - side * 0.5,
+        y1: cy + side * 0.5,
+        // Distance is -z in view space.
+        near: -hi.z - dz,
+        far: -lo.z + dz,
+    };
+    LightShadow::Map(render_map(verts, view, projection, size))
+}
+
+/// Nearest and farthest distance of any vertex from `position`.
+fn distance_range(verts: &[Geo], position: Vec3) -> (f32, f32) {
+    verts
+        .par_iter()
+        .flat_map(|m| m.world.par_iter())
+        .map(|p| {
+            let d = p.distance(position);
+            (d, d)
+        })
+        .reduce(
+            || (f32::INFINITY, 0.0f32),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        )
+}
+
+/// Near plane: closer than any vertex can be along a face's axis.
+fn near_plane(verts: &[Geo], position: Vec3) -> Option<f32> {
+    let (lo, hi) = distance_range(verts, position);
+    (hi > 0.0 && hi.is_finite()).then(|| (lo * 0.25).max(hi * 1e-5))
+}
+
+fn spot(
+    verts: &[Geo],
+    position: Vec3,
+    direction: Vec3,
+    cos_outer: f32,
+    size: u32,
+) -> LightShadow {
+    let Some(near) = near_plane(verts, position) else {
+        return LightShadow::None;
+    };
+    let half = cos_outer.clamp(-1.0, 1.0).acos().min(85f32.to_radians());
+    let tan_half = half.tan() * (1.0 + 4.0 / size as f32);
+    let projection = MapProjection::Perspective { tan_half, near };
+    LightShadow::Map(render_map(verts, look(position, direction), projection, size))
+}
+
+fn point(verts: &[Geo], position: Vec3, size: u32) -> LightShadow {
+    let Some(near) = near_plane(verts, position) else {
+        return LightShadow::None;
+    };
+    // 90 degrees plus two texels on each side.
+    let projection = MapProjection::Perspective {
+        tan_half: 1.0 + 4.0 / size as f32,
+        near,
+    };
+    let faces = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z]
+        .map(|d| render_map(verts, look(position, d), projection, size));
+    LightShadow::Cube {
+        position,
+        faces: Box::new(faces),
+    }
+}
+
+/// Rasterizes every triangle's depth (reverse-Z, nearest wins) into a
+/// `size` x `size` map: clip, set up and bin in parallel chunks, then each
+/// band of rows depth-tests its triangles in submission order.
+fn render_map(
+    verts: &[Geo],
+    view_from_world: Mat4,
+    projection: MapProjection,
+    size: u32,
+) -> ShadowMap {
+    let clip_from_world = projection.clip_from_view() * view_from_world;
+    let vp = Viewport {
+        width: size,
+        height: size,
+    };
+    let (gx, gy) = vp.guard_band();
+    let grid = TileGrid::bands(size, size);
+    let mut chunks = Vec::new();
+    for (mi, m) in verts.iter().enumerate() {
+        let n = m.triangles.len();
+        for start in (0..n).step_by(CHUNK) {
+            chunks.push((mi, start, (start + CHUNK).min(n)));
+        }
+    }
+    let clip: Vec<Vec<Vec4>> = verts
+        .par_iter()
+        .map(|m| {
+            m.world
+                .iter()
+                .map(|p| clip_from_world * p.extend(1.0))
+                .collect()
+        })
+        .collect();
+    let per_chunk: Vec<(Vec<Tri>, Vec<Vec<u32>>)> = chunks
+        .par_iter()
+        .map(|&(mi, start, end)| {
+            let c = &clip[mi];
+            let mut tris = Vec::with_capacity(end - start);
+            for idx in &verts[mi].triangles[start..end] {
+                let v = idx.map(|i| c[i as usize]);
+                let base = |k: usize| ClipVertex {
+                    pos: v[k],
+                    bary: Vec3::ZERO,
+                };
+                match clip_triangle(v, gx, gy) {
+                    Clipped::Rejected => {}
+                    Clipped::Inside => {
+                        tris.extend(setup([base(0), base(1), base(2)], vp, CullMode::None, 0, 0))
+                    }
+                    Clipped::Polygon(p) => {
+                        let p = p.as_slice();
+                        for k in 1..p.len() - 1 {
+                            tris.extend(setup([p[0], p[k], p[k + 1]], vp, CullMode::None, 0, 0));
+                        }
+                    }
+                }
+            }
+            let bins = bin(&tris, &grid);
+            (tris, bins)
+        })
+        .collect();
+    let mut depth = vec![0.0f32; size as usize * size as usize];
+    let band = (grid.tile_w * grid.tile_h) as usize;
+    depth.par_chunks_mut(band).enumerate().for_each(|(ti, d)| {
+        let rect = grid.rect(ti);
+        let stride = rect.width();
+        for (tris, bins) in &per_chunk {
+            for &i in &bins[ti] {
+                raster_triangle(&tris[i as usize], rect, |px, py, z| {
+                    let k = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
+                    if z <= 1.0 && z > d[k] {
+                        d[k] = z;
+                    }
+                });
+            }
+        }
+    });
+    ShadowMap {
+        size,
+        view_from_world,
+        projection,
+        depth,
+    }
+}

@@ -1,0 +1,312 @@
+//! Ambient occlusion per pixel, from the geometry buffer of the visible
+//! surfaces (the pixel-center sample of each pixel): the fraction of the
+//! cosine-weighted hemisphere around the normal that reaches no occluder
+//! within `radius`. 1 = unoccluded.
+//!
+//! - `raytraced`: `samples` rays per pixel against the scene's BVH, from a
+//!   fixed stratified pattern (Hammersley points, shifted per pixel by a
+//!   hash of its coordinates: deterministic, no visible structure).
+//! - `ssao`: ground-truth AO in screen space (GTAO, Jimenez et al. 2016):
+//!   per pixel, slices through the view vector at rotated screen
+//!   directions; in each slice the highest occluder within `radius` on both
+//!   sides (from the depth buffer), then the exact cosine-weighted visible
+//!   arc between the two horizons around the normal projected into the
+//!   slice. The slice rotation and step offset follow a 4x4 pattern that a
+//!   5x5 tent blur ([1 2 2 2 1] per axis) averages out exactly on flat
+//!   surfaces; the blur's weights fall with a neighbor's distance from the
+//!   pixel's tangent plane and with the angle between normals, so it does not
+//!   cross depth edges.
+
+use std::f32::consts::{FRAC_PI_2, PI, TAU};
+
+use glam::{Mat4, Vec3};
+use rayon::prelude::*;
+
+use crate::raytrace::Tracer;
+use crate::scene::camera::{Camera, Projection};
+
+/// One pixel of the geometry buffer.
+#[derive(Debug, Clone, Copy)]
+pub struct GPixel {
+    /// Distance along the view axis; +inf where nothing was drawn.
+    pub depth: f32,
+    /// World-space position.
+    pub position: Vec3,
+    /// Interpolated unit normal (world space), facing the camera.
+    pub normal: Vec3,
+    /// Unit normal of the triangle's plane, facing the camera.
+    pub geo_normal: Vec3,
+}
+
+impl GPixel {
+    pub const EMPTY: GPixel = GPixel {
+        depth: f32::INFINITY,
+        position: Vec3::ZERO,
+        normal: Vec3::Z,
+        geo_normal: Vec3::Z,
+    };
+}
+
+/// The camera as SSAO needs it: pixel <-> view space.
+#[derive(Debug, Clone, Copy)]
+pub struct AoView {
+    pub width: u32,
+    pub height: u32,
+    pub view_from_world: Mat4,
+    /// Perspective: tan of half the vertical field of view; orthographic:
+    /// half the view height. Times `aspect` horizontally.
+    pub half: f32,
+    pub aspect: f32,
+    pub orthographic: bool,
+}
+
+impl AoView {
+    pub fn new(cam: &Camera, width: u32, height: u32) -> AoView {
+        let (half, orthographic) = match cam.projection {
+            Projection::Perspective { fov_y } => ((fov_y.to_radians() * 0.5).tan(), false),
+            Projection::Orthographic { height } => (height * 0.5, true),
+        };
+        AoView {
+            width,
+            height,
+            view_from_world: cam.view_from_world(),
+            half,
+            aspect: width as f32 / height as f32,
+            orthographic,
+        }
+    }
+
+    /// View-space position of pixel (x, y)'s center at view depth `d`.
+    #[inline]
+    fn position(&self, x: f32, y: f32, d: f32) -> Vec3 {
+        let sx = x / self.width as f32 * 2.0 - 1.0;
+        let sy = 1.0 - y / self.height as f32 * 2.0;
+        if self.orthographic {
+            Vec3::new(sx * self.half * self.aspect, sy * self.half, -d)
+        } else {
+            Vec3::new(sx * self.half * self.aspect * d, sy * self.half * d, -d)
+        }
+    }
+
+    /// World size of one pixel at view depth `d`.
+    #[inline]
+    fn pixel_size(&self, d: f32) -> f32 {
+        let h = 2.0 * self.half / self.height as f32;
+        if self.orthographic { h } else { h * d }
+    }
+}
+
+/// A hash of a pixel's coordinates to two numbers in [0, 1).
+#[inline]
+fn pixel_hash(x: u32, y: u32) -> (f32, f32) {
+    let mut h = x.wrapping_mul(0x9E37_79B1) ^ y.wrapping_mul(0x85EB_CA77);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2C1B_3C6D);
+    h ^= h >> 12;
+    h = h.wrapping_mul(0x297A_2D39);
+    h ^= h >> 15;
+    let a = (h & 0xFFFF) as f32 / 65536.0;
+    let b = (h >> 16) as f32 / 65536.0;
+    (a, b)
+}
+
+#[inline]
+fn radical_inverse(mut i: u32) -> f32 {
+    i = i.reverse_bits();
+    i as f32 * (1.0 / 4_294_967_296.0)
+}
+
+/// Ray-traced AO of every pixel of `g` (rows of `width` pixels).
+pub fn raytraced(
+    tracer: &Tracer,
+    g: &[GPixel],
+    width: u32,
+    samples: u32,
+    radius: Option<f32>,
+) -> Vec<f32> {
+    let t_max = radius.unwrap_or(f32::INFINITY);
+    let n = samples.max(1);
+    let w = width as usize;
+    let mut out = vec![1.0f32; g.len()];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let p = &g[y * w + x];
+            if !p.depth.is_finite() {
+                continue;
+            }
+            let (tx, ty) = p.normal.any_orthonormal_pair();
+            let origin = p.position + p.geo_normal * tracer.epsilon;
+            let (su, sv) = pixel_hash(x as u32, y as u32);
+            let mut open = 0u32;
+            for i in 0..n {
+                let u = ((i as f32 + 0.5) / n as f32 + su).fract();
+                let v = (radical_inverse(i) + sv).fract();
+                let r = u.sqrt();
+                let phi = TAU * v;
+                let dir = tx * (r * phi.cos())
+                    + ty * (r * phi.sin())
+                    + p.normal * (1.0 - u).max(0.0).sqrt();
+                if !tracer.occluded(origin, dir, t_max) {
+                    open += 1;
+                }
+            }
+            *o = open as f32 / n as f32;
+        }
+    });
+    out
+}
+
+/// 4x4 ordered pattern (0..16), for the per-pixel slice rotation and step
+/// offset of SSAO.
+const BAYER4: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
+
+/// Slices and steps per side for a budget of `samples` depth reads.
+pub fn ssao_layout(samples: u32) -> (u32, u32) {
+    let slices = (samples / 8).max(1);
+    let steps = (samples / (2 * slices)).max(1);
+    (slices, steps)
+}
+
+/// Screen-space (GTAO) AO of every pixel of `g`, blurred.
+pub fn ssao(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
+    let raw = ssao_raw(g, view, radius, samples);
+    blur(g, view, &raw)
+}
+
+/// GTAO before the blur.
+pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
+    let (w, h) = (view.width as usize, view.height as usize);
+    let (slices, steps) = ssao_layout(samples);
+    let rot = view.view_from_world;
+    let mut out = vec![1.0f32; g.len()];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let c = &g[y * w + x];
+            if !c.depth.is_finite() {
+                continue;
+            }
+            let (fx, fy) = (x as f32 + 0.5, y as f32 + 0.5);
+            let p = view.position(fx, fy, c.depth);
+            let n = rot.transform_vector3(c.normal).normalize_or(Vec3::Z);
+            let v = if view.orthographic {
+                Vec3::Z
+            } else {
+                (-p).normalize_or(Vec3::Z)
+            };
+            let r_px = (radius / view.pixel_size(c.depth)).min(h.max(w) as f32 * 0.5);
+            if r_px < 1.0 {
+                continue;
+            }
+            let turn = (BAYER4[y % 4][x % 4] as f32 + 0.5) / 16.0;
+            let jitter = (BAYER4[(y + 1) % 4][(x + 2) % 4] as f32 + 0.5) / 16.0;
+            let mut sum = 0.0f32;
+            let mut norm = 0.0f32;
+            for k in 0..slices {
+                let phi = (k as f32 + turn) * PI / slices as f32;
+                let (dx, dy) = (phi.cos(), phi.sin());
+                let dv = Vec3::new(dx, -dy, 0.0);
+                let Some(t_axis) = (dv - v * dv.dot(v)).try_normalize() else {
+                    continue;
+                };
+                let axis = v.cross(t_axis);
+                let np = n - axis * n.dot(axis);
+                let len = np.length();
+                if len < 1e-6 {
+                    continue;
+                }
+                let cos_g = (np.dot(v) / len).clamp(-1.0, 1.0);
+                let sign = if np.dot(t_axis) < 0.0 { -1.0 } else { 1.0 };
+                let gamma = sign * cos_g.acos();
+                let sin_g = gamma.sin();
+                let mut horizon = [-1.0f32; 2];
+                for (side, best) in [(1.0f32, 0usize), (-1.0, 1)] {
+                    for j in 0..steps {
+                        let s = (j as f32 + jitter) / steps as f32;
+                        let dist = 1.0 + s * (r_px - 1.0);
+                        let sx = fx + side * dx * dist;
+                        let sy = fy + side * dy * dist;
+                        if sx < 0.0 || sy < 0.0 || sx >= w as f32 || sy >= h as f32 {
+                            break;
+                        }
+                        let (ix, iy) = (sx as usize, sy as usize);
+                        if ix == x && iy == y {
+                            continue;
+                        }
+                        let sd = g[iy * w + ix].depth;
+                        if !sd.is_finite() {
+                            continue;
+                        }
+                        let q = view.position(ix as f32 + 0.5, iy as f32 + 0.5, sd);
+                        let d = q - p;
+                        let l = d.length();
+                        if l > radius || l <= 0.0 {
+                            continue;
+                        }
+                        horizon[best] = horizon[best].max(d.dot(v) / l);
+                    }
+                }
+                let h2 = gamma + (horizon[0].clamp(-1.0, 1.0).acos() - gamma).min(FRAC_PI_2);
+                let h1 = gamma + (-horizon[1].clamp(-1.0, 1.0).acos() - gamma).max(-FRAC_PI_2);
+                let arc = |hh: f32| 0.25 * (-(2.0 * hh - gamma).cos() + cos_g + 2.0 * hh * sin_g);
+                sum += len * (arc(h1) + arc(h2));
+                norm += len * (cos_g + gamma * sin_g);
+            }
+            if norm > 0.0 {
+                *o = (sum / norm).clamp(0.0, 1.0);
+            }
+        }
+    });
+    out
+}
+
+/// The depth- and normal-aware 5x5 tent blur.
+fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
+    const TENT: [f32; 5] = [1.0, 2.0, 2.0, 2.0, 1.0];
+    let (w, h) = (view.width as i32, view.height as i32);
+    let mut out = vec![1.0f32; raw.len()];
+    out.par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let y = y as i32;
+            for (x, o) in row.iter_mut().enumerate() {
+                let x = x as i32;
+                let c = &g[(y * w + x) as usize];
+                if !c.depth.is_finite() {
+                    continue;
+                }
+                let px = view.pixel_size(c.depth);
+                let mut sum = 0.0;
+                let mut wsum = 0.0;
+                for (j, wy) in TENT.iter().enumerate() {
+                    let sy = y + j as i32 - 2;
+                    if sy < 0 || sy >= h {
+                        continue;
+                    }
+                    for (i, wx) in TENT.iter().enumerate() {
+                        let sx = x + i as i32 - 2;
+                        if sx < 0 || sx >= w {
+                            continue;
+                        }
+                        let k = (sy * w + sx) as usize;
+                        let s = &g[k];
+                        if !s.depth.is_finite() {
+                            continue;
+                        }
+                        // Distance from the center's tangent plane, in
+                        // pixel footprints, and the normals' agreement.
+                        let plane = c.normal.dot(s.position - c.position).abs() / px;
+                        let agree = c.normal.dot(s.normal).max(0.0);
+                        let wt = wx * wy * (-0.5 * plane * plane).exp() * agree * agree;
+                        sum += wt * raw[k];
+                        wsum += wt;
+                    }
+                }
+                *o = if wsum > 0.0 {
+                    sum / wsum
+                } else {
+                    raw[(y * w + x) as usize]
+                };
+            }
+        });
+    out
+}

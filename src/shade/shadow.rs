@@ -1,0 +1,292 @@
+//! Shadow lookups: how much of a light reaches a point, from a shadow map
+//! (hard or PCF) or from a ray towards the light.
+//!
+//! Shadow maps hold reverse-Z depth (near 1, nothing 0): orthographic maps
+//! (directional lights) are linear in distance, perspective maps (spot
+//! lights, the six faces of a point light's cube) use an infinite far plane,
+//! z = near / distance, whose float precision is relative to the distance.
+//!
+//! Bias, all in texels of the map at the receiver (`render.shadow_bias`):
+//! - normal offset: the lookup point moves along the geometric normal by
+//!   `normal * sin(angle between normal and light)` texels;
+//! - receiver plane: every texel the filter reads is compared with the depth
+//!   of the receiver's own (geometric) plane at that texel's center, not
+//!   with the depth at the shaded point, so a tilted surface never shadows
+//!   itself across the filter's footprint;
+//! - depth bias: `constant + slope * tan(angle)` texels (tan capped at 10),
+//!   which absorbs curvature and rasterization rounding.
+//!
+//! The PCF kernel: a 3x3-texel box, area-weighted, around the lookup point
+//! (so 4x4 texels are read, the outer ones partially); "hard" reads the one
+//! texel under the point.
+
+use glam::{Mat4, Vec3};
+
+use crate::raytrace::Tracer;
+use crate::scene::ShadowBias;
+
+/// How a map projects light-view space (looking down -Z) to texels.
+#[derive(Debug, Clone, Copy)]
+pub enum MapProjection {
+    /// x in [x0, x1], y in [y0, y1]; distance (-z) in [near, far].
+    Ortho {
+        x0: f32,
+        x1: f32,
+        y0: f32,
+        y1: f32,
+        near: f32,
+        far: f32,
+    },
+    /// tan of the half field of view (square), near plane distance.
+    Perspective { tan_half: f32, near: f32 },
+}
+
+impl MapProjection {
+    /// Clip from light view: the matrix the depth pass rasterizes with.
+    pub fn clip_from_view(&self) -> Mat4 {
+        use glam::Vec4;
+        match *self {
+            MapProjection::Ortho {
+                x0,
+                x1,
+                y0,
+                y1,
+                near,
+                far,
+            } => {
+                let (sx, sy) = (2.0 / (x1 - x0), 2.0 / (y1 - y0));
+                // z_clip = (far - d) / (far - near) with d = -z_view.
+                let a = 1.0 / (far - near);
+                Mat4::from_cols(
+                    Vec4::new(sx, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, sy, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, a, 0.0),
+                    Vec4::new(-(x0 + x1) / (x1 - x0), -(y0 + y1) / (y1 - y0), far * a, 1.0),
+                )
+            }
+            MapProjection::Perspective { tan_half, near } => {
+                let s = 1.0 / tan_half;
+                // z_clip = near, w = d: z = near / d.
+                Mat4::from_cols(
+                    Vec4::new(s, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, s, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, 0.0, -1.0),
+                    Vec4::new(0.0, 0.0, near, 0.0),
+                )
+            }
+        }
+    }
+}
+
+/// One depth map.
+#[derive(Debug, Clone)]
+pub struct ShadowMap {
+    pub size: u32,
+    pub view_from_world: Mat4,
+    pub projection: MapProjection,
+    /// Reverse-Z depth per texel, rows from the top; 0 where nothing was
+    /// drawn.
+    pub depth: Vec<f32>,
+}
+
+/// What a light with `shadows = true` is tested against this frame.
+#[derive(Debug, Clone)]
+pub enum LightShadow {
+    /// Casts no shadows (the light does not ask, or `render.shadows = off`).
+    None,
+    Map(ShadowMap),
+    /// A point light's cube at `position`: faces +X, -X, +Y, -Y, +Z, -Z.
+    Cube {
+        position: Vec3,
+        faces: Box<[ShadowMap; 6]>,
+    },
+    /// Rays towards the light: to its position (point, spot), or unbounded
+    /// (directional).
+    Ray { position: Option<Vec3> },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    Hard,
+    Pcf,
+}
+
+/// Every light's shadow for one frame.
+pub struct Shadows<'a> {
+    /// Per light of the frame, in the same order.
+    pub lights: Vec<LightShadow>,
+    pub filter: Filter,
+    pub bias: ShadowBias,
+    pub tracer: Option<Tracer<'a>>,
+}
+
+const MAX_TAN: f32 = 10.0;
+
+impl Shadows<'_> {
+    /// No shadows at all.
+    pub fn none() -> Shadows<'static> {
+        Shadows {
+            lights: Vec::new(),
+            filter: Filter::Pcf,
+            bias: ShadowBias::default(),
+            tracer: None,
+        }
+    }
+
+    /// Fraction of light `i` reaching `p` (geometric unit normal `ng`,
+    /// facing the viewer; `l` unit towards the light): 0 in shadow, 1 lit.
+    /// A surface facing away from the light is in its own shadow.
+    #[inline]
+    pub fn visibility(&self, i: usize, p: Vec3, ng: Vec3, l: Vec3) -> f32 {
+        let Some(s) = self.lights.get(i) else {
+            return 1.0;
+        };
+        if matches!(s, LightShadow::None) {
+            return 1.0;
+        }
+        let cos = ng.dot(l);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        match s {
+            LightShadow::None => 1.0,
+            LightShadow::Map(m) => self.lookup(m, p, ng, cos),
+            LightShadow::Cube { position, faces } => {
+                self.lookup(&faces[cube_face(p - *position)], p, ng, cos)
+            }
+            LightShadow::Ray { position } => {
+                let Some(t) = &self.tracer else { return 1.0 };
+                let o = p + ng * t.epsilon;
+                let occluded = match position {
+                    Some(q) => t.occluded(o, *q - o, 1.0 - 1e-4),
+                    None => t.occluded(o, l, f32::INFINITY),
+                };
+                if occluded { 0.0 } else { 1.0 }
+            }
+        }
+    }
+
+    fn lookup(&self, m: &ShadowMap, p: Vec3, ng: Vec3, cos: f32) -> f32 {
+        let b = &self.bias;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let tan = (sin / cos).min(MAX_TAN);
+        let size = m.size as f32;
+        let v = &m.view_from_world;
+        let q0 = v.transform_point3(p);
+        let texel = |d: f32| match m.projection {
+            MapProjection::Ortho { x0, x1, .. } => (x1 - x0) / size,
+            MapProjection::Perspective { tan_half, .. } => 2.0 * d * tan_half / size,
+        };
+        // Normal offset.
+        let q = q0 + v.transform_vector3(ng) * (b.normal * sin * texel(-q0.z));
+        let nv = v.transform_vector3(ng);
+        let d = -q.z;
+        let t = texel(d);
+        let depth_bias = t * (b.constant + b.slope * tan);
+        // Texel coordinates of q, the receiver's reverse-Z depth there, and
+        // its gradient per texel along the map's x and y (rows run down).
+        let (fx, fy, z, gx, gy, z_per_texel) = match m.projection {
+            MapProjection::Ortho {
+                x0,
+                x1,
+                y0,
+                y1,
+                near,
+                far,
+            } => {
+                if d < near {
+                    return 1.0;
+                }
+                let fx = (q.x - x0) / (x1 - x0) * size;
+                let fy = (y1 - q.y) / (y1 - y0) * size;
+                let a = 1.0 / (far - near);
+                let z = (far - (d - depth_bias)) * a;
+                // d' = d + (nv.x dx + nv.y dy) / nv.z along the plane.
+                let (tx, ty) = ((x1 - x0) / size, (y1 - y0) / size);
+                let inv = if nv.z.abs() > 1e-12 { 1.0 / nv.z } else { 0.0 };
+                let gx = -(nv.x * tx * inv) * a;
+                let gy = (nv.y * ty * inv) * a;
+                (fx, fy, z, gx, gy, t * a)
+            }
+            MapProjection::Perspective { tan_half, near } => {
+                if d <= near {
+                    return 1.0;
+                }
+                let sx = q.x / (d * tan_half);
+                let sy = q.y / (d * tan_half);
+                let fx = (sx * 0.5 + 0.5) * size;
+                let fy = (0.5 - sy * 0.5) * size;
+                let z = near / (d - depth_bias).max(near * 1e-3);
+                // 1/d' = (nv . r) / (nv . q), r = (sx tan, sy tan, -1):
+                // affine in sx, sy.
+                let nq = nv.dot(q);
+                let (gx, gy) = if nq.abs() > 1e-20 {
+                    let k = near * tan_half / nq * (2.0 / size);
+                    (nv.x * k, -nv.y * k)
+                } else {
+                    (0.0, 0.0)
+                };
+                (fx, fy, z, gx, gy, near * t / (d * d))
+            }
+        };
+        // The plane's slope, capped like the slope bias.
+        let cap = z_per_texel * MAX_TAN;
+        let (gx, gy) = (gx.clamp(-cap, cap), gy.clamp(-cap, cap));
+        if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size
+        {
+            return 1.0;
+        }
+        let n = m.size as i32;
+        // Lit when the stored depth is not nearer (greater) than the
+        // receiver's at that texel center.
+        let lit = |ix: i32, iy: i32| -> f32 {
+            let (cx, cy) = (ix.clamp(0, n - 1), iy.clamp(0, n - 1));
+            let stored = m.depth[(cy * n + cx) as usize];
+            let zr = z + gx * (ix as f32 + 0.5 - fx) + gy * (iy as f32 + 0.5 - fy);
+            if stored <= zr { 1.0 } else { 0.0 }
+        };
+        match self.filter {
+            Filter::Hard => lit(fx as i32, fy as i32),
+            Filter::Pcf => {
+                // Box [f - 1.5, f + 1.5] per axis; texel i covers [i, i+1].
+                let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
+                let w = |i: i32, f: f32| {
+                    let lo = (i as f32).max(f - 1.5);
+                    let hi = (i as f32 + 1.0).min(f + 1.5);
+                    (hi - lo).max(0.0) / 3.0
+                };
+                let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
+                let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
+                let mut sum = 0.0;
+                for (j, wyj) in wy.iter().enumerate() {
+                    if *wyj == 0.0 {
+                        continue;
+                    }
+                    let mut row = 0.0;
+                    for (i, wxi) in wx.iter().enumerate() {
+                        if *wxi > 0.0 {
+                            row += wxi * lit(bx + i as i32, by + j as i32);
+                        }
+                    }
+                    sum += wyj * row;
+                }
+                sum
+            }
+        }
+    }
+}
+
+/// The cube face (+X, -X, +Y, -Y, +Z, -Z) a direction falls on.
+#[inline]
+pub fn cube_face(d: Vec3) -> usize {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 { 0 } else { 1 }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 { 2 } else { 3 }
+    } else if d.z >= 0.0 {
+        4
+    } else {
+        5
+    }
+}
