@@ -137,9 +137,7 @@ fn features_of_later_issues_are_refused_not_ignored() {
     write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     for (key, text) in [
         ("render.msaa", "[render]\nmsaa = 4\n"),
-        ("light.shadows", "[[light]]\nshadows = true\n"),
-        ("output.depth", "[output]\ndepth = true\n"),
-        ("render.ao", "[render]\nao = { method = \"ssao\" }\n"),
+        ("output.gif", "[output]\ngif = \"a.gif\"\n"),
     ] {
         let s = write(
             &dir,

@@ -354,7 +354,7 @@ mod tests {
         for i in 0..400 {
             let a = i as f32 * 0.7;
             let o = Vec3::new(3.0 * a.cos(), 1.5 * (a * 1.3).sin(), 3.0 * a.sin());
-            let target = Vec3::new((a * 2.1).sin(), (a * 0.37).cos() * 0.3, (a * 1.7).cos());
+            let target = Vec3::new((a * 2.1).sin(), (a * 0.37).cos() * 0.3, (a * 1.7).cos()) * 1.6;
             let d = target - o;
             let want = brute(&pos, &tris, o, d);
             let got = bvh.nearest(o, d, 0.0, f32::INFINITY).map(|h| h.t);

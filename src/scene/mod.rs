@@ -55,7 +55,7 @@ pub struct ShadowBias {
     /// Depth bias (default 1).
     pub constant: f32,
     /// Depth bias times the tangent of the angle between normal and light
-    /// (default 1; the tangent is capped at 10).
+    /// (default 0.5; the tangent is capped at 10).
     pub slope: f32,
     /// Lookup point moved along the geometric normal, times the sine of
     /// the angle between normal and light (default 1).
@@ -66,7 +66,7 @@ impl Default for ShadowBias {
     fn default() -> ShadowBias {
         ShadowBias {
             constant: 1.0,
-            slope: 1.0,
+            slope: 0.5,
             normal: 1.0,
         }
     }

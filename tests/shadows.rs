@@ -1,0 +1,461 @@
+//! Shadows, ambient occlusion and the EXR data buffers against analytic
+//! and ray-traced truth, and where shadow maps are known to fail (acne at
+//! grazing light, peter-panning at contact, SSAO halos).
+
+mod common;
+
+use std::path::Path;
+
+use glam::Vec3;
+use softraster::batch::RenderJob;
+use softraster::output::exr::read_channel;
+use softraster::procedural::{self, Builder};
+use softraster::render::{Frame, render_frame};
+use softraster::scene::Scene;
+use softraster::scene::build::LoadOptions;
+
+/// A procedural mesh as OBJ text without a material library.
+fn obj(b: Builder) -> String {
+    b.to_obj("m", "none.mtl", "m")
+        .text
+        .replace("mtllib none.mtl\n", "")
+        .replace("usemtl m\n", "")
+}
+
+fn load(dir: &Path, text: &str) -> Scene {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn render(dir: &Path, text: &str) -> Frame {
+    render_frame(&load(dir, text), 0, 0)
+}
+
+/// Per pixel: the fraction of the (single) light that arrives, as the
+/// ratio of the image with `shadows` to the image without; NaN where the
+/// unshadowed image is black (background, or facing away from the light).
+/// `scene` holds `{shadows}` where `render.shadows` goes.
+fn shadow_factor(dir: &Path, scene: &str, shadows: &str) -> Vec<f32> {
+    let lit = render(dir, &scene.replace("{shadows}", "off"));
+    let sh = render(dir, &scene.replace("{shadows}", shadows));
+    lit.color
+        .iter()
+        .zip(&sh.color)
+        .map(|(a, b)| {
+            if a.x > 1e-4 {
+                (b.x / a.x).clamp(0.0, 1.0)
+            } else {
+                f32::NAN
+            }
+        })
+        .collect()
+}
+
+/// A top-down orthographic camera over the XZ plane: pixel (px, py) looks at
+/// world (x, z) with x to the right and z down the image.
+const TOP_DOWN: &str = "[[camera]]\neye = [0.0, 10.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\nprojection = \"orthographic\"\nheight = 6.0\nnear = 1.0\nfar = 20.0\n";
+
+fn top_down_point(px: u32, py: u32, size: u32, height: f32) -> (f32, f32) {
+    let s = height / size as f32;
+    (
+        (px as f32 + 0.5) * s - height * 0.5,
+        (py as f32 + 0.5) * s - height * 0.5,
+    )
+}
+
+const MATTE: &str = "[model.material]\nkd = [1.0, 1.0, 1.0]\nks = [0.0, 0.0, 0.0]\n";
+
+#[test]
+fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
+    let dir = common::scratch("depth_exr");
+    std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(1.0, 96, 48))).unwrap();
+    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(6.0, 0.0, 1.0))).unwrap();
+    let (w, h, fov) = (96u32, 80u32, 50.0f32);
+    let text = format!(
+        "[output]\nwidth = {w}\nheight = {h}\ndepth = true\ncolor = false\nname = \"f\"\n\
+         [[model]]\npath = \"ground.obj\"\n[[model]]\npath = \"sphere.obj\"\ntranslate = [0.3, 1.2, -0.4]\n\
+         [[camera]]\neye = [0.5, 2.5, 5.0]\ntarget = [0.0, 0.6, 0.0]\nfov = {fov}\nnear = 0.3\nfar = 40.0\n"
+    );
+    let scene = load(&dir, &text);
+    let out = dir.join("out");
+    let mut job = RenderJob {
+        scene,
+        frames: 0..1,
+        cameras: vec![0],
+    };
+    job.scene.output.dir = out.clone();
+    job.run(|_| {}).unwrap();
+    let (ew, eh, z) = read_channel(&out.join("f_depth.exr"), "Z").unwrap();
+    assert_eq!((ew, eh), (w, h));
+    assert!(!out.join("f.png").exists(), "color = false writes no PNG");
+
+    // The exact surfaces drawn: both meshes' triangles in world space.
+    let s = &job.scene;
+    let mut tris: Vec<[Vec3; 3]> = Vec::new();
+    for m in &s.models {
+        for t in &m.mesh.triangles {
+            tris.push(t.map(|i| m.world_from_object.transform_point3(m.mesh.positions[i as usize])));
+        }
+    }
+    let cam = &s.cameras[0];
+    let world_from_view = cam.view_from_world().inverse();
+    let forward = cam.forward();
+    let center = Vec3::new(0.3, 1.2, -0.4);
+    let (mut sphere_px, mut plane_px, mut empty) = (0, 0, 0);
+    let mut worst = 0.0f64;
+    let mut worst_ideal = 0.0f32;
+    for py in 0..h {
+        for px in 0..w {
+            let got = z[(py * w + px) as usize];
+            let d = world_from_view.transform_vector3(common::view_ray(px, py, w, h, fov));
+            let Some((t, k)) = ray_mesh(cam.eye, d, &tris) else {
+                assert!(got.is_infinite() || near_edge(px, py, &z, w, h), "({px},{py}) {got}");
+                if got.is_infinite() {
+                    empty += 1;
+                }
+                continue;
+            };
+            if !got.is_finite() {
+                continue; // silhouette pixel: coverage decided by the rule
+            }
+            // Distance along the view axis of the hit.
+            let want = (d * t as f32).dot(forward) as f64;
+            let rel = ((got as f64 - want) / want).abs();
+            if rel >= 1e-5 && near_edge(px, py, &z, w, h) {
+                continue; // a different triangle won the edge
+            }
+            assert!(rel < 1e-5, "({px},{py}): {got} vs {want}, rel {rel:e}");
+            worst = worst.max(rel);
+            if k >= 2 {
+                sphere_px += 1;
+                // Against the ideal sphere: within the facets' sagitta.
+                let dd = d.normalize();
+                let oc = cam.eye - center;
+                let b = oc.dot(dd);
+                let disc = b * b - (oc.length_squared() - 1.0);
+                if disc > 0.1 {
+                    let ti = -b - disc.sqrt();
+                    let ideal = (dd * ti).dot(forward);
+                    worst_ideal = worst_ideal.max((got - ideal).abs() / ideal);
+                }
+            } else {
+                plane_px += 1;
+            }
+        }
+    }
+    println!(
+        "depth EXR: worst relative error {worst:e} over {} pixels; ideal sphere within {worst_ideal:e}",
+        sphere_px + plane_px
+    );
+    assert!(sphere_px > 600 && plane_px > 2000 && empty > 50, "{sphere_px} {plane_px} {empty}");
+    // 96x48 facets: sagitta 1 - cos(pi/48) = 2.1e-3 of the radius.
+    assert!(worst_ideal < 2.5e-3 / 3.0, "{worst_ideal}");
+}
+
+/// Whether a 4-neighbor has a very different depth (an occlusion edge).
+fn near_edge(px: u32, py: u32, z: &[f32], w: u32, h: u32) -> bool {
+    let c = z[(py * w + px) as usize];
+    [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)].iter().any(|(dx, dy)| {
+        let (x, y) = (px as i32 + dx, py as i32 + dy);
+        if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
+            return false;
+        }
+        let n = z[(y as u32 * w + x as u32) as usize];
+        !(n.is_finite() && c.is_finite()) || (n - c).abs() > 0.05 * c
+    })
+}
+
+/// Nearest hit of a ray with a triangle list, in f64: (t, triangle index).
+fn ray_mesh(o: Vec3, d: Vec3, tris: &[[Vec3; 3]]) -> Option<(f64, usize)> {
+    let dv = |v: Vec3| glam::DVec3::new(v.x as f64, v.y as f64, v.z as f64);
+    let (o, d) = (dv(o), dv(d));
+    let mut best: Option<(f64, usize)> = None;
+    for (k, t) in tris.iter().enumerate() {
+        let (a, b, c) = (dv(t[0]), dv(t[1]), dv(t[2]));
+        let (e1, e2) = (b - a, c - a);
+        let p = d.cross(e2);
+        let det = e1.dot(p);
+        if det.abs() < 1e-15 {
+            continue;
+        }
+        let s = o - a;
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = d.dot(q) / det;
+        let tt = e2.dot(q) / det;
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && tt > 0.0 && best.is_none_or(|b| tt < b.0) {
+            best = Some((tt, k));
+        }
+    }
+    best
+}
+
+#[test]
+fn raytraced_ao_under_a_sphere_matches_the_closed_form() {
+    // A point on a plane sees a sphere (radius r, center at height h and
+    // distance d) over a cosine-weighted solid angle of r^2 h / d^3.
+    let dir = common::scratch("ao_closed_form");
+    let (r, hc) = (0.5f32, 1.0f32);
+    std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(r, 128, 64))).unwrap();
+    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(50.0, 0.0, 1.0))).unwrap();
+    let size = 48u32;
+    let samples = 1024u32;
+    let text = format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ method = \"raytraced\", samples = {samples} }}\n\
+         [[model]]\npath = \"ground.obj\"\n[[model]]\npath = \"sphere.obj\"\ntranslate = [0.0, {hc}, 0.0]\n{TOP_DOWN}"
+    );
+    let f = render(&dir, &text);
+    let mut n = 0;
+    let mut sum_sq = 0.0f64;
+    let mut worst = 0.0f32;
+    for py in 0..size {
+        for px in 0..size {
+            let (x, z) = top_down_point(px, py, size, 6.0);
+            let rho2 = x * x + z * z;
+            if rho2 < (r * 1.3) * (r * 1.3) {
+                continue; // the sphere itself is seen here
+            }
+            let d = (rho2 + hc * hc).sqrt();
+            let want = 1.0 - r * r * hc / (d * d * d);
+            let got = f.ao[(py * size + px) as usize];
+            // Binomial noise of `samples` stratified rays: at most
+            // sqrt(p (1 - p) / n) = 0.0156 for p = 1/2.
+            let sigma = (want * (1.0 - want) / samples as f32).sqrt().max(1e-3);
+            assert!(
+                (got - want).abs() < 4.0 * sigma + 2e-3,
+                "({x:.2},{z:.2}): {got} vs {want} (sigma {sigma})"
+            );
+            worst = worst.max((got - want).abs());
+            sum_sq += ((got - want) as f64).powi(2);
+            n += 1;
+        }
+    }
+    let rmse = (sum_sq / n as f64).sqrt();
+    println!("raytraced AO vs 1 - r^2 h / d^3: RMSE {rmse:.5}, worst {worst:.5} over {n} pixels");
+    assert!(n > 1500);
+    assert!(rmse < 0.006, "{rmse}");
+}
+
+/// Sphere (radius 1, center at height 1.5) over the plane y = 0, one
+/// directional light travelling along `dir` (unit): the shadow is the
+/// set of plane points whose ray towards the light passes within 1 of the
+/// center.
+fn analytic_shadow(x: f32, z: f32, center: Vec3, light_dir: Vec3) -> bool {
+    let p = Vec3::new(x, 0.0, z);
+    let to_light = -light_dir;
+    let c = center - p;
+    c.dot(to_light) > 0.0 && c.cross(to_light).length() < 1.0
+}
+
+fn sphere_on_plane_scene(dir: &Path, light_dir: Vec3, size: u32, extra: &str) -> String {
+    std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(1.0, 128, 64))).unwrap();
+    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(8.0, 0.0, 1.0))).unwrap();
+    format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{extra}\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+         [[model]]\npath = \"ground.obj\"\n{MATTE}[[model]]\npath = \"sphere.obj\"\ntranslate = [0.0, 1.5, 0.0]\n{MATTE}\
+         [[light]]\nkind = \"directional\"\ndirection = [{}, {}, {}]\nirradiance = 1.0\nshadows = true\n{TOP_DOWN}",
+        light_dir.x, light_dir.y, light_dir.z
+    )
+}
+
+#[test]
+fn shadow_of_a_sphere_is_the_analytic_ellipse() {
+    let dir = common::scratch("shadow_ellipse");
+    let light = Vec3::new(-1.0, -1.6, -0.5).normalize();
+    let size = 300u32;
+    let center = Vec3::new(0.0, 1.5, 0.0);
+    let scene = sphere_on_plane_scene(&dir, light, size, "");
+    for method in ["hard", "pcf", "raytraced"] {
+        let f = shadow_factor(&dir, &scene, method);
+        let (mut wrong, mut shadowed, mut plane) = (0, 0, 0);
+        let px_size = 6.0 / size as f32;
+        for py in 0..size {
+            for px in 0..size {
+                let (x, z) = top_down_point(px, py, size, 6.0);
+                if x * x + z * z < 1.05 {
+                    continue; // the sphere is seen from above here
+                }
+                let k = f[(py * size + px) as usize];
+                if k.is_nan() {
+                    continue;
+                }
+                plane += 1;
+                let want = analytic_shadow(x, z, center, light);
+                shadowed += want as u32;
+                if (k < 0.5) != want {
+                    // Only within 2 pixels of the boundary.
+                    let near = (0..16).any(|i| {
+                        let a = i as f32 * std::f32::consts::TAU / 16.0;
+                        let (dx, dz) = (a.cos() * 2.0 * px_size, a.sin() * 2.0 * px_size);
+                        analytic_shadow(x + dx, z + dz, center, light) != want
+                    });
+                    assert!(near, "{method}: ({px},{py}) factor {k}, analytic {want}");
+                    wrong += 1;
+                }
+            }
+        }
+        println!("{method}: {wrong} boundary pixels differ of {shadowed} shadowed, {plane} plane pixels");
+        assert!(shadowed > 3000 && plane > 50_000, "{shadowed} {plane}");
+    }
+}
+
+/// Pixels wrongly in shadow among lit-side pixels: shadow-map factor below
+/// `below` where the ray-traced factor is 1, away (more than 2 pixels)
+/// from any ray-traced shadow.
+fn acne(map: &[f32], truth: &[f32], w: u32, h: u32, below: f32) -> (usize, usize) {
+    let (mut wrong, mut lit) = (0, 0);
+    for y in 0..h as i32 {
+        for x in 0..w as i32 {
+            let i = (y * w as i32 + x) as usize;
+            if truth[i].is_nan() || truth[i] < 1.0 {
+                continue;
+            }
+            let near_shadow = (-2..=2).any(|dy| {
+                (-2..=2).any(|dx| {
+                    let (sx, sy) = (x + dx, y + dy);
+                    sx >= 0
+                        && sy >= 0
+                        && sx < w as i32
+                        && sy < h as i32
+                        && truth[(sy * w as i32 + sx) as usize] < 1.0
+                })
+            });
+            if near_shadow {
+                continue;
+            }
+            lit += 1;
+            if map[i] < below {
+                wrong += 1;
+            }
+        }
+    }
+    (wrong, lit)
+}
+
+#[test]
+fn no_acne_on_a_sphere_and_plane_at_grazing_light() {
+    let dir = common::scratch("acne_sphere");
+    let size = 320u32;
+    // 10 degrees above the horizon, from several azimuths.
+    let e = 10f32.to_radians();
+    for az in [0.0f32, 35.0, 100.0] {
+        let a = az.to_radians();
+        let light = Vec3::new(-e.cos() * a.cos(), -e.sin(), -e.cos() * a.sin());
+        let scene = sphere_on_plane_scene(&dir, light, size, &std::env::var("XBIAS").unwrap_or_default());
+        // A low camera, so the sphere's lit side fills the frame.
+        let scene = scene.replace(
+            TOP_DOWN,
+            "[[camera]]\neye = [4.0, 2.5, 3.0]\ntarget = [0.0, 1.0, 0.0]\nfov = 45.0\n",
+        );
+        let truth = shadow_factor(&dir, &scene, "raytraced");
+        for method in ["pcf", "hard"] {
+            let f = shadow_factor(&dir, &scene, method);
+            let (wrong, lit) = acne(&f, &truth, size, size, 0.5);
+            let (partial, _) = acne(&f, &truth, size, size, 0.99);
+            println!(
+                "azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
+            );
+            assert!(lit > 10_000, "{lit}");
+            assert!((wrong as f64) < lit as f64 * 1e-3, "{method} {az}: {wrong} of {lit}");
+        }
+    }
+}
+
+#[test]
+fn a_box_on_the_plane_meets_its_shadow() {
+    // Peter-panning: the gap between a box's base and its shadow. A solid
+    // box hides depth bias (the map holds its far, light-facing side, a
+    // whole box width from the plane behind it); a thin wall (0.04 thick
+    // along the light) shows any bias above its thickness.
+    let dir = common::scratch("peter_panning");
+    std::fs::write(dir.join("box.obj"), obj(procedural::cube([0.0, 0.5, 0.0], 0.5))).unwrap();
+    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(8.0, 0.0, 1.0))).unwrap();
+    let size = 400u32;
+    let bias = std::env::var("XBIAS").unwrap_or_default();
+    for (what, thick) in [("box", 1.0f32), ("wall", 0.04)] {
+        for elevation in [30.0f32, 10.0] {
+            let e = elevation.to_radians();
+            // Travelling along -x: the shadow falls on the -x side.
+            let light = Vec3::new(-e.cos(), -e.sin(), 0.0);
+            let scene = format!(
+                "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{bias}\n\
+                 [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+                 [[model]]\npath = \"ground.obj\"\n{MATTE}[[model]]\npath = \"box.obj\"\nscale = [{thick}, 1.0, 1.0]\n{MATTE}\
+                 [[light]]\nkind = \"directional\"\ndirection = [{}, {}, 0.0]\nirradiance = 1.0\nshadows = true\n{TOP_DOWN}",
+                light.x, light.y
+            );
+            let truth = shadow_factor(&dir, &scene, "raytraced");
+            // The first pixel column left of the base.
+            let edge = ((-thick * 0.5 + 3.0) / 6.0 * size as f32).floor() as u32;
+            for method in ["pcf", "hard"] {
+                let f = shadow_factor(&dir, &scene, method);
+                let mut worst = 0;
+                let mut rows = 0;
+                for py in 0..size {
+                    let (_, z) = top_down_point(0, py, size, 6.0);
+                    if z.abs() > 0.45 {
+                        continue;
+                    }
+                    rows += 1;
+                    // Walk left from the base: lit pixels the ray tracer
+                    // shades, before the map's shadow begins.
+                    let mut gap = 0;
+                    for px in (0..edge).rev() {
+                        let i = (py * size + px) as usize;
+                        if f[i] < 0.5 {
+                            break;
+                        }
+                        if truth[i] < 0.5 {
+                            gap += 1;
+                        }
+                    }
+                    worst = worst.max(gap);
+                }
+                println!("{what}, elevation {elevation}: {method}: widest gap {worst} px over {rows} rows");
+                assert!(rows > 50);
+                assert!(worst < 2, "{what}, {method} at {elevation} degrees: gap {worst} px");
+            }
+        }
+    }
+}
+
+#[test]
+fn no_acne_on_diablo3_at_grazing_light() {
+    let Some(assets) = common::shared_assets() else {
+        return;
+    };
+    let dir = common::scratch("acne_diablo3");
+    let t = assets.join("tinyrenderer");
+    let size = 400u32;
+    let bias = std::env::var("XBIAS").unwrap_or_default();
+    let e = 10f32.to_radians();
+    for az in [20.0f32, 135.0, 250.0] {
+        let a = az.to_radians();
+        let light = Vec3::new(-e.cos() * a.cos(), -e.sin(), -e.cos() * a.sin());
+        let scene = format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{bias}\n\
+             [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+             [[model]]\npath = \"{}\"\nscale = [2.0, 1.0, 2.0]\n{MATTE}\
+             [[model]]\npath = \"{}\"\n{MATTE}\
+             [[light]]\nkind = \"directional\"\ndirection = [{}, {}, {}]\nirradiance = 1.0\nshadows = true\n\
+             [[camera]]\neye = [1.2, 0.6, 3.2]\ntarget = [0.0, -0.1, 0.0]\nfov = 45.0\n",
+            t.join("floor.obj").display(),
+            t.join("diablo3_pose/diablo3_pose.obj").display(),
+            light.x,
+            light.y,
+            light.z
+        );
+        let truth = shadow_factor(&dir, &scene, "raytraced");
+        for method in ["pcf", "hard"] {
+            let f = shadow_factor(&dir, &scene, method);
+            let (wrong, lit) = acne(&f, &truth, size, size, 0.5);
+            let (partial, _) = acne(&f, &truth, size, size, 0.99);
+            println!(
+                "diablo3, azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
+            );
+            assert!(lit > 10_000, "{lit}");
+            assert!((wrong as f64) < lit as f64 * 1e-3, "{method} {az}: {wrong} of {lit}");
+        }
+    }
+}
