@@ -66,10 +66,7 @@ impl RenderJob {
         let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
         let writer = std::thread::spawn(move || {
             for (done, outputs) in writer_rx {
-                let r = outputs
-                    .iter()
-                    .try_for_each(Output::write)
-                    .map(|_| done);
+                let r = outputs.iter().try_for_each(Output::write).map(|_| done);
                 let failed = r.is_err();
                 if done_tx.send(r).is_err() || failed {
                     break;

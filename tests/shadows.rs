@@ -70,7 +70,11 @@ const MATTE: &str = "[model.material]\nkd = [1.0, 1.0, 1.0]\nks = [0.0, 0.0, 0.0
 fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
     let dir = common::scratch("depth_exr");
     std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(1.0, 96, 48))).unwrap();
-    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(6.0, 0.0, 1.0))).unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(6.0, 0.0, 1.0)),
+    )
+    .unwrap();
     let (w, h, fov) = (96u32, 80u32, 50.0f32);
     let text = format!(
         "[output]\nwidth = {w}\nheight = {h}\ndepth = true\ncolor = false\nname = \"f\"\n\
@@ -95,7 +99,10 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
     let mut tris: Vec<[Vec3; 3]> = Vec::new();
     for m in &s.models {
         for t in &m.mesh.triangles {
-            tris.push(t.map(|i| m.world_from_object.transform_point3(m.mesh.positions[i as usize])));
+            tris.push(t.map(|i| {
+                m.world_from_object
+                    .transform_point3(m.mesh.positions[i as usize])
+            }));
         }
     }
     let cam = &s.cameras[0];
@@ -110,7 +117,10 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
             let got = z[(py * w + px) as usize];
             let d = world_from_view.transform_vector3(common::view_ray(px, py, w, h, fov));
             let Some((t, k)) = ray_mesh(cam.eye, d, &tris) else {
-                assert!(got.is_infinite() || near_edge(px, py, &z, w, h), "({px},{py}) {got}");
+                assert!(
+                    got.is_infinite() || near_edge(px, py, &z, w, h),
+                    "({px},{py}) {got}"
+                );
                 if got.is_infinite() {
                     empty += 1;
                 }
@@ -148,7 +158,10 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
         "depth EXR: worst relative error {worst:e} over {} pixels; ideal sphere within {worst_ideal:e}",
         sphere_px + plane_px
     );
-    assert!(sphere_px > 600 && plane_px > 2000 && empty > 50, "{sphere_px} {plane_px} {empty}");
+    assert!(
+        sphere_px > 600 && plane_px > 2000 && empty > 50,
+        "{sphere_px} {plane_px} {empty}"
+    );
     // 96x48 facets: sagitta 1 - cos(pi/48) = 2.1e-3 of the radius.
     assert!(worst_ideal < 2.5e-3 / 3.0, "{worst_ideal}");
 }
@@ -156,14 +169,16 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
 /// Whether a 4-neighbor has a very different depth (an occlusion edge).
 fn near_edge(px: u32, py: u32, z: &[f32], w: u32, h: u32) -> bool {
     let c = z[(py * w + px) as usize];
-    [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)].iter().any(|(dx, dy)| {
-        let (x, y) = (px as i32 + dx, py as i32 + dy);
-        if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
-            return false;
-        }
-        let n = z[(y as u32 * w + x as u32) as usize];
-        !(n.is_finite() && c.is_finite()) || (n - c).abs() > 0.05 * c
-    })
+    [(-1i32, 0i32), (1, 0), (0, -1), (0, 1)]
+        .iter()
+        .any(|(dx, dy)| {
+            let (x, y) = (px as i32 + dx, py as i32 + dy);
+            if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
+                return false;
+            }
+            let n = z[(y as u32 * w + x as u32) as usize];
+            !(n.is_finite() && c.is_finite()) || (n - c).abs() > 0.05 * c
+        })
 }
 
 /// Nearest hit of a ray with a triangle list, in f64: (t, triangle index).
@@ -198,7 +213,11 @@ fn raytraced_ao_under_a_sphere_matches_the_closed_form() {
     let dir = common::scratch("ao_closed_form");
     let (r, hc) = (0.5f32, 1.0f32);
     std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(r, 128, 64))).unwrap();
-    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(50.0, 0.0, 1.0))).unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(50.0, 0.0, 1.0)),
+    )
+    .unwrap();
     let size = 48u32;
     let samples = 1024u32;
     let text = format!(
@@ -249,8 +268,16 @@ fn analytic_shadow(x: f32, z: f32, center: Vec3, light_dir: Vec3) -> bool {
 }
 
 fn sphere_on_plane_scene(dir: &Path, light_dir: Vec3, size: u32, extra: &str) -> String {
-    std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(1.0, 128, 64))).unwrap();
-    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(8.0, 0.0, 1.0))).unwrap();
+    std::fs::write(
+        dir.join("sphere.obj"),
+        obj(procedural::sphere(1.0, 128, 64)),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(8.0, 0.0, 1.0)),
+    )
+    .unwrap();
     format!(
         "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{extra}\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
          [[model]]\npath = \"ground.obj\"\n{MATTE}[[model]]\npath = \"sphere.obj\"\ntranslate = [0.0, 1.5, 0.0]\n{MATTE}\
@@ -295,7 +322,9 @@ fn shadow_of_a_sphere_is_the_analytic_ellipse() {
                 }
             }
         }
-        println!("{method}: {wrong} boundary pixels differ of {shadowed} shadowed, {plane} plane pixels");
+        println!(
+            "{method}: {wrong} boundary pixels differ of {shadowed} shadowed, {plane} plane pixels"
+        );
         assert!(shadowed > 3000 && plane > 50_000, "{shadowed} {plane}");
     }
 }
@@ -342,7 +371,12 @@ fn no_acne_on_a_sphere_and_plane_at_grazing_light() {
     for az in [0.0f32, 35.0, 100.0] {
         let a = az.to_radians();
         let light = Vec3::new(-e.cos() * a.cos(), -e.sin(), -e.cos() * a.sin());
-        let scene = sphere_on_plane_scene(&dir, light, size, &std::env::var("XBIAS").unwrap_or_default());
+        let scene = sphere_on_plane_scene(
+            &dir,
+            light,
+            size,
+            &std::env::var("XBIAS").unwrap_or_default(),
+        );
         // A low camera, so the sphere's lit side fills the frame.
         let scene = scene.replace(
             TOP_DOWN,
@@ -357,7 +391,10 @@ fn no_acne_on_a_sphere_and_plane_at_grazing_light() {
                 "azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
             );
             assert!(lit > 10_000, "{lit}");
-            assert!((wrong as f64) < lit as f64 * 1e-3, "{method} {az}: {wrong} of {lit}");
+            assert!(
+                (wrong as f64) < lit as f64 * 1e-3,
+                "{method} {az}: {wrong} of {lit}"
+            );
         }
     }
 }
@@ -369,8 +406,16 @@ fn a_box_on_the_plane_meets_its_shadow() {
     // whole box width from the plane behind it); a thin wall (0.04 thick
     // along the light) shows any bias above its thickness.
     let dir = common::scratch("peter_panning");
-    std::fs::write(dir.join("box.obj"), obj(procedural::cube([0.0, 0.5, 0.0], 0.5))).unwrap();
-    std::fs::write(dir.join("ground.obj"), obj(procedural::ground(8.0, 0.0, 1.0))).unwrap();
+    std::fs::write(
+        dir.join("box.obj"),
+        obj(procedural::cube([0.0, 0.5, 0.0], 0.5)),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(8.0, 0.0, 1.0)),
+    )
+    .unwrap();
     let size = 400u32;
     let bias = std::env::var("XBIAS").unwrap_or_default();
     for (what, thick) in [("box", 1.0f32), ("wall", 0.04)] {
@@ -412,9 +457,14 @@ fn a_box_on_the_plane_meets_its_shadow() {
                     }
                     worst = worst.max(gap);
                 }
-                println!("{what}, elevation {elevation}: {method}: widest gap {worst} px over {rows} rows");
+                println!(
+                    "{what}, elevation {elevation}: {method}: widest gap {worst} px over {rows} rows"
+                );
                 assert!(rows > 50);
-                assert!(worst < 2, "{what}, {method} at {elevation} degrees: gap {worst} px");
+                assert!(
+                    worst < 2,
+                    "{what}, {method} at {elevation} degrees: gap {worst} px"
+                );
             }
         }
     }
@@ -455,7 +505,244 @@ fn no_acne_on_diablo3_at_grazing_light() {
                 "diablo3, azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
             );
             assert!(lit > 10_000, "{lit}");
-            assert!((wrong as f64) < lit as f64 * 1e-3, "{method} {az}: {wrong} of {lit}");
+            assert!(
+                (wrong as f64) < lit as f64 * 1e-3,
+                "{method} {az}: {wrong} of {lit}"
+            );
+        }
+    }
+}
+
+/// AO buffer of a scene under `ao` (TOML inline table).
+fn ao_of(dir: &Path, scene: &str, ao: &str) -> Vec<f32> {
+    let f = render(dir, &scene.replace("{ao}", ao));
+    assert!(!f.ao.is_empty());
+    f.ao
+}
+
+/// RMSE of SSAO against ray-traced AO over covered pixels, and the count.
+fn ssao_rmse(dir: &Path, scene: &str, radius: f32) -> (f64, usize) {
+    let truth = ao_of(
+        dir,
+        scene,
+        &format!("{{ method = \"raytraced\", samples = 512, radius = {radius} }}"),
+    );
+    let extra = std::env::var("XSSAO").unwrap_or_default();
+    let ssao = ao_of(
+        dir,
+        scene,
+        &format!("{{ method = \"ssao\", radius = {radius} {extra} }}"),
+    );
+    let depth = render(dir, &scene.replace("{ao}", "{ method = \"off\" }")).depth;
+    if std::env::var_os("DUMP_AO").is_some() {
+        let side = (truth.len() as f64).sqrt() as u32;
+        for (name, v) in [("truth", &truth), ("ssao", &ssao)] {
+            let img = softraster::output::Image8 {
+                width: side,
+                height: side,
+                channels: 3,
+                data: v.iter().flat_map(|a| [(a * 255.0) as u8; 3]).collect(),
+            };
+            softraster::output::png::write(&dir.join(format!("{name}.png")), &img).unwrap();
+        }
+    }
+    let mut n = 0;
+    let mut sum = 0.0f64;
+    for i in 0..truth.len() {
+        if depth[i].is_finite() {
+            sum += ((ssao[i] - truth[i]) as f64).powi(2);
+            n += 1;
+        }
+    }
+    ((sum / n as f64).sqrt(), n)
+}
+
+/// Scene text for models standing on a ground plane at their lowest point.
+fn on_ground(dir: &Path, models: &str, camera: &str, size: u32) -> (String, f32) {
+    let probe = load(dir, &format!("[output]\nwidth = 8\nheight = 8\n{models}"));
+    let mut lo = f32::INFINITY;
+    for m in &probe.models {
+        for p in &m.mesh.positions {
+            lo = lo.min(m.world_from_object.transform_point3(*p).y);
+        }
+    }
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(1.0, 0.0, 1.0)),
+    )
+    .unwrap();
+    let radius = probe.bounds_radius * 0.2;
+    (
+        format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ao}}\n{models}\
+             [[model]]\npath = \"ground.obj\"\ntranslate = [0.0, {lo}, 0.0]\nscale = {}\n{camera}",
+            probe.bounds_radius * 3.0
+        ),
+        radius,
+    )
+}
+
+#[test]
+fn ssao_matches_raytraced_ao_on_bunny_and_diablo3() {
+    let Some(assets) = common::shared_assets() else {
+        return;
+    };
+    let dir = common::scratch("ssao_vs_raytraced");
+    let size = 160u32;
+    for (name, model, camera) in [
+        (
+            "bunny on a plane",
+            assets.join("common/stanford-bunny.obj"),
+            "[[camera]]\neye = [0.6, 0.7, 2.0]\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n",
+        ),
+        (
+            "diablo3 on a plane",
+            assets.join("tinyrenderer/diablo3_pose/diablo3_pose.obj"),
+            "[[camera]]\neye = [0.6, 0.45, 1.9]\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n",
+        ),
+    ] {
+        let models = format!(
+            "[[model]]\npath = \"{}\"\nnormalize = true\n",
+            model.display()
+        );
+        let (scene, radius) = on_ground(&dir, &models, camera, size);
+        let (rmse, n) = ssao_rmse(&dir, &scene, radius);
+        println!(
+            "{name}: SSAO (16 samples, radius {radius:.3}) vs ray-traced AO (512 rays): RMSE {rmse:.4} over {n} pixels"
+        );
+        assert!(n > 5000, "{n}");
+        assert!(rmse < 0.05, "{name}: RMSE {rmse}");
+    }
+}
+
+#[test]
+fn ssao_leaves_no_halo_behind_a_floating_sphere() {
+    // A sphere 3 units in front of a wall, AO radius 0.5: nothing on the
+    // wall is within reach, so the wall around the silhouette stays 1.
+    let dir = common::scratch("ssao_halo");
+    std::fs::write(dir.join("sphere.obj"), obj(procedural::sphere(0.5, 64, 32))).unwrap();
+    std::fs::write(dir.join("wall.obj"), obj(procedural::ground(4.0, 0.0, 1.0))).unwrap();
+    let size = 200u32;
+    let scene = format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ method = \"ssao\", radius = 0.5 }}\n\
+         [[model]]\npath = \"wall.obj\"\nrotate = [90.0, 0.0, 0.0]\ntranslate = [0.0, 0.0, -3.0]\n\
+         [[model]]\npath = \"sphere.obj\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 40.0\n"
+    );
+    let f = render(&dir, &scene);
+    let z = &f.depth;
+    let (mut checked, mut worst) = (0, 1.0f32);
+    for y in 0..size as i32 {
+        for x in 0..size as i32 {
+            let i = (y * size as i32 + x) as usize;
+            if z[i] < 6.0 {
+                continue; // the sphere
+            }
+            // Wall pixels within 8 pixels of the sphere's silhouette.
+            let near = (-8..=8).any(|dy| {
+                (-8..=8).any(|dx| {
+                    let (sx, sy) = (x + dx, y + dy);
+                    sx >= 0
+                        && sy >= 0
+                        && sx < size as i32
+                        && sy < size as i32
+                        && z[(sy * size as i32 + sx) as usize] < 6.0
+                })
+            });
+            if near {
+                checked += 1;
+                worst = worst.min(f.ao[i]);
+            }
+        }
+    }
+    println!("halo: lowest wall AO next to the silhouette {worst} over {checked} pixels");
+    assert!(checked > 300, "{checked}");
+    assert!(worst > 0.98, "halo: {worst}");
+}
+
+/// Pixels where the map and the ray tracer disagree (factor on either side
+/// of 1/2) that are more than 2 pixels from any ray-traced shadow edge.
+fn disagreements_off_edges(map: &[f32], truth: &[f32], w: u32, h: u32) -> (usize, usize) {
+    let shadowed = |x: i32, y: i32| truth[(y * w as i32 + x) as usize] < 0.5;
+    let (mut far, mut near) = (0, 0);
+    for y in 0..h as i32 {
+        for x in 0..w as i32 {
+            let i = (y * w as i32 + x) as usize;
+            if truth[i].is_nan() || map[i].is_nan() || (map[i] < 0.5) == shadowed(x, y) {
+                continue;
+            }
+            let edge = (-2..=2).any(|dy| {
+                (-2..=2).any(|dx| {
+                    let (sx, sy) = (x + dx, y + dy);
+                    sx >= 0
+                        && sy >= 0
+                        && sx < w as i32
+                        && sy < h as i32
+                        && !truth[(sy * w as i32 + sx) as usize].is_nan()
+                        && shadowed(sx, sy) != shadowed(x, y)
+                })
+            });
+            if edge { near += 1 } else { far += 1 }
+        }
+    }
+    (far, near)
+}
+
+#[test]
+fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
+    // Spheres all around a point light (every cube face casts), and a spot
+    // light over them; the maps must agree with ray-traced shadows except
+    // along shadow edges.
+    let dir = common::scratch("point_spot_shadows");
+    std::fs::write(
+        dir.join("sphere.obj"),
+        obj(procedural::sphere(0.35, 64, 32)),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(6.0, 0.0, 1.0)),
+    )
+    .unwrap();
+    let size = 240u32;
+    let mut models = format!("[[model]]\npath = \"ground.obj\"\n{MATTE}");
+    for (x, y, z) in [
+        (1.0, 1.6, 0.2),
+        (-1.1, 1.2, -0.3),
+        (0.2, 1.4, 1.2),
+        (-0.3, 1.8, -1.2),
+        (0.5, 3.3, 0.3),
+        (0.0, 0.9, 0.0),
+    ] {
+        models.push_str(&format!(
+            "[[model]]\npath = \"sphere.obj\"\ntranslate = [{x}, {y}, {z}]\n{MATTE}"
+        ));
+    }
+    let camera = "[[camera]]\neye = [3.5, 6.0, 5.0]\ntarget = [0.0, 0.8, 0.0]\nfov = 50.0\n";
+    for (what, light) in [
+        (
+            "point",
+            "kind = \"point\"\nposition = [0.0, 1.9, 0.0]\nintensity = 10.0",
+        ),
+        (
+            "spot",
+            "kind = \"spot\"\nposition = [1.5, 4.0, 1.0]\ndirection = [-0.3, -1.0, -0.2]\nintensity = 40.0\ninner_angle = 30.0\nouter_angle = 40.0",
+        ),
+    ] {
+        let scene = format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+             {models}[[light]]\n{light}\nshadows = true\n{camera}"
+        );
+        let truth = shadow_factor(&dir, &scene, "raytraced");
+        let in_shadow = truth.iter().filter(|k| **k < 0.5).count();
+        for method in ["hard", "pcf"] {
+            let f = shadow_factor(&dir, &scene, method);
+            let (far, near) = disagreements_off_edges(&f, &truth, size, size);
+            println!(
+                "{what} light, {method}: {far} pixels disagree away from edges, {near} along edges; {in_shadow} shadowed"
+            );
+            assert!(in_shadow > 2000, "{in_shadow}");
+            assert!(far <= 3, "{what} {method}: {far}");
         }
     }
 }

@@ -278,8 +278,8 @@ fn best_split(
             if cnt == 0 || rc == 0 {
                 continue;
             }
-            let cost = NODE_COST
-                + TRI_COST * (acc.half_area() * cnt as f32 + ra * rc as f32) * inv_area;
+            let cost =
+                NODE_COST + TRI_COST * (acc.half_area() * cnt as f32 + ra * rc as f32) * inv_area;
             if best.is_none_or(|b| cost < b.2) {
                 best = Some((axis, lo + (i + 1) as f32 / scale, cost));
             }
@@ -370,6 +370,9 @@ mod tests {
                 assert!(!bvh.occluded(o, d, 0.0, w * 0.999));
             }
         }
-        assert!(misses > 20 && misses < 380, "a mix of hits and misses: {misses}");
+        assert!(
+            misses > 20 && misses < 380,
+            "a mix of hits and misses: {misses}"
+        );
     }
 }

@@ -74,12 +74,8 @@ impl<'a> Tracer<'a> {
         self.instances.iter().any(|i| {
             box_hit(i.lo, i.hi, oa, inv, t_max) && {
                 let m = &i.object_from_world;
-                i.bvh.occluded(
-                    m.transform_point3(o),
-                    m.transform_vector3(d),
-                    0.0,
-                    t_max,
-                )
+                i.bvh
+                    .occluded(m.transform_point3(o), m.transform_vector3(d), 0.0, t_max)
             }
         })
     }
@@ -94,9 +90,9 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let m = &i.object_from_world;
-            if let Some(h) =
-                i.bvh
-                    .nearest(m.transform_point3(o), m.transform_vector3(d), 0.0, best)
+            if let Some(h) = i
+                .bvh
+                .nearest(m.transform_point3(o), m.transform_vector3(d), 0.0, best)
             {
                 best = h.t;
                 hit = Some(h.t);

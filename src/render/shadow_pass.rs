@@ -157,20 +157,19 @@ fn near_plane(verts: &[Geo], position: Vec3) -> Option<f32> {
     (hi > 0.0 && hi.is_finite()).then(|| (lo * 0.25).max(hi * 1e-5))
 }
 
-fn spot(
-    verts: &[Geo],
-    position: Vec3,
-    direction: Vec3,
-    cos_outer: f32,
-    size: u32,
-) -> LightShadow {
+fn spot(verts: &[Geo], position: Vec3, direction: Vec3, cos_outer: f32, size: u32) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
     };
     let half = cos_outer.clamp(-1.0, 1.0).acos().min(85f32.to_radians());
     let tan_half = half.tan() * (1.0 + 4.0 / size as f32);
     let projection = MapProjection::Perspective { tan_half, near };
-    LightShadow::Map(render_map(verts, look(position, direction), projection, size))
+    LightShadow::Map(render_map(
+        verts,
+        look(position, direction),
+        projection,
+        size,
+    ))
 }
 
 fn point(verts: &[Geo], position: Vec3, size: u32) -> LightShadow {

@@ -238,11 +238,17 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
                         }
                         let q = view.position(ix as f32 + 0.5, iy as f32 + 0.5, sd);
                         let d = q - p;
-                        let l = d.length();
-                        if l > radius || l <= 0.0 {
+                        if d.length_squared() > radius * radius {
                             continue;
                         }
-                        horizon[best] = horizon[best].max(d.dot(v) / l);
+                        // The sample's pixel center is off the slice by up
+                        // to a pixel: measure its angle within the slice.
+                        let ds = d - axis * d.dot(axis);
+                        let l = ds.length();
+                        if l <= 0.0 {
+                            continue;
+                        }
+                        horizon[best] = horizon[best].max(ds.dot(v) / l);
                     }
                 }
                 let h2 = gamma + (horizon[0].clamp(-1.0, 1.0).acos() - gamma).min(FRAC_PI_2);

@@ -240,7 +240,15 @@ mod tests {
     #[test]
     fn uniform_ambient_is_conserved_for_a_white_dielectric() {
         let c = dielectric(1.0, 0.7);
-        let l = radiance(Vec3::ZERO, Vec3::Z, Vec3::Z, &c, Vec3::splat(0.5), &[], &unshadowed);
+        let l = radiance(
+            Vec3::ZERO,
+            Vec3::Z,
+            Vec3::Z,
+            &c,
+            Vec3::splat(0.5),
+            &[],
+            &unshadowed,
+        );
         assert!((l - Vec3::splat(0.5)).abs().max_element() < 1e-5, "{l}");
         // Occlusion scales it.
         let occluded = PbrColor {

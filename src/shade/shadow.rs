@@ -102,7 +102,9 @@ pub enum LightShadow {
     },
     /// Rays towards the light: to its position (point, spot), or unbounded
     /// (directional).
-    Ray { position: Option<Vec3> },
+    Ray {
+        position: Option<Vec3>,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -232,8 +234,7 @@ impl Shadows<'_> {
         // The plane's slope, capped like the slope bias.
         let cap = z_per_texel * MAX_TAN;
         let (gx, gy) = (gx.clamp(-cap, cap), gy.clamp(-cap, cap));
-        if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size
-        {
+        if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size {
             return 1.0;
         }
         let n = m.size as i32;
