@@ -24,7 +24,8 @@ pub struct BenchArgs {
     #[arg(long, default_value = "../shared/assets")]
     pub assets: PathBuf,
     /// Which workloads: diablo3, nefertiti, flighthelmet (glTF, pbr),
-    /// diablo3-4k, diablo3-4k-aniso, filters, or all (the first three).
+    /// diablo3-4k, diablo3-4k-aniso, filters, shadows, ao (time and error
+    /// of each method, CSV), or all (the first three).
     #[arg(long, default_value = "all")]
     pub case: String,
     #[arg(long, default_value_t = 72)]
@@ -108,7 +109,7 @@ fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<Strin
         }
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters, shadows, ao or all"
             )));
         }
     })
@@ -236,6 +237,9 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         }
         return Ok(());
     }
+    if args.case == "shadows" || args.case == "ao" {
+        return accuracy_tables(args);
+    }
     let cases: Vec<&str> = match args.case.as_str() {
         "all" => vec!["diablo3", "nefertiti", "flighthelmet"],
         c => vec![c],
@@ -266,6 +270,52 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// `--case shadows | ao`: time and error of each method (CSV on stdout).
+fn accuracy_tables(args: &BenchArgs) -> Result<(), Error> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        builder = builder.num_threads(n.max(1));
+    }
+    let pool = builder
+        .build()
+        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))?;
+    let threads = pool.current_num_threads();
+    let assets = std::fs::canonicalize(&args.assets).map_err(|e| Error::io(&args.assets, e))?;
+    pool.install(|| {
+        if args.case == "shadows" {
+            // Every 9th frame of the turntable (8 frames of 72).
+            let frames: Vec<u32> = (0..args.frames).step_by(9).collect();
+            let rows = crate::accuracy::shadows(&assets, args.size, &frames)?;
+            println!(
+                "# diablo3 on the floor, one directional light, {}x{}, frames {frames:?}, {threads} thread(s); reference: raytraced",
+                args.size, args.size
+            );
+            println!("scene,method,ms_per_frame,mean_abs_error_linear,pct_pixels_off_by_8_levels");
+            for r in rows {
+                println!(
+                    "diablo3,{},{:.2},{:.5},{:.3}",
+                    r.method, r.ms, r.error, r.second
+                );
+            }
+        } else {
+            // Every 18th frame (4 of 72): the reference is 1024 rays a pixel.
+            let frames: Vec<u32> = (0..args.frames).step_by(18).collect();
+            let tables = crate::accuracy::ao(&assets, args.size, &frames, 1024)?;
+            println!(
+                "# {}x{}, frames {frames:?}, {threads} thread(s); reference: raytraced, 1024 rays, same radius",
+                args.size, args.size
+            );
+            println!("scene,method,ms_per_frame,rmse_ao,worst_abs_ao");
+            for (scene, rows) in tables {
+                for r in rows {
+                    println!("{scene},{},{:.2},{:.4},{:.3}", r.method, r.ms, r.error, r.second);
+                }
+            }
+        }
+        Ok(())
+    })
 }
 
 /// One texture filter's accuracy on the grazing-angle checkerboard.

@@ -5,6 +5,7 @@
 //! ([`raster`]) and shading ([`shade`]) -> [`render::Frame`] -> writers
 //! ([`output`]).
 
+pub mod accuracy;
 pub mod assets;
 pub mod batch;
 pub mod bench;

@@ -26,45 +26,80 @@ fn run(args: &[&str]) -> (i32, String) {
 fn frames_are_byte_identical_whatever_the_thread_count() {
     let dir = common::scratch("determinism");
     let scene = root().join("scenes/showcase.toml");
-    let mut outputs = Vec::new();
-    for threads in ["1", "4"] {
-        let out = dir.join(threads);
-        let (code, err) = run(&[
-            "render",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--threads",
-            threads,
-            "--frames",
-            "0..3",
-            "--quiet",
-            "--set",
-            "output.width=200",
-            "--set",
-            "output.height=150",
-        ]);
-        assert_eq!(code, 0, "{err}");
-        let mut files: Vec<_> = std::fs::read_dir(&out)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .collect();
-        files.sort();
-        assert_eq!(files.len(), 3);
-        outputs.push(
-            files
-                .iter()
-                .map(|f| std::fs::read(f).unwrap())
-                .collect::<Vec<_>>(),
-        );
-        // No temporary files left behind.
+    let shadows = [
+        "light.0.shadows=true",
+        "light.1.shadows=true",
+        "light.2.shadows=true",
+        "output.depth=true",
+        "output.ao=true",
+    ];
+    for (variant, sets, per_frame) in [
+        ("plain", vec![], 1),
+        (
+            "pcf-ssao",
+            [&shadows[..], &["render.ao={method=\"ssao\"}"]].concat(),
+            3,
+        ),
+        (
+            "raytraced",
+            [
+                &shadows[..],
+                &[
+                    "render.shadows=\"raytraced\"",
+                    "render.ao={method=\"raytraced\",samples=8,radius=0.5}",
+                ],
+            ]
+            .concat(),
+            3,
+        ),
+    ] {
+        let mut outputs = Vec::new();
+        for threads in ["1", "4"] {
+            let out = dir.join(variant).join(threads);
+            let mut args = vec![
+                "render",
+                scene.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                threads,
+                "--frames",
+                "0..3",
+                "--quiet",
+                "--set",
+                "output.width=200",
+                "--set",
+                "output.height=150",
+            ];
+            for s in &sets {
+                args.extend(["--set", s]);
+            }
+            let (code, err) = run(&args);
+            assert_eq!(code, 0, "{variant}: {err}");
+            let mut files: Vec<_> = std::fs::read_dir(&out)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .collect();
+            files.sort();
+            assert_eq!(files.len(), 3 * per_frame, "{variant}: {files:?}");
+            outputs.push(
+                files
+                    .iter()
+                    .map(|f| std::fs::read(f).unwrap())
+                    .collect::<Vec<_>>(),
+            );
+            // No temporary files left behind.
+            assert!(
+                files
+                    .iter()
+                    .all(|f| !f.file_name().unwrap().to_string_lossy().starts_with('.'))
+            );
+        }
         assert!(
-            files
-                .iter()
-                .all(|f| !f.file_name().unwrap().to_string_lossy().starts_with('.'))
+            outputs[0] == outputs[1],
+            "{variant}: 1 and 4 threads differ"
         );
     }
-    assert!(outputs[0] == outputs[1], "1 and 4 threads differ");
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

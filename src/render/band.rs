@@ -188,7 +188,7 @@ impl FrameData<'_> {
                     };
                     let frag = it.at_pixel(px, py);
                     let occlusion = ao.map_or(1.0, |a| a[i]);
-                    let (c, d) = self.shade(t, it, frag, px, py, g, occlusion);
+                    let (c, d) = self.shade(t, it, frag, (px, py), g, occlusion);
                     // A NaN from degenerate input must not poison the frame.
                     color[i] = if c.is_finite() {
                         c.extend(1.0)
@@ -227,7 +227,7 @@ impl FrameData<'_> {
                     [Gradients::default(); 2]
                 };
                 let frag = it.at_pixel(px, py);
-                let (c, _) = self.shade(t, &it, frag, px, py, g, 1.0);
+                let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
                 let (m, uv, vcolor) = self.material_uv(t, frag.lambda);
                 let tc = TexCoords { uv, grads: g };
                 let a = self.ctx.opacity(m, &tc, vcolor).clamp(0.0, 1.0);
@@ -284,8 +284,7 @@ impl FrameData<'_> {
         t: &Tri,
         it: &Interpolator,
         frag: Fragment,
-        px: i32,
-        py: i32,
+        (px, py): (i32, i32),
         grads: [Gradients; 2],
         ao: f32,
     ) -> (Vec3, f32) {

@@ -88,6 +88,30 @@ impl AoView {
         }
     }
 
+    /// The point of plane `pl` (view-space normal, n.p) seen at screen
+    /// position (x, y) in pixels; None when the ray grazes it.
+    #[inline]
+    fn on_plane(&self, x: f32, y: f32, pl: glam::Vec4) -> Option<Vec3> {
+        let n = pl.truncate();
+        if self.orthographic {
+            let o = self.position(x, y, 0.0);
+            // o + t (0, 0, -1): n.o - t n.z = c.
+            if n.z.abs() < 1e-4 {
+                return None;
+            }
+            let t = (n.dot(o) - pl.w) / n.z;
+            Some(o - Vec3::Z * t)
+        } else {
+            let r = self.position(x, y, 1.0);
+            let nr = n.dot(r);
+            if nr.abs() < 1e-4 * r.length() {
+                return None;
+            }
+            let t = pl.w / nr;
+            (t > 0.0).then_some(r * t)
+        }
+    }
+
     /// World size of one pixel at view depth `d`.
     #[inline]
     fn pixel_size(&self, d: f32) -> f32 {
@@ -167,6 +191,15 @@ pub fn ssao_layout(samples: u32) -> (u32, u32) {
     (slices, steps)
 }
 
+/// acos to within 7e-5 radians (Abramowitz and Stegun 4.4.45).
+#[inline]
+fn fast_acos(x: f32) -> f32 {
+    let a = x.abs().min(1.0);
+    let r =
+        (1.0 - a).sqrt() * (1.570_728_8 + a * (-0.212_114_4 + a * (0.074_261 - a * 0.018_729_3)));
+    if x < 0.0 { PI - r } else { r }
+}
+
 /// Screen-space (GTAO) AO of every pixel of `g`, blurred.
 pub fn ssao(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
     let raw = ssao_raw(g, view, radius, samples);
@@ -178,6 +211,29 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
     let (w, h) = (view.width as usize, view.height as usize);
     let (slices, steps) = ssao_layout(samples);
     let rot = view.view_from_world;
+    // Each pixel's tangent plane in view space (n, n.p), NaN where empty:
+    // a sample at an exact point of the slice's screen line is the ray
+    // there met with the plane of the pixel it falls in (exact on planes;
+    // a pixel center would sit off the slice and tilt flat horizons).
+    let planes: Vec<glam::Vec4> = g
+        .par_iter()
+        .map(|p| {
+            if !p.depth.is_finite() {
+                return glam::Vec4::NAN;
+            }
+            let n = rot.transform_vector3(p.geo_normal);
+            let q = rot.transform_point3(p.position);
+            n.extend(n.dot(q))
+        })
+        .collect();
+    // Slice directions per pattern value: (cos, sin) of (k + turn) pi / slices.
+    let dirs: Vec<(f32, f32)> = (0..16 * slices)
+        .map(|i| {
+            let (t, k) = (i / slices, i % slices);
+            let phi = (k as f32 + (t as f32 + 0.5) / 16.0) * PI / slices as f32;
+            (phi.cos(), phi.sin())
+        })
+        .collect();
     let mut out = vec![1.0f32; g.len()];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
@@ -197,13 +253,12 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
             if r_px < 1.0 {
                 continue;
             }
-            let turn = (BAYER4[y % 4][x % 4] as f32 + 0.5) / 16.0;
+            let turn = BAYER4[y % 4][x % 4] as u32;
             let jitter = (BAYER4[(y + 1) % 4][(x + 2) % 4] as f32 + 0.5) / 16.0;
             let mut sum = 0.0f32;
             let mut norm = 0.0f32;
             for k in 0..slices {
-                let phi = (k as f32 + turn) * PI / slices as f32;
-                let (dx, dy) = (phi.cos(), phi.sin());
+                let (dx, dy) = dirs[(turn * slices + k) as usize];
                 let dv = Vec3::new(dx, -dy, 0.0);
                 let Some(t_axis) = (dv - v * dv.dot(v)).try_normalize() else {
                     continue;
@@ -216,7 +271,7 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
                 }
                 let cos_g = (np.dot(v) / len).clamp(-1.0, 1.0);
                 let sign = if np.dot(t_axis) < 0.0 { -1.0 } else { 1.0 };
-                let gamma = sign * cos_g.acos();
+                let gamma = sign * fast_acos(cos_g);
                 let sin_g = gamma.sin();
                 let mut horizon = [-1.0f32; 2];
                 for (side, best) in [(1.0f32, 0usize), (-1.0, 1)] {
@@ -232,11 +287,13 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
                         if ix == x && iy == y {
                             continue;
                         }
-                        let sd = g[iy * w + ix].depth;
-                        if !sd.is_finite() {
+                        let pl = planes[iy * w + ix];
+                        if pl.w.is_nan() {
                             continue;
                         }
-                        let q = view.position(ix as f32 + 0.5, iy as f32 + 0.5, sd);
+                        let Some(q) = view.on_plane(sx, sy, pl) else {
+                            continue;
+                        };
                         let d = q - p;
                         if d.length_squared() > radius * radius {
                             continue;
@@ -251,8 +308,8 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
                         horizon[best] = horizon[best].max(ds.dot(v) / l);
                     }
                 }
-                let h2 = gamma + (horizon[0].clamp(-1.0, 1.0).acos() - gamma).min(FRAC_PI_2);
-                let h1 = gamma + (-horizon[1].clamp(-1.0, 1.0).acos() - gamma).max(-FRAC_PI_2);
+                let h2 = gamma + (fast_acos(horizon[0]) - gamma).min(FRAC_PI_2);
+                let h1 = gamma + (-fast_acos(horizon[1]) - gamma).max(-FRAC_PI_2);
                 let arc = |hh: f32| 0.25 * (-(2.0 * hh - gamma).cos() + cos_g + 2.0 * hh * sin_g);
                 sum += len * (arc(h1) + arc(h2));
                 norm += len * (cos_g + gamma * sin_g);
@@ -265,7 +322,9 @@ pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
     out
 }
 
-/// The depth- and normal-aware 5x5 tent blur.
+/// The depth- and normal-aware 5x5 tent blur: weights fall as
+/// 1/(1+p^2)^2 with p the neighbor's distance from the pixel's tangent plane
+/// in pixel footprints, times the squared cosine between the normals.
 fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
     const TENT: [f32; 5] = [1.0, 2.0, 2.0, 2.0, 1.0];
     let (w, h) = (view.width as i32, view.height as i32);
@@ -302,7 +361,8 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
                         // pixel footprints, and the normals' agreement.
                         let plane = c.normal.dot(s.position - c.position).abs() / px;
                         let agree = c.normal.dot(s.normal).max(0.0);
-                        let wt = wx * wy * (-0.5 * plane * plane).exp() * agree * agree;
+                        let fall = 1.0 / (1.0 + plane * plane);
+                        let wt = wx * wy * fall * fall * agree * agree;
                         sum += wt * raw[k];
                         wsum += wt;
                     }
@@ -315,4 +375,58 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
             }
         });
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_acos_is_within_its_bound() {
+        for i in 0..=2000 {
+            let x = i as f32 / 1000.0 - 1.0;
+            assert!((fast_acos(x) - x.acos()).abs() < 1e-4, "{x}");
+        }
+    }
+
+    #[test]
+    fn an_open_plane_is_unoccluded_at_any_tilt() {
+        // A plane seen at an angle: every sample lies in the tangent plane,
+        // so the horizons are the tangent and the visibility is exactly 1.
+        let (w, h) = (64u32, 48u32);
+        let cam = Camera {
+            name: "c".into(),
+            eye: Vec3::new(0.0, 2.0, 3.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y: 50.0 },
+            near: 0.1,
+            far: 50.0,
+        };
+        let view = AoView::new(&cam, w, h);
+        let world_from_view = view.view_from_world.inverse();
+        let mut g = vec![GPixel::EMPTY; (w * h) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                // Intersect the pixel's ray with y = 0.
+                let p = view.position(x as f32 + 0.5, y as f32 + 0.5, 1.0);
+                let d = world_from_view.transform_vector3(p);
+                if d.y >= -1e-3 {
+                    continue;
+                }
+                let t = -cam.eye.y / d.y;
+                let world = cam.eye + d * t;
+                g[(y * w + x) as usize] = GPixel {
+                    depth: t,
+                    position: world,
+                    normal: Vec3::Y,
+                    geo_normal: Vec3::Y,
+                };
+            }
+        }
+        let ao = ssao(&g, &view, 0.5, 32);
+        for (i, a) in ao.iter().enumerate() {
+            assert!((a - 1.0).abs() < 2e-3, "pixel {i}: {a}");
+        }
+    }
 }

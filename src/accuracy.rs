@@ -1,0 +1,241 @@
+//! Time against error of the shadow and ambient-occlusion methods, on the
+//! shared models (`softraster bench --case shadows | ao`): each method
+//! renders the same 700x700 frames, timed, and is compared with the
+//! ray-traced reference of the same frames.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::error::Error;
+use crate::output;
+use crate::render::{Frame, FrameSetup, render_into};
+use crate::scene::Scene;
+use crate::scene::build::LoadOptions;
+
+/// One method's row of an accuracy table.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub method: String,
+    /// Median frame time (render and resolve), milliseconds.
+    pub ms: f64,
+    /// Shadows: mean absolute error of linear RGB; AO: RMSE of the AO
+    /// buffer over covered pixels.
+    pub error: f64,
+    /// Shadows: percentage of pixels whose 8-bit color differs by more than
+    /// 8 levels from the reference; AO: worst absolute AO error.
+    pub second: f64,
+}
+
+fn load(dir: &Path, text: &str) -> Result<Scene, Error> {
+    Scene::from_text(&dir.join("accuracy.toml"), text, &LoadOptions::default())
+}
+
+/// Renders frames `frames` of `scene`: the frames and the median time.
+fn timed(scene: &Scene, frames: &[u32]) -> (Vec<Frame>, f64) {
+    let mut out = Vec::new();
+    let mut times = Vec::new();
+    // One buffer, as a render job reuses it; copies kept for comparison.
+    let mut frame = Frame::new(0, 0);
+    for &f in frames {
+        let t = Instant::now();
+        render_into(&FrameSetup::new(scene, 0, f), &mut frame);
+        let _ = output::resolve(&frame, &scene.settings);
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        out.push(frame.clone());
+    }
+    times.sort_by(f64::total_cmp);
+    (out, times[times.len() / 2])
+}
+
+/// diablo3 standing on the tinyrenderer floor, lit by one directional
+/// light at 35 degrees elevation that casts shadows, turning 5 degrees a
+/// frame. `{render}` is where each method's settings go.
+fn diablo3_scene(assets: &Path, size: u32) -> String {
+    let t = assets.join("tinyrenderer");
+    format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\n{{render}}\n\
+         [[model]]\npath = \"{}\"\nscale = [2.0, 1.0, 2.0]\n\
+         [[model]]\npath = \"{}\"\n[model.material]\nmap_kd = \"{}\"\n\
+         [[light]]\nkind = \"directional\"\ndirection = [-0.47, -0.57, -0.67]\nirradiance = 2.0\nshadows = true\n\
+         [[camera]]\neye = [0.0, 0.9, 3.6]\ntarget = [0.0, -0.2, 0.0]\nfov = 45.0\n\
+         [animation]\nframes = 72\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360.0 }}\n",
+        t.join("floor.obj").display(),
+        t.join("diablo3_pose/diablo3_pose.obj").display(),
+        t.join("diablo3_pose/diablo3_pose_diffuse.tga").display(),
+    )
+}
+
+/// Shadow methods (hard and PCF at 1024, 2048, 4096; ray-traced) on
+/// diablo3, against ray-traced shadows.
+pub fn shadows(assets: &Path, size: u32, frames: &[u32]) -> Result<Vec<Row>, Error> {
+    let dir = assets.to_path_buf();
+    let text = diablo3_scene(assets, size);
+    let scene = |render: &str| load(&dir, &text.replace("{render}", render));
+    let (reference, rt_ms) = timed(&scene("shadows = \"raytraced\"")?, frames);
+    let (_, off_ms) = timed(&scene("shadows = \"off\"")?, frames);
+    let mut rows = vec![Row {
+        method: "off (no shadow pass)".into(),
+        ms: off_ms,
+        error: f64::NAN,
+        second: f64::NAN,
+    }];
+    for filter in ["hard", "pcf"] {
+        for map in [1024, 2048, 4096] {
+            let s = scene(&format!("shadows = \"{filter}\"\nshadow_map_size = {map}"))?;
+            let (got, ms) = timed(&s, frames);
+            let (mae, off) = color_error(&got, &reference, &s);
+            rows.push(Row {
+                method: format!("{filter} {map}"),
+                ms,
+                error: mae,
+                second: off,
+            });
+        }
+    }
+    rows.push(Row {
+        method: "raytraced (reference)".into(),
+        ms: rt_ms,
+        error: 0.0,
+        second: 0.0,
+    });
+    Ok(rows)
+}
+
+/// Mean absolute linear error, and the percentage of pixels whose 8-bit
+/// colors differ by more than 8 levels.
+fn color_error(got: &[Frame], reference: &[Frame], s: &Scene) -> (f64, f64) {
+    let (mut sum, mut off, mut n) = (0.0f64, 0usize, 0usize);
+    for (a, b) in got.iter().zip(reference) {
+        for (x, y) in a.color.iter().zip(&b.color) {
+            sum += (x.truncate() - y.truncate()).abs().element_sum() as f64 / 3.0;
+        }
+        let (ia, ib) = (
+            output::resolve(a, &s.settings),
+            output::resolve(b, &s.settings),
+        );
+        for (pa, pb) in ia.data.chunks(3).zip(ib.data.chunks(3)) {
+            if pa.iter().zip(pb).any(|(u, v)| u.abs_diff(*v) > 8) {
+                off += 1;
+            }
+        }
+        n += a.color.len();
+    }
+    (sum / n as f64, 100.0 * off as f64 / n as f64)
+}
+
+/// AO methods (SSAO at 8..64 samples, ray-traced at 16..256 rays) on
+/// bunny-on-plane and diablo3-on-plane, against ray-traced AO with
+/// `reference_samples` rays, at the SSAO default radius (a fifth of the
+/// scene's bounding radius).
+pub fn ao(
+    assets: &Path,
+    size: u32,
+    frames: &[u32],
+    reference_samples: u32,
+) -> Result<Vec<(String, Vec<Row>)>, Error> {
+    let dir = std::env::temp_dir().join(format!("softraster-ao-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let ground = dir.join("ground.obj");
+    std::fs::write(
+        &ground,
+        crate::procedural::ground(1.0, 0.0, 1.0)
+            .to_obj("g", "none.mtl", "m")
+            .text
+            .replace("mtllib none.mtl\n", "")
+            .replace("usemtl m\n", ""),
+    )
+    .map_err(|e| Error::io(&ground, e))?;
+    let mut out = Vec::new();
+    for (name, model, eye) in [
+        (
+            "bunny on a plane",
+            assets.join("common/stanford-bunny.obj"),
+            "[0.6, 0.7, 2.0]",
+        ),
+        (
+            "diablo3 on a plane",
+            assets.join("tinyrenderer/diablo3_pose/diablo3_pose.obj"),
+            "[0.6, 0.45, 1.9]",
+        ),
+    ] {
+        if !model.is_file() {
+            return Err(Error::asset(&model, None, "missing shared model"));
+        }
+        let models = format!(
+            "[[model]]\npath = \"{}\"\nnormalize = true\n",
+            model.display()
+        );
+        let probe = load(&dir, &format!("[output]\nwidth = 8\nheight = 8\n{models}"))?;
+        let mut lo = f32::INFINITY;
+        for m in &probe.models {
+            for p in &m.mesh.positions {
+                lo = lo.min(m.world_from_object.transform_point3(*p).y);
+            }
+        }
+        let radius = probe.bounds_radius * 0.2;
+        let text = format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ao}}\n{models}\
+             [[model]]\npath = \"ground.obj\"\ntranslate = [0.0, {lo}, 0.0]\nscale = {}\n\
+             [[camera]]\neye = {eye}\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n\
+             [animation]\nframes = 72\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360.0 }}\n",
+            probe.bounds_radius * 3.0
+        );
+        let scene = |ao: &str| load(&dir, &text.replace("{ao}", ao));
+        let rt = |n: u32| format!("{{ method = \"raytraced\", samples = {n}, radius = {radius} }}");
+        let (reference, ref_ms) = timed(&scene(&rt(reference_samples))?, frames);
+        let (_, off_ms) = timed(&scene("{ method = \"off\" }")?, frames);
+        let mut rows = vec![Row {
+            method: "off".into(),
+            ms: off_ms,
+            error: f64::NAN,
+            second: f64::NAN,
+        }];
+        let mut methods: Vec<(String, String)> = [4, 8, 16, 32, 64]
+            .iter()
+            .map(|n| {
+                (
+                    format!("ssao {n}"),
+                    format!("{{ method = \"ssao\", samples = {n}, radius = {radius} }}"),
+                )
+            })
+            .collect();
+        for n in [16, 64, 256] {
+            methods.push((format!("raytraced {n}"), rt(n)));
+        }
+        for (label, ao) in methods {
+            let (got, ms) = timed(&scene(&ao)?, frames);
+            let (rmse, worst) = ao_error(&got, &reference);
+            rows.push(Row {
+                method: label,
+                ms,
+                error: rmse,
+                second: worst,
+            });
+        }
+        rows.push(Row {
+            method: format!("raytraced {reference_samples} (reference)"),
+            ms: ref_ms,
+            error: 0.0,
+            second: 0.0,
+        });
+        out.push((name.to_string(), rows));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(out)
+}
+
+/// RMSE and worst absolute error of the AO buffers over covered pixels.
+fn ao_error(got: &[Frame], reference: &[Frame]) -> (f64, f64) {
+    let (mut sum, mut worst, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (a, b) in got.iter().zip(reference) {
+        for i in 0..a.ao.len() {
+            if b.depth[i].is_finite() {
+                let e = (a.ao[i] - b.ao[i]) as f64;
+                sum += e * e;
+                worst = worst.max(e.abs());
+                n += 1;
+            }
+        }
+    }
+    ((sum / n.max(1) as f64).sqrt(), worst)
+}
