@@ -34,6 +34,9 @@ pub(super) struct FrameData<'a> {
     pub bg: Vec4,
     /// Texture filtering needs derivatives (trilinear, anisotropic).
     pub grads: bool,
+    /// Shading reads the triangle's plane normal (flat shading, shadows,
+    /// AO); otherwise it is not computed.
+    pub geo_normal: bool,
 }
 
 impl FrameData<'_> {
@@ -366,12 +369,16 @@ impl FrameData<'_> {
         // Light the side the camera sees.
         let n = raw_normal.normalize_or(Vec3::Y);
         let normal = if t.front { n } else { -n };
-        let [a, b, c] = idx.map(|k| mv.world[k]);
-        let g = (b - a).cross(c - a).normalize_or(normal);
-        let geo_normal = if g.dot(ctx.view_vector(position)) < 0.0 {
-            -g
+        let geo_normal = if self.geo_normal {
+            let [a, b, c] = idx.map(|k| mv.world[k]);
+            let g = (b - a).cross(c - a).normalize_or(normal);
+            if g.dot(ctx.view_vector(position)) < 0.0 {
+                -g
+            } else {
+                g
+            }
         } else {
-            g
+            normal
         };
         Point {
             position,

@@ -316,6 +316,9 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         reverse: s.depth == DepthMode::ReverseZ,
         bg: background(s.background),
         grads: filtered,
+        geo_normal: s.shading == ShadingMode::Flat
+            || !shadows.lights.is_empty()
+            || s.ao.method != AoMethod::Off,
     };
     let bins: Vec<(&[Vec<u32>], u32)> = per_chunk
         .iter()
