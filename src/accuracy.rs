@@ -134,52 +134,9 @@ pub fn ao(
     reference_samples: u32,
 ) -> Result<Vec<(String, Vec<Row>)>, Error> {
     let dir = std::env::temp_dir().join(format!("softraster-ao-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let ground = dir.join("ground.obj");
-    std::fs::write(
-        &ground,
-        crate::procedural::ground(1.0, 0.0, 1.0)
-            .to_obj("g", "none.mtl", "m")
-            .text
-            .replace("mtllib none.mtl\n", "")
-            .replace("usemtl m\n", ""),
-    )
-    .map_err(|e| Error::io(&ground, e))?;
     let mut out = Vec::new();
-    for (name, model, eye) in [
-        (
-            "bunny on a plane",
-            assets.join("common/stanford-bunny.obj"),
-            "[0.6, 0.7, 2.0]",
-        ),
-        (
-            "diablo3 on a plane",
-            assets.join("tinyrenderer/diablo3_pose/diablo3_pose.obj"),
-            "[0.6, 0.45, 1.9]",
-        ),
-    ] {
-        if !model.is_file() {
-            return Err(Error::asset(&model, None, "missing shared model"));
-        }
-        let models = format!(
-            "[[model]]\npath = \"{}\"\nnormalize = true\n",
-            model.display()
-        );
-        let probe = load(&dir, &format!("[output]\nwidth = 8\nheight = 8\n{models}"))?;
-        let mut lo = f32::INFINITY;
-        for m in &probe.models {
-            for p in &m.mesh.positions {
-                lo = lo.min(m.world_from_object.transform_point3(*p).y);
-            }
-        }
-        let radius = probe.bounds_radius * 0.2;
-        let text = format!(
-            "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ao}}\n{models}\
-             [[model]]\npath = \"ground.obj\"\ntranslate = [0.0, {lo}, 0.0]\nscale = {}\n\
-             [[camera]]\neye = {eye}\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n\
-             [animation]\nframes = 72\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360.0 }}\n",
-            probe.bounds_radius * 3.0
-        );
+    for (name, model, eye) in AO_SCENES {
+        let (text, radius) = ao_scene(&dir, &assets.join(model), eye, size)?;
         let scene = |ao: &str| load(&dir, &text.replace("{ao}", ao));
         let rt = |n: u32| format!("{{ method = \"raytraced\", samples = {n}, radius = {radius} }}");
         let (reference, ref_ms) = timed(&scene(&rt(reference_samples))?, frames);
@@ -222,6 +179,60 @@ pub fn ao(
     }
     let _ = std::fs::remove_dir_all(&dir);
     Ok(out)
+}
+
+/// The AO comparison scenes: name, model under the shared assets, eye.
+pub const AO_SCENES: [(&str, &str, &str); 2] = [
+    (
+        "bunny on a plane",
+        "common/stanford-bunny.obj",
+        "[0.6, 0.7, 2.0]",
+    ),
+    (
+        "diablo3 on a plane",
+        "tinyrenderer/diablo3_pose/diablo3_pose.obj",
+        "[0.6, 0.45, 1.9]",
+    ),
+];
+
+/// `model` normalized, standing on a ground plane (written into `dir`) at
+/// its lowest point, seen from `eye`, turning 5 degrees a frame. The text
+/// holds `{ao}` where `render.ao` goes. Returns it and the SSAO default
+/// radius (a fifth of the scene's bounding radius), used by every method.
+pub fn ao_scene(dir: &Path, model: &Path, eye: &str, size: u32) -> Result<(String, f32), Error> {
+    if !model.is_file() {
+        return Err(Error::asset(model, None, "missing shared model"));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let ground = dir.join("ground.obj");
+    std::fs::write(
+        &ground,
+        crate::procedural::ground(1.0, 0.0, 1.0)
+            .to_obj("g", "none.mtl", "m")
+            .text
+            .replace("mtllib none.mtl\n", "")
+            .replace("usemtl m\n", ""),
+    )
+    .map_err(|e| Error::io(&ground, e))?;
+    let models = format!(
+        "[[model]]\npath = \"{}\"\nnormalize = true\n",
+        model.display()
+    );
+    let probe = load(dir, &format!("[output]\nwidth = 8\nheight = 8\n{models}"))?;
+    let mut lo = f32::INFINITY;
+    for m in &probe.models {
+        for p in &m.mesh.positions {
+            lo = lo.min(m.world_from_object.transform_point3(*p).y);
+        }
+    }
+    let text = format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ao}}\n{models}\
+         [[model]]\npath = \"ground.obj\"\ntranslate = [0.0, {lo}, 0.0]\nscale = {}\n\
+         [[camera]]\neye = {eye}\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n\
+         [animation]\nframes = 72\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360.0 }}\n",
+        probe.bounds_radius * 3.0
+    );
+    Ok((text, probe.bounds_radius * 0.2))
 }
 
 /// RMSE and worst absolute error of the AO buffers over covered pixels.

@@ -244,13 +244,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         "all" => vec!["diablo3", "nefertiti", "flighthelmet"],
         c => vec![c],
     };
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        builder = builder.num_threads(n.max(1));
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))?;
+    let pool = thread_pool(args)?;
     println!(
         "softraster bench: {} frames at {}x{}, {} thread(s)",
         args.frames,
@@ -272,15 +266,20 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// `--case shadows | ao`: time and error of each method (CSV on stdout).
-fn accuracy_tables(args: &BenchArgs) -> Result<(), Error> {
+/// The worker pool `--threads` asks for (all cores by default).
+fn thread_pool(args: &BenchArgs) -> Result<rayon::ThreadPool, Error> {
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
         builder = builder.num_threads(n.max(1));
     }
-    let pool = builder
+    builder
         .build()
-        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))?;
+        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))
+}
+
+/// `--case shadows | ao`: time and error of each method (CSV on stdout).
+fn accuracy_tables(args: &BenchArgs) -> Result<(), Error> {
+    let pool = thread_pool(args)?;
     let threads = pool.current_num_threads();
     let assets = std::fs::canonicalize(&args.assets).map_err(|e| Error::io(&args.assets, e))?;
     pool.install(|| {

@@ -329,6 +329,47 @@ fn shadow_of_a_sphere_is_the_analytic_ellipse() {
     }
 }
 
+/// Whether any pixel within `r` (a square) of (x, y) in a `w` x `h` image
+/// satisfies `f(index)`.
+fn any_near(x: i32, y: i32, w: u32, h: u32, r: i32, f: impl Fn(usize) -> bool) -> bool {
+    (-r..=r).any(|dy| {
+        (-r..=r).any(|dx| {
+            let (sx, sy) = (x + dx, y + dy);
+            sx >= 0 && sy >= 0 && sx < w as i32 && sy < h as i32 && f((sy * w as i32 + sx) as usize)
+        })
+    })
+}
+
+/// Renders `scene` (with `{shadows}` in it) ray-traced, then with each map
+/// filter, and returns per filter (wrongly shadowed, lit) pixels; prints
+/// them under `label`.
+fn acne_counts(dir: &Path, scene: &str, size: u32, label: &str) -> Vec<(usize, usize)> {
+    let truth = shadow_factor(dir, scene, "raytraced");
+    ["pcf", "hard"]
+        .iter()
+        .map(|method| {
+            let f = shadow_factor(dir, scene, method);
+            let (wrong, lit) = acne(&f, &truth, size, size, 0.5);
+            let (partial, _) = acne(&f, &truth, size, size, 0.99);
+            println!(
+                "{label}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
+            );
+            assert!(lit > 10_000, "{label}: {lit}");
+            (wrong, lit)
+        })
+        .collect()
+}
+
+/// Fewer than 0.1% of lit pixels wrongly in shadow, for both filters.
+fn assert_no_acne(counts: &[(usize, usize)], label: &str) {
+    for &(wrong, lit) in counts {
+        assert!(
+            (wrong as f64) < lit as f64 * 1e-3,
+            "{label}: {wrong} of {lit}"
+        );
+    }
+}
+
 /// Pixels wrongly in shadow among lit-side pixels: shadow-map factor below
 /// `below` where the ray-traced factor is 1, away (more than 2 pixels)
 /// from any ray-traced shadow.
@@ -340,17 +381,7 @@ fn acne(map: &[f32], truth: &[f32], w: u32, h: u32, below: f32) -> (usize, usize
             if truth[i].is_nan() || truth[i] < 1.0 {
                 continue;
             }
-            let near_shadow = (-2..=2).any(|dy| {
-                (-2..=2).any(|dx| {
-                    let (sx, sy) = (x + dx, y + dy);
-                    sx >= 0
-                        && sy >= 0
-                        && sx < w as i32
-                        && sy < h as i32
-                        && truth[(sy * w as i32 + sx) as usize] < 1.0
-                })
-            });
-            if near_shadow {
+            if any_near(x, y, w, h, 2, |k| truth[k] < 1.0) {
                 continue;
             }
             lit += 1;
@@ -371,30 +402,20 @@ fn no_acne_on_a_sphere_and_plane_at_grazing_light() {
     for az in [0.0f32, 35.0, 100.0] {
         let a = az.to_radians();
         let light = Vec3::new(-e.cos() * a.cos(), -e.sin(), -e.cos() * a.sin());
-        let scene = sphere_on_plane_scene(
-            &dir,
-            light,
-            size,
-            &std::env::var("XBIAS").unwrap_or_default(),
-        );
         // A low camera, so the sphere's lit side fills the frame.
-        let scene = scene.replace(
-            TOP_DOWN,
-            "[[camera]]\neye = [4.0, 2.5, 3.0]\ntarget = [0.0, 1.0, 0.0]\nfov = 45.0\n",
-        );
-        let truth = shadow_factor(&dir, &scene, "raytraced");
-        for method in ["pcf", "hard"] {
-            let f = shadow_factor(&dir, &scene, method);
-            let (wrong, lit) = acne(&f, &truth, size, size, 0.5);
-            let (partial, _) = acne(&f, &truth, size, size, 0.99);
-            println!(
-                "azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
-            );
-            assert!(lit > 10_000, "{lit}");
-            assert!(
-                (wrong as f64) < lit as f64 * 1e-3,
-                "{method} {az}: {wrong} of {lit}"
-            );
+        let scene = |bias: &str| {
+            sphere_on_plane_scene(&dir, light, size, bias).replace(
+                TOP_DOWN,
+                "[[camera]]\neye = [4.0, 2.5, 3.0]\ntarget = [0.0, 1.0, 0.0]\nfov = 45.0\n",
+            )
+        };
+        let label = format!("sphere, azimuth {az}");
+        assert_no_acne(&acne_counts(&dir, &scene(""), size, &label), &label);
+        if az == 0.0 {
+            // The measurement sees acne: without bias it is everywhere.
+            let unbiased = "shadow_bias = { constant = 0.0, slope = 0.0, normal = 0.0 }";
+            let counts = acne_counts(&dir, &scene(unbiased), size, "no bias");
+            assert!(counts.iter().all(|&(w, l)| w * 100 > l), "{counts:?}");
         }
     }
 }
@@ -417,57 +438,68 @@ fn a_box_on_the_plane_meets_its_shadow() {
     )
     .unwrap();
     let size = 400u32;
-    let bias = std::env::var("XBIAS").unwrap_or_default();
     for (what, thick) in [("box", 1.0f32), ("wall", 0.04)] {
         for elevation in [30.0f32, 10.0] {
-            let e = elevation.to_radians();
-            // Travelling along -x: the shadow falls on the -x side.
-            let light = Vec3::new(-e.cos(), -e.sin(), 0.0);
-            let scene = format!(
-                "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{bias}\n\
-                 [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
-                 [[model]]\npath = \"ground.obj\"\n{MATTE}[[model]]\npath = \"box.obj\"\nscale = [{thick}, 1.0, 1.0]\n{MATTE}\
-                 [[light]]\nkind = \"directional\"\ndirection = [{}, {}, 0.0]\nirradiance = 1.0\nshadows = true\n{TOP_DOWN}",
-                light.x, light.y
-            );
-            let truth = shadow_factor(&dir, &scene, "raytraced");
-            // The first pixel column left of the base.
-            let edge = ((-thick * 0.5 + 3.0) / 6.0 * size as f32).floor() as u32;
             for method in ["pcf", "hard"] {
-                let f = shadow_factor(&dir, &scene, method);
-                let mut worst = 0;
-                let mut rows = 0;
-                for py in 0..size {
-                    let (_, z) = top_down_point(0, py, size, 6.0);
-                    if z.abs() > 0.45 {
-                        continue;
-                    }
-                    rows += 1;
-                    // Walk left from the base: lit pixels the ray tracer
-                    // shades, before the map's shadow begins.
-                    let mut gap = 0;
-                    for px in (0..edge).rev() {
-                        let i = (py * size + px) as usize;
-                        if f[i] < 0.5 {
-                            break;
-                        }
-                        if truth[i] < 0.5 {
-                            gap += 1;
-                        }
-                    }
-                    worst = worst.max(gap);
-                }
-                println!(
-                    "{what}, elevation {elevation}: {method}: widest gap {worst} px over {rows} rows"
-                );
-                assert!(rows > 50);
+                let gap = widest_gap(&dir, size, thick, elevation, method, "");
+                println!("{what}, elevation {elevation}: {method}: widest gap {gap} px");
                 assert!(
-                    worst < 2,
-                    "{what}, {method} at {elevation} degrees: gap {worst} px"
+                    gap < 2,
+                    "{what}, {method} at {elevation} degrees: gap {gap} px"
                 );
             }
         }
     }
+    // The measurement sees peter-panning: a depth bias above the wall's
+    // thickness opens a gap.
+    let biased = "shadow_bias = { constant = 16.0 }";
+    let gap = widest_gap(&dir, size, 0.04, 10.0, "pcf", biased);
+    println!("wall, elevation 10, constant bias 16 texels: widest gap {gap} px");
+    assert!(gap >= 2, "{gap}");
+}
+
+/// Widest run (pixels) of plane lit by the map but shadowed by rays, next
+/// to the base of a unit-high box `thick` wide along the light, which
+/// travels along -x at `elevation` degrees; top-down view, rows across the
+/// box. `extra`: more `[render]` keys.
+fn widest_gap(dir: &Path, size: u32, thick: f32, elevation: f32, method: &str, extra: &str) -> u32 {
+    let e = elevation.to_radians();
+    let light = Vec3::new(-e.cos(), -e.sin(), 0.0);
+    let scene = format!(
+        "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{extra}\n\
+         [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+         [[model]]\npath = \"ground.obj\"\n{MATTE}[[model]]\npath = \"box.obj\"\nscale = [{thick}, 1.0, 1.0]\n{MATTE}\
+         [[light]]\nkind = \"directional\"\ndirection = [{}, {}, 0.0]\nirradiance = 1.0\nshadows = true\n{TOP_DOWN}",
+        light.x, light.y
+    );
+    let truth = shadow_factor(dir, &scene, "raytraced");
+    let f = shadow_factor(dir, &scene, method);
+    // The first pixel column left of the base.
+    let edge = ((-thick * 0.5 + 3.0) / 6.0 * size as f32).floor() as u32;
+    let mut worst = 0;
+    let mut rows = 0;
+    for py in 0..size {
+        let (_, z) = top_down_point(0, py, size, 6.0);
+        if z.abs() > 0.45 {
+            continue;
+        }
+        rows += 1;
+        // Walk left from the base: pixels the ray tracer shadows before the
+        // map's shadow begins.
+        let mut gap = 0;
+        for px in (0..edge).rev() {
+            let i = (py * size + px) as usize;
+            if f[i] < 0.5 {
+                break;
+            }
+            if truth[i] < 0.5 {
+                gap += 1;
+            }
+        }
+        worst = worst.max(gap);
+    }
+    assert!(rows > 50, "{rows}");
+    worst
 }
 
 #[test]
@@ -478,13 +510,12 @@ fn no_acne_on_diablo3_at_grazing_light() {
     let dir = common::scratch("acne_diablo3");
     let t = assets.join("tinyrenderer");
     let size = 400u32;
-    let bias = std::env::var("XBIAS").unwrap_or_default();
     let e = 10f32.to_radians();
     for az in [20.0f32, 135.0, 250.0] {
         let a = az.to_radians();
         let light = Vec3::new(-e.cos() * a.cos(), -e.sin(), -e.cos() * a.sin());
         let scene = format!(
-            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n{bias}\n\
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n\
              [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
              [[model]]\npath = \"{}\"\nscale = [2.0, 1.0, 2.0]\n{MATTE}\
              [[model]]\npath = \"{}\"\n{MATTE}\
@@ -496,20 +527,8 @@ fn no_acne_on_diablo3_at_grazing_light() {
             light.y,
             light.z
         );
-        let truth = shadow_factor(&dir, &scene, "raytraced");
-        for method in ["pcf", "hard"] {
-            let f = shadow_factor(&dir, &scene, method);
-            let (wrong, lit) = acne(&f, &truth, size, size, 0.5);
-            let (partial, _) = acne(&f, &truth, size, size, 0.99);
-            println!(
-                "diablo3, azimuth {az}: {method}: {wrong} of {lit} lit pixels in shadow ({partial} below 0.99)"
-            );
-            assert!(lit > 10_000, "{lit}");
-            assert!(
-                (wrong as f64) < lit as f64 * 1e-3,
-                "{method} {az}: {wrong} of {lit}"
-            );
-        }
+        let label = format!("diablo3, azimuth {az}");
+        assert_no_acne(&acne_counts(&dir, &scene, size, &label), &label);
     }
 }
 
@@ -527,11 +546,10 @@ fn ssao_rmse(dir: &Path, scene: &str, radius: f32) -> (f64, usize) {
         scene,
         &format!("{{ method = \"raytraced\", samples = 512, radius = {radius} }}"),
     );
-    let extra = std::env::var("XSSAO").unwrap_or_default();
     let ssao = ao_of(
         dir,
         scene,
-        &format!("{{ method = \"ssao\", radius = {radius} {extra} }}"),
+        &format!("{{ method = \"ssao\", radius = {radius} }}"),
     );
     let depth = render(dir, &scene.replace("{ao}", "{ method = \"off\" }")).depth;
     if std::env::var_os("DUMP_AO").is_some() {
@@ -557,31 +575,6 @@ fn ssao_rmse(dir: &Path, scene: &str, radius: f32) -> (f64, usize) {
     ((sum / n as f64).sqrt(), n)
 }
 
-/// Scene text for models standing on a ground plane at their lowest point.
-fn on_ground(dir: &Path, models: &str, camera: &str, size: u32) -> (String, f32) {
-    let probe = load(dir, &format!("[output]\nwidth = 8\nheight = 8\n{models}"));
-    let mut lo = f32::INFINITY;
-    for m in &probe.models {
-        for p in &m.mesh.positions {
-            lo = lo.min(m.world_from_object.transform_point3(*p).y);
-        }
-    }
-    std::fs::write(
-        dir.join("ground.obj"),
-        obj(procedural::ground(1.0, 0.0, 1.0)),
-    )
-    .unwrap();
-    let radius = probe.bounds_radius * 0.2;
-    (
-        format!(
-            "[output]\nwidth = {size}\nheight = {size}\n[render]\nao = {{ao}}\n{models}\
-             [[model]]\npath = \"ground.obj\"\ntranslate = [0.0, {lo}, 0.0]\nscale = {}\n{camera}",
-            probe.bounds_radius * 3.0
-        ),
-        radius,
-    )
-}
-
 #[test]
 fn ssao_matches_raytraced_ao_on_bunny_and_diablo3() {
     let Some(assets) = common::shared_assets() else {
@@ -589,23 +582,10 @@ fn ssao_matches_raytraced_ao_on_bunny_and_diablo3() {
     };
     let dir = common::scratch("ssao_vs_raytraced");
     let size = 160u32;
-    for (name, model, camera) in [
-        (
-            "bunny on a plane",
-            assets.join("common/stanford-bunny.obj"),
-            "[[camera]]\neye = [0.6, 0.7, 2.0]\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n",
-        ),
-        (
-            "diablo3 on a plane",
-            assets.join("tinyrenderer/diablo3_pose/diablo3_pose.obj"),
-            "[[camera]]\neye = [0.6, 0.45, 1.9]\ntarget = [0.0, -0.05, 0.0]\nfov = 45.0\n",
-        ),
-    ] {
-        let models = format!(
-            "[[model]]\npath = \"{}\"\nnormalize = true\n",
-            model.display()
-        );
-        let (scene, radius) = on_ground(&dir, &models, camera, size);
+    // The scenes of `bench --case ao`.
+    for (name, model, eye) in softraster::accuracy::AO_SCENES {
+        let (scene, radius) =
+            softraster::accuracy::ao_scene(&dir, &assets.join(model), eye, size).unwrap();
         let (rmse, n) = ssao_rmse(&dir, &scene, radius);
         println!(
             "{name}: SSAO (16 samples, radius {radius:.3}) vs ray-traced AO (512 rays): RMSE {rmse:.4} over {n} pixels"
@@ -639,17 +619,7 @@ fn ssao_leaves_no_halo_behind_a_floating_sphere() {
                 continue; // the sphere
             }
             // Wall pixels within 8 pixels of the sphere's silhouette.
-            let near = (-8..=8).any(|dy| {
-                (-8..=8).any(|dx| {
-                    let (sx, sy) = (x + dx, y + dy);
-                    sx >= 0
-                        && sy >= 0
-                        && sx < size as i32
-                        && sy < size as i32
-                        && z[(sy * size as i32 + sx) as usize] < 6.0
-                })
-            });
-            if near {
+            if any_near(x, y, size, size, 8, |k| z[k] < 6.0) {
                 checked += 1;
                 worst = worst.min(f.ao[i]);
             }
@@ -671,16 +641,9 @@ fn disagreements_off_edges(map: &[f32], truth: &[f32], w: u32, h: u32) -> (usize
             if truth[i].is_nan() || map[i].is_nan() || (map[i] < 0.5) == shadowed(x, y) {
                 continue;
             }
-            let edge = (-2..=2).any(|dy| {
-                (-2..=2).any(|dx| {
-                    let (sx, sy) = (x + dx, y + dy);
-                    sx >= 0
-                        && sy >= 0
-                        && sx < w as i32
-                        && sy < h as i32
-                        && !truth[(sy * w as i32 + sx) as usize].is_nan()
-                        && shadowed(sx, sy) != shadowed(x, y)
-                })
+            let here = shadowed(x, y);
+            let edge = any_near(x, y, w, h, 2, |k| {
+                !truth[k].is_nan() && (truth[k] < 0.5) != here
             });
             if edge { near += 1 } else { far += 1 }
         }

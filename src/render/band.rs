@@ -105,8 +105,7 @@ impl FrameData<'_> {
     pub fn gbuffer(&self, vis: &Visibility, out: &mut [GPixel]) {
         let rect = vis.rect;
         let tw = rect.width();
-        let mut current = NO_TRIANGLE;
-        let mut it: Option<Interpolator> = None;
+        let mut cache = InterpolatorCache::default();
         for (i, g) in out.iter_mut().enumerate() {
             let id = vis.id[i];
             if id == NO_TRIANGLE {
@@ -114,11 +113,7 @@ impl FrameData<'_> {
                 continue;
             }
             let t = &self.tris[id as usize];
-            if id != current || it.is_none() {
-                current = id;
-                it = Some(Interpolator::new(t));
-            }
-            let Some(it) = &it else { continue };
+            let it = cache.get(id, t);
             let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
             let frag = it.at_pixel(px, py);
             let p = self.point(t, frag);
@@ -152,8 +147,7 @@ impl FrameData<'_> {
         let (tw, th) = (rect.width(), rect.height());
         color.fill(self.bg);
         depth.fill(f32::INFINITY);
-        let mut current = NO_TRIANGLE;
-        let mut it: Option<Interpolator> = None;
+        let mut cache = InterpolatorCache::default();
         for qy in (0..th).step_by(2) {
             for qx in (0..tw).step_by(2) {
                 // Derivatives of the (at most four) triangles in this quad.
@@ -170,11 +164,7 @@ impl FrameData<'_> {
                         continue;
                     }
                     let t = &self.tris[id as usize];
-                    if id != current || it.is_none() {
-                        current = id;
-                        it = Some(Interpolator::new(t));
-                    }
-                    let Some(it) = &it else { continue };
+                    let it = cache.get(id, t);
                     let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
                     let g = if self.grads {
                         let slot = quad
@@ -387,6 +377,26 @@ impl FrameData<'_> {
             geo_normal,
             view_depth,
         }
+    }
+}
+
+/// The interpolator of the last triangle asked for: consecutive pixels
+/// mostly belong to one triangle.
+#[derive(Default)]
+struct InterpolatorCache {
+    last: Option<(u32, Interpolator)>,
+}
+
+impl InterpolatorCache {
+    #[inline]
+    fn get(&mut self, id: u32, t: &Tri) -> &Interpolator {
+        if self.last.as_ref().is_some_and(|(last, _)| *last != id) {
+            self.last = None;
+        }
+        &self
+            .last
+            .get_or_insert_with(|| (id, Interpolator::new(t)))
+            .1
     }
 }
 

@@ -356,8 +356,16 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
     let view = AoView::new(&fs.camera, s.width, s.height);
     frame.ao = match s.ao.method {
         AoMethod::Raytraced => {
-            let tracer = Tracer::new(scene, &fs.world_from_object);
-            ao::raytraced(&tracer, &gbuf, s.width, s.ao.samples, s.ao.radius)
+            // Ray-traced shadows already placed the scene for this frame.
+            let own;
+            let tracer = match &shadows.tracer {
+                Some(t) => t,
+                None => {
+                    own = Tracer::new(scene, &fs.world_from_object);
+                    &own
+                }
+            };
+            ao::raytraced(tracer, &gbuf, s.width, s.ao.samples, s.ao.radius)
         }
         _ => {
             let radius = s.ao.radius.unwrap_or(scene.bounds_radius * 0.2);
