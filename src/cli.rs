@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use softraster::batch::RenderJob;
+use softraster::batch::{RenderJob, parse_frames};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
@@ -26,8 +26,13 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render every frame of a scene to PNG.
+    /// Render every frame of a scene to PNG (and EXR, GIF as the scene asks).
     Render(RenderArgs),
+    /// Assemble PNG frames into a looping GIF with one shared palette.
+    Gif(GifArgs),
+    /// Compare two images, or two directories of images paired by name.
+    /// Exit status: 0 pass, 1 fail (or a missing/extra file), 2 error.
+    Compare(CompareArgs),
     /// Time the reference turntables (load, per-frame, total).
     Bench(softraster::bench::BenchArgs),
     /// Write the procedural showcase assets (meshes, textures) to a directory.
@@ -44,9 +49,17 @@ struct RenderArgs {
     /// Output directory; wins over `output.dir`.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Half-open frame range `a..b`, or one frame `n`.
+    /// Frames to render: `a..b` (half-open), `a-b` (inclusive), `n`, or a
+    /// comma-separated list of those, e.g. `0..36` or `1-100,120`.
     #[arg(long)]
     frames: Option<String>,
+    /// Do not render frames whose files all exist already.
+    #[arg(long)]
+    skip_existing: bool,
+    /// Progress report: `auto` (a bar on a terminal, a line per frame
+    /// otherwise) or `json` (one JSON object per frame on stdout).
+    #[arg(long, value_enum, default_value_t = Progress::Auto)]
+    progress: Progress,
     /// Render only this camera.
     #[arg(long)]
     camera: Option<String>,
@@ -61,6 +74,49 @@ struct RenderArgs {
     quiet: bool,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Progress {
+    Auto,
+    Json,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// Reference image or directory.
+    reference: PathBuf,
+    /// Test image or directory.
+    test: PathBuf,
+    /// flip (mean FLIP error, pass <= threshold), ssim (pass >=), psnr (dB,
+    /// pass >=) or mae (fraction of full scale, pass <=).
+    #[arg(long, default_value = "flip")]
+    metric: String,
+    /// Pass/fail threshold (defaults: flip 0.05, ssim 0.98, psnr 40, mae 0.01).
+    #[arg(long)]
+    threshold: Option<f64>,
+    /// Write the error map: a PNG (two images) or a directory of PNGs.
+    #[arg(long)]
+    diff: Option<PathBuf>,
+    /// One JSON report on stdout instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct GifArgs {
+    /// PNG frames, in order (all of one size).
+    #[arg(required = true)]
+    frames: Vec<PathBuf>,
+    /// The GIF to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Per frame, in milliseconds (GIF stores hundredths of a second).
+    #[arg(long, default_value_t = 40)]
+    delay_ms: u32,
+    /// none | ordered | floyd-steinberg.
+    #[arg(long, default_value = "none")]
+    dither: String,
+}
+
 pub fn main() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -71,6 +127,8 @@ pub fn main() -> i32 {
     };
     let result = match cli.command {
         Command::Render(args) => render(args),
+        Command::Gif(args) => gif(args),
+        Command::Compare(args) => return compare(args),
         Command::Bench(args) => softraster::bench::run(&args),
         Command::GenerateAssets { dir } => softraster::procedural::write_showcase_assets(&dir),
     };
@@ -88,31 +146,82 @@ pub fn main() -> i32 {
     }
 }
 
-/// `a..b` (half-open) or `n`.
-pub fn parse_frames(s: &str, total: u32) -> Result<std::ops::Range<u32>, Error> {
-    let bad = || Error::Argument(format!("--frames {s}: expected a..b (half-open) or n"));
-    let r = if let Some((a, b)) = s.split_once("..") {
-        let a = if a.is_empty() {
-            0
-        } else {
-            a.trim().parse().map_err(|_| bad())?
-        };
-        let b = if b.is_empty() {
-            total
-        } else {
-            b.trim().parse().map_err(|_| bad())?
-        };
-        a..b
-    } else {
-        let n: u32 = s.trim().parse().map_err(|_| bad())?;
-        n..n + 1
+fn compare(args: CompareArgs) -> i32 {
+    use softraster::output::compare::{Metric, compare_paths};
+    let Some(metric) = Metric::parse(&args.metric) else {
+        eprintln!(
+            "error: --metric {}: expected flip, ssim, psnr or mae",
+            args.metric
+        );
+        return 2;
     };
-    if r.start >= r.end || r.end > total {
+    let threshold = args.threshold.unwrap_or_else(|| metric.default_threshold());
+    if !threshold.is_finite() {
+        eprintln!("error: --threshold must be a finite number");
+        return 2;
+    }
+    match compare_paths(
+        &args.reference,
+        &args.test,
+        metric,
+        threshold,
+        args.diff.as_deref(),
+    ) {
+        Ok(report) => {
+            if args.json {
+                println!("{}", report.to_json());
+            } else {
+                print!("{}", report.to_text());
+            }
+            report.exit_code()
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+fn gif(args: GifArgs) -> Result<(), Error> {
+    use softraster::scene::desc::GifDither;
+    let dither = match args.dither.as_str() {
+        "none" => GifDither::None,
+        "ordered" => GifDither::Ordered,
+        "floyd-steinberg" => GifDither::FloydSteinberg,
+        other => {
+            return Err(Error::Argument(format!(
+                "--dither {other}: expected none, ordered or floyd-steinberg"
+            )));
+        }
+    };
+    if args.delay_ms < 10 {
         return Err(Error::Argument(format!(
-            "--frames {s}: the scene has frames 0..{total}"
+            "--delay-ms {}: GIF delays start at 10 ms",
+            args.delay_ms
         )));
     }
-    Ok(r)
+    let info = softraster::output::gif::assemble(
+        &args.frames,
+        &args.output,
+        softraster::output::gif::GifOptions {
+            delay_ms: args.delay_ms,
+            dither,
+        },
+    )?;
+    eprintln!(
+        "{}: {} frames, {}x{}, {} colors{}",
+        args.output.display(),
+        info.frames,
+        info.width,
+        info.height,
+        info.colors,
+        if info.transparent {
+            " (one transparent)"
+        } else {
+            ""
+        }
+    );
+    Ok(())
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {
@@ -146,7 +255,7 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         }
         let frames = match &args.frames {
             Some(f) => parse_frames(f, scene.animation.frames)?,
-            None => 0..scene.animation.frames,
+            None => (0..scene.animation.frames).collect(),
         };
         let cameras = match &args.camera {
             Some(name) => vec![scene
@@ -166,6 +275,7 @@ fn render(args: RenderArgs) -> Result<(), Error> {
             scene,
             frames,
             cameras,
+            skip_existing: args.skip_existing,
         };
         if !args.quiet {
             eprintln!(
@@ -180,7 +290,8 @@ fn render(args: RenderArgs) -> Result<(), Error> {
                 job.scene.output.dir.display()
             );
         }
-        let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
+        let json = args.progress == Progress::Json;
+        let bar = (!args.quiet && !json && std::io::stderr().is_terminal()).then(|| {
             let b = indicatif::ProgressBar::new(job.total() as u64);
             b.set_style(
                 indicatif::ProgressStyle::with_template(
@@ -192,23 +303,54 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         });
         let t0 = std::time::Instant::now();
         let quiet = args.quiet;
-        job.run(|d| {
-            if let Some(b) = &bar {
+        let summary = job.run(|d| {
+            if json {
+                let line = serde_json::json!({
+                    "event": "frame",
+                    "frame": d.frame,
+                    "camera": d.camera,
+                    "files": d.files,
+                    "seconds": d.render_seconds,
+                    "skipped": d.skipped,
+                });
+                println!("{line}");
+            } else if let Some(b) = &bar {
                 b.set_message(format!("{:.1} ms/frame", d.render_seconds * 1e3));
                 b.inc(1);
             } else if !quiet {
                 let files: Vec<_> = d.files.iter().map(|f| f.display().to_string()).collect();
-                eprintln!(
-                    "frame {} camera {}: {:.1} ms -> {}",
-                    d.frame,
-                    d.camera,
-                    d.render_seconds * 1e3,
-                    files.join(", ")
-                );
+                if d.skipped {
+                    eprintln!(
+                        "frame {} camera {}: exists, skipped ({})",
+                        d.frame,
+                        d.camera,
+                        files.join(", ")
+                    );
+                } else {
+                    eprintln!(
+                        "frame {} camera {}: {:.1} ms -> {}",
+                        d.frame,
+                        d.camera,
+                        d.render_seconds * 1e3,
+                        files.join(", ")
+                    );
+                }
             }
         })?;
         if let Some(b) = &bar {
             b.finish();
+        }
+        for g in &summary.gifs {
+            if json {
+                println!("{}", serde_json::json!({ "event": "gif", "file": g }));
+            } else if !quiet {
+                eprintln!("gif: {}", g.display());
+            }
+        }
+        if let Some(why) = &summary.gif_skipped
+            && !quiet
+        {
+            eprintln!("note: {why}");
         }
         if !quiet {
             eprintln!(
@@ -219,19 +361,4 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         }
         Ok(())
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn frame_ranges() {
-        assert_eq!(parse_frames("0..72", 72).unwrap(), 0..72);
-        assert_eq!(parse_frames("5", 72).unwrap(), 5..6);
-        assert_eq!(parse_frames("10..", 72).unwrap(), 10..72);
-        assert!(parse_frames("5..5", 72).is_err());
-        assert!(parse_frames("70..80", 72).is_err());
-        assert!(parse_frames("x", 72).is_err());
-    }
 }

@@ -167,24 +167,6 @@ fn out_of_range_obj_index_exits_2_naming_the_line() {
 }
 
 #[test]
-fn features_of_later_issues_are_refused_not_ignored() {
-    let dir = common::scratch("unsupported");
-    write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    for (key, text) in [
-        ("render.msaa", "[render]\nmsaa = 4\n"),
-        ("output.gif", "[output]\ngif = \"a.gif\"\n"),
-    ] {
-        let s = write(
-            &dir,
-            "s.toml",
-            &format!("[[model]]\npath = \"m.obj\"\n{text}"),
-        );
-        let err = exit_2(&s, &dir);
-        assert!(err.contains("not supported yet"), "{key}: {err}");
-    }
-}
-
-#[test]
 fn set_overrides_and_bad_arguments() {
     let dir = common::scratch("set");
     write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");

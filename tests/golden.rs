@@ -1,27 +1,28 @@
 //! Golden images: small scenes rendered and compared with committed PNGs
-//! under `tests/golden/`. Tolerance: a pixel differs when a channel is off by
-//! more than 2/255; at most 0.1% of pixels may differ (room for last-bit
-//! floating-point differences across CPUs, none for a real regression).
+//! under `tests/golden/`, through the code path of `softraster compare`
+//! (FLIP). Tolerance: mean FLIP error at most 0.001, and at most 0.1% of
+//! pixels with a FLIP error above 0.1 (room for last-bit floating-point
+//! differences across CPUs, none for a real regression: one wrong 8x8
+//! block in a 320x240 frame fails).
 //!
-//! On a mismatch the new image and a diff image (magenta = differing pixel)
-//! are written to `tests/failures/`. To accept new output as the golden:
+//! On a mismatch the new image and the FLIP error map are written to
+//! `tests/failures/`. To accept new output as the golden:
 //! `UPDATE_GOLDENS=1 cargo test --test golden`, then look at the images.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
-use softraster::output::compare::{Tolerance, compare};
+use softraster::output::compare::{Metric, score};
 use softraster::output::{png, resolve};
 use softraster::render::render_frame;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 use softraster::scene::overrides::SetOverride;
 
-const TOLERANCE: Tolerance = Tolerance {
-    channel: 2,
-    fraction: 0.001,
-};
+const MEAN_FLIP: f64 = 0.001;
+const LOCAL_FLIP: f32 = 0.1;
+const LOCAL_FRACTION: f64 = 0.001;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -50,18 +51,21 @@ fn check(name: &str, scene: &Path, frame: u32, sets: &[&str]) {
     let save = || {
         png::write(&fail_dir.join(format!("{name}.new.png")), &img).unwrap();
     };
-    let Some((cmp, diff)) = compare(&reference, &img, TOLERANCE) else {
-        save();
-        panic!("{name}: size or channels differ from {}", golden.display());
+    let s = match score(&reference, &img, Metric::Flip) {
+        Ok(s) => s,
+        Err(e) => {
+            save();
+            panic!("{name}: {e} ({})", golden.display());
+        }
     };
-    if !cmp.passes(TOLERANCE) {
+    let local = s.error_map.iter().filter(|&&e| e > LOCAL_FLIP).count();
+    let pixels = s.error_map.len();
+    if s.value > MEAN_FLIP || local as f64 > LOCAL_FRACTION * pixels as f64 {
         save();
-        png::write(&fail_dir.join(format!("{name}.diff.png")), &diff).unwrap();
+        png::write(&fail_dir.join(format!("{name}.flip.png")), &s.diff_image()).unwrap();
         panic!(
-            "{name}: {} of {} pixels differ (max channel diff {}); new image and diff in {}",
-            cmp.differing_pixels,
-            cmp.pixels,
-            cmp.max_channel_diff,
+            "{name}: mean FLIP {:.5} (max {MEAN_FLIP}), {local} of {pixels} pixels above {LOCAL_FLIP}; new image and error map in {}",
+            s.value,
             fail_dir.display()
         );
     }

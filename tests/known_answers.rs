@@ -67,6 +67,7 @@ fn two_triangles_sharing_a_diagonal_cover_every_pixel_once() {
     let vp = Viewport {
         width: 64,
         height: 48,
+        msaa: false,
     };
     let (w, h) = (64.0, 48.0);
     let quad = [
@@ -127,6 +128,7 @@ fn a_quads_pixel_count_matches_its_area() {
     let vp = Viewport {
         width: 96,
         height: 96,
+        msaa: false,
     };
     for (angle, half) in [
         (0.0f32, Vec2::new(20.3, 13.7)),
@@ -308,6 +310,7 @@ fn uvs_are_perspective_correct_on_a_tilted_plane() {
     let vp = Viewport {
         width: 120,
         height: 90,
+        msaa: false,
     };
     let cam = softraster::scene::Camera {
         name: "c".into(),

@@ -83,11 +83,7 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
     );
     let scene = load(&dir, &text);
     let out = dir.join("out");
-    let mut job = RenderJob {
-        scene,
-        frames: 0..1,
-        cameras: vec![0],
-    };
+    let mut job = RenderJob::all(scene);
     job.scene.output.dir = out.clone();
     job.run(|_| {}).unwrap();
     let (ew, eh, z) = read_channel(&out.join("f_depth.exr"), "Z").unwrap();

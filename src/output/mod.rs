@@ -5,6 +5,7 @@
 
 pub mod compare;
 pub mod exr;
+pub mod gif;
 pub mod png;
 
 use std::io::Write;
@@ -28,7 +29,9 @@ pub struct Image8 {
 }
 
 /// Exposure, tone map and sRGB encoding (the data views are written as
-/// their values, without a transfer curve).
+/// their values, without a transfer curve). Frame colors are premultiplied
+/// by their coverage alpha (partly covered MSAA pixels, blended surfaces
+/// over a transparent background); an RGBA image gets straight alpha.
 pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
     let alpha = s.background == Background::Transparent;
     let channels = if alpha { 4 } else { 3 };
@@ -48,6 +51,12 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
                 let px = match last {
                     Some((lc, px)) if lc == *c => px,
                     _ => {
+                        let key = *c;
+                        let c = if alpha && c.w > 0.0 && c.w < 1.0 {
+                            (c.truncate() / c.w).extend(c.w)
+                        } else {
+                            *c
+                        };
                         let rgb = if data_view {
                             [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
                         } else {
@@ -55,7 +64,7 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
                             [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
                         };
                         let px = [rgb[0], rgb[1], rgb[2], encode_linear(c.w)];
-                        last = Some((*c, px));
+                        last = Some((key, px));
                         px
                     }
                 };

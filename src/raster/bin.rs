@@ -77,7 +77,9 @@ impl TileGrid {
 
 /// Per tile, the indices (into `tris`) of the triangles that may cover one of
 /// its pixels, in order.
-pub fn bin(tris: &[Tri], grid: &TileGrid) -> Vec<Vec<u32>> {
+/// `msaa`: the triangles were set up for multisampling (coverage reaches
+/// half a pixel past the pixel centers).
+pub fn bin(tris: &[Tri], grid: &TileGrid, msaa: bool) -> Vec<Vec<u32>> {
     let mut bins = vec![Vec::new(); grid.count()];
     for (i, t) in tris.iter().enumerate() {
         let (tw, th) = (grid.tile_w as i32, grid.tile_h as i32);
@@ -88,7 +90,7 @@ pub fn bin(tris: &[Tri], grid: &TileGrid) -> Vec<Vec<u32>> {
         for ty in ty0..=ty1 {
             for tx in tx0..=tx1 {
                 let index = (ty as u32 * grid.tiles_x + tx as u32) as usize;
-                if !single && !touches(&edges, grid.rect(index)) {
+                if !single && !touches(&edges, grid.rect(index), msaa) {
                     continue;
                 }
                 bins[index].push(i as u32);
@@ -99,11 +101,13 @@ pub fn bin(tris: &[Tri], grid: &TileGrid) -> Vec<Vec<u32>> {
 }
 
 /// False when one edge function is negative at every pixel center of the
-/// tile (checked at the corner where it is largest).
-fn touches(edges: &[super::setup::Edge; 3], r: TileRect) -> bool {
+/// tile (checked at the corner where it is largest), or with `msaa` at
+/// every point within half a pixel of one.
+fn touches(edges: &[super::setup::Edge; 3], r: TileRect, msaa: bool) -> bool {
     edges.iter().all(|e| {
         let px = if e.a > 0 { r.x1 - 1 } else { r.x0 } as i64;
         let py = if e.b > 0 { r.y1 - 1 } else { r.y0 } as i64;
-        e.at(px, py) + e.bias >= 0
+        let reach = if msaa { (e.a.abs() + e.b.abs()) / 2 } else { 0 };
+        e.at(px, py) + e.bias + reach >= 0
     })
 }

@@ -1,10 +1,138 @@
-//! Coverage: which pixel centers of a tile a triangle covers, with its depth
-//! there. The visibility pass runs the depth test before any shading: a tile
-//! ends with the nearest triangle id and depth per pixel, and every visible
-//! pixel is shaded exactly once afterwards.
+//! Coverage: which pixel centers (or, with MSAA, which samples) of a tile a
+//! triangle covers, with its depth there. The visibility pass runs the depth
+//! test before any shading: a tile ends with the nearest triangle id and
+//! depth per pixel (per sample), and every visible fragment is shaded
+//! exactly once afterwards.
 
 use super::bin::TileRect;
-use super::setup::Tri;
+use super::setup::{SUBPIXEL, Tri};
+
+/// The standard Direct3D sample positions for 1, 2, 4, 8 and 16 samples:
+/// offsets from the pixel center in 1/16 pixel, x right and y down (the
+/// D3D11_STANDARD_MULTISAMPLE_PATTERN, which Vulkan's standard locations
+/// repeat). None for other counts.
+pub fn sample_pattern(samples: u32) -> Option<&'static [(i8, i8)]> {
+    const P1: [(i8, i8); 1] = [(0, 0)];
+    const P2: [(i8, i8); 2] = [(4, 4), (-4, -4)];
+    const P4: [(i8, i8); 4] = [(-2, -6), (6, -2), (-6, 2), (2, 6)];
+    const P8: [(i8, i8); 8] = [
+        (1, -3),
+        (-1, 3),
+        (5, 1),
+        (-3, -5),
+        (-5, 5),
+        (-7, -1),
+        (3, 7),
+        (7, -7),
+    ];
+    const P16: [(i8, i8); 16] = [
+        (1, 1),
+        (-1, -3),
+        (-3, 2),
+        (4, -1),
+        (-5, -2),
+        (2, 5),
+        (5, 3),
+        (3, -5),
+        (-2, 6),
+        (0, -7),
+        (-4, -6),
+        (-6, 4),
+        (-8, 0),
+        (7, -4),
+        (6, 7),
+        (-7, -8),
+    ];
+    match samples {
+        1 => Some(&P1),
+        2 => Some(&P2),
+        4 => Some(&P4),
+        8 => Some(&P8),
+        16 => Some(&P16),
+        _ => None,
+    }
+}
+
+/// Most samples per pixel.
+pub const MAX_SAMPLES: usize = 16;
+
+/// Calls `visit(px, py, mask, z)` for every pixel of `rect` where `t`
+/// covers at least one sample of `pattern` (top-left rule at each sample):
+/// bit s of `mask` is set when sample s is covered, and `z[s]` is the
+/// depth there. `t` must come from a multisampling setup (its pixel bounds
+/// reach half a pixel further).
+#[inline]
+pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
+    t: &Tri,
+    rect: TileRect,
+    pattern: &[(i8, i8)],
+    mut visit: F,
+) {
+    let x0 = t.min_x.max(rect.x0);
+    let x1 = t.max_x.min(rect.x1 - 1);
+    let y0 = t.min_y.max(rect.y0);
+    let y1 = t.max_y.min(rect.y1 - 1);
+    if x0 > x1 || y0 > y1 {
+        return;
+    }
+    let n = pattern.len().min(MAX_SAMPLES);
+    let e = t.edges();
+    // Edge-function offsets of each sample from the pixel center: exact,
+    // as a and b are multiples of SUBPIXEL (a 1/16 pixel step is a/16).
+    let mut off = [[0i64; MAX_SAMPLES]; 3];
+    let mut reach = [i64::MIN; 3];
+    for k in 0..3 {
+        for (s, &(ox, oy)) in pattern.iter().take(n).enumerate() {
+            let o = (e[k].a * ox as i64 + e[k].b * oy as i64) / 16;
+            off[k][s] = o;
+            reach[k] = reach[k].max(o);
+        }
+    }
+    debug_assert!(e.iter().all(|e| e.a % SUBPIXEL == 0 && e.b % SUBPIXEL == 0));
+    let inv_area = 1.0 / t.area2 as f64;
+    let dz1 = ((t.z[1] - t.z[0]) as f64 * inv_area) as f32;
+    let dz2 = ((t.z[2] - t.z[0]) as f64 * inv_area) as f32;
+    let z0 = t.z[0];
+    let (x0l, y0l) = (x0 as i64, y0 as i64);
+    let mut row = [
+        e[0].at(x0l, y0l) + e[0].bias,
+        e[1].at(x0l, y0l) + e[1].bias,
+        e[2].at(x0l, y0l) + e[2].bias,
+    ];
+    let mut z = [0f32; MAX_SAMPLES];
+    for py in y0..=y1 {
+        let mut w = row;
+        let mut inside_seen = false;
+        for px in x0..=x1 {
+            // Some sample of the pixel can be inside every edge: the pixels
+            // passing this form a convex run along the row.
+            if w[0] + reach[0] >= 0 && w[1] + reach[1] >= 0 && w[2] + reach[2] >= 0 {
+                inside_seen = true;
+                let mut mask = 0u32;
+                for s in 0..n {
+                    let (a, b, c) = (w[0] + off[0][s], w[1] + off[1][s], w[2] + off[2][s]);
+                    if (a | b | c) >= 0 {
+                        mask |= 1 << s;
+                        let e1 = (b - e[1].bias) as f32;
+                        let e2 = (c - e[2].bias) as f32;
+                        z[s] = z0 + e1 * dz1 + e2 * dz2;
+                    }
+                }
+                if mask != 0 {
+                    visit(px, py, mask, &z);
+                }
+            } else if inside_seen {
+                break;
+            }
+            w[0] += e[0].a;
+            w[1] += e[1].a;
+            w[2] += e[2].a;
+        }
+        row[0] += e[0].b;
+        row[1] += e[1].b;
+        row[2] += e[2].b;
+    }
+}
 
 /// Calls `visit(px, py, z)` for every pixel center inside `rect` covered by
 /// `t` (top-left rule), row by row.
@@ -54,23 +182,31 @@ pub fn raster_triangle<F: FnMut(i32, i32, f32)>(t: &Tri, rect: TileRect, mut vis
 
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
-/// Depth and triangle id per pixel of one tile.
+/// Depth and triangle id per sample of one tile: `samples` consecutive
+/// entries per pixel, pixels row-major.
 pub struct Visibility {
     pub rect: TileRect,
+    /// The sample offsets (one entry, (0, 0), without MSAA).
+    pub pattern: &'static [(i8, i8)],
     pub depth: Vec<f32>,
     pub id: Vec<u32>,
 }
 
 impl Visibility {
-    pub fn new(rect: TileRect, reverse_z: bool) -> Visibility {
-        let n = rect.width() * rect.height();
+    pub fn new(rect: TileRect, reverse_z: bool, pattern: &'static [(i8, i8)]) -> Visibility {
+        let n = rect.width() * rect.height() * pattern.len();
         Visibility {
             rect,
+            pattern,
             // Reverse-Z clears to 0 (far) and keeps greater; standard clears
             // to 1 and keeps less.
             depth: vec![if reverse_z { 0.0 } else { 1.0 }; n],
             id: vec![NO_TRIANGLE; n],
         }
+    }
+
+    pub fn samples(&self) -> usize {
+        self.pattern.len()
     }
 
     /// Depth-tests triangle `id` into the tile. Equal depths keep the earlier
@@ -81,7 +217,8 @@ impl Visibility {
     }
 
     /// As `draw`, for pixels that also pass `keep(px, py)` (the alpha test
-    /// of cutout materials), asked only where the depth test passes.
+    /// of cutout materials, once per pixel), asked only where the depth
+    /// test passes.
     #[inline]
     pub fn draw_if<const REVERSE_Z: bool>(
         &mut self,
@@ -92,11 +229,29 @@ impl Visibility {
         let rect = self.rect;
         let stride = rect.width();
         let (depth, ids) = (&mut self.depth, &mut self.id);
-        raster_triangle(t, rect, |px, py, z| {
-            let i = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
-            if in_front(z, depth[i], REVERSE_Z) && keep(px, py) {
-                depth[i] = z;
-                ids[i] = id;
+        let n = self.pattern.len();
+        if n == 1 {
+            raster_triangle(t, rect, |px, py, z| {
+                let i = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
+                if in_front(z, depth[i], REVERSE_Z) && keep(px, py) {
+                    depth[i] = z;
+                    ids[i] = id;
+                }
+            });
+            return;
+        }
+        raster_samples(t, rect, self.pattern, |px, py, mask, z| {
+            let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * n;
+            let mut kept: Option<bool> = None;
+            for (s, &zs) in z.iter().enumerate().take(n) {
+                let i = base + s;
+                if mask & (1 << s) != 0
+                    && in_front(zs, depth[i], REVERSE_Z)
+                    && *kept.get_or_insert_with(|| keep(px, py))
+                {
+                    depth[i] = zs;
+                    ids[i] = id;
+                }
             }
         });
     }

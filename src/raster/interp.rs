@@ -59,6 +59,14 @@ impl Interpolator {
         self.finish(g)
     }
 
+    /// Whether the center of pixel (px, py) is inside the triangle (top-left
+    /// rule).
+    #[inline]
+    pub fn covers_center(&self, px: i32, py: i32) -> bool {
+        let (x, y) = (px as i64, py as i64);
+        self.edges.iter().all(|e| e.at(x, y) + e.bias >= 0)
+    }
+
     /// At any screen position (x, y) in pixels (pixel centers at +0.5).
     pub fn at(&self, x: f64, y: f64) -> Fragment {
         // E_k(x, y) = a (x - 1/2) + b (y - 1/2) + c, with a and b per pixel.
@@ -122,6 +130,7 @@ mod tests {
             Viewport {
                 width: 32,
                 height: 32,
+                msaa: false,
             },
             CullMode::None,
             0,

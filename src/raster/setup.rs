@@ -100,6 +100,9 @@ impl Tri {
 pub struct Viewport {
     pub width: u32,
     pub height: u32,
+    /// Multisampling: samples lie up to half a pixel from the pixel center,
+    /// so a triangle's pixel bounds reach half a pixel further.
+    pub msaa: bool,
 }
 
 impl Viewport {
@@ -161,11 +164,21 @@ pub fn setup(
     }
     let (lo_x, hi_x) = (*x.iter().min()? as i64, *x.iter().max()? as i64);
     let (lo_y, hi_y) = (*y.iter().min()? as i64, *y.iter().max()? as i64);
-    // Pixel px is a candidate when lo <= SUBPIXEL px + HALF <= hi.
-    let min_x = (lo_x - HALF + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
-    let max_x = (hi_x - HALF).div_euclid(SUBPIXEL).min(vp.width as i64 - 1);
-    let min_y = (lo_y - HALF + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
-    let max_y = (hi_y - HALF).div_euclid(SUBPIXEL).min(vp.height as i64 - 1);
+    // Pixel px is a candidate when lo <= SUBPIXEL px + HALF + o <= hi for
+    // a sample offset o: 0, or within half a pixel with MSAA.
+    let reach = if vp.msaa { HALF } else { 0 };
+    let min_x = (lo_x - HALF - reach + SUBPIXEL - 1)
+        .div_euclid(SUBPIXEL)
+        .max(0);
+    let max_x = (hi_x - HALF + reach)
+        .div_euclid(SUBPIXEL)
+        .min(vp.width as i64 - 1);
+    let min_y = (lo_y - HALF - reach + SUBPIXEL - 1)
+        .div_euclid(SUBPIXEL)
+        .max(0);
+    let max_y = (hi_y - HALF + reach)
+        .div_euclid(SUBPIXEL)
+        .min(vp.height as i64 - 1);
     if min_x > max_x || min_y > max_y {
         return None;
     }
@@ -203,6 +216,7 @@ mod tests {
         let vp = Viewport {
             width: 8,
             height: 8,
+            msaa: false,
         };
         let ccw = [cv(-1.0, -1.0), cv(1.0, -1.0), cv(-1.0, 1.0)];
         let t = setup(ccw, vp, CullMode::Back, 0, 0).unwrap();
@@ -218,6 +232,7 @@ mod tests {
         let vp = Viewport {
             width: 8,
             height: 8,
+            msaa: false,
         };
         let t = setup(
             [cv(-1.0, -1.0), cv(1.0, -1.0), cv(-1.0, 1.0)],

@@ -7,13 +7,21 @@
 //! centers (extrapolated where it does not cover them, "helper lanes"), and
 //! the differences across the quad's top row and left column are d/dx and
 //! d/dy ("coarse" derivatives).
+//!
+//! With MSAA, coverage and depth are per sample and each triangle present
+//! in a pixel is shaded once there: at the pixel center when the center is
+//! inside it, otherwise at the centroid of the samples it covers. The
+//! resolve averages the fragments' linear colors weighted by their sample
+//! counts, before tone mapping.
 
 use glam::{Vec2, Vec3, Vec4};
 
 use super::{Draw, FrameSetup, ModelVertices};
 use crate::assets::texture::Gradients;
 use crate::raster::bin::TileRect;
-use crate::raster::coverage::{NO_TRIANGLE, Visibility, in_front, raster_triangle};
+use crate::raster::coverage::{
+    MAX_SAMPLES, NO_TRIANGLE, Visibility, in_front, raster_samples, raster_triangle,
+};
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::desc::ShadingMode;
@@ -30,6 +38,8 @@ pub(super) struct FrameData<'a> {
     /// Per draw.
     pub alpha: &'a [AlphaMode],
     pub tris: &'a [Tri],
+    /// Sample offsets in 1/16 pixel; one entry without MSAA.
+    pub pattern: &'static [(i8, i8)],
     pub reverse: bool,
     pub bg: Vec4,
     /// Texture filtering needs derivatives (trilinear, anisotropic).
@@ -50,7 +60,7 @@ impl FrameData<'_> {
         ti: usize,
         bins: &[(&[Vec<u32>], u32)],
     ) -> (Visibility, Vec<u32>) {
-        let mut vis = Visibility::new(rect, self.reverse);
+        let mut vis = Visibility::new(rect, self.reverse, self.pattern);
         let mut blended = Vec::new();
         for (b, off) in bins {
             for &i in &b[ti] {
@@ -93,7 +103,11 @@ impl FrameData<'_> {
         color: &mut [Vec4],
         depth: &mut [f32],
     ) {
-        self.shade_visible(vis, ao, color, depth);
+        if vis.samples() > 1 {
+            self.shade_visible_msaa(vis, ao, color, depth);
+        } else {
+            self.shade_visible(vis, ao, color, depth);
+        }
         if !blended.is_empty() {
             self.blend(vis, blended, color);
         }
@@ -102,12 +116,28 @@ impl FrameData<'_> {
     /// The geometry buffer of a band: view depth, interpolated normal and
     /// geometric normal (both facing the camera) and position per pixel;
     /// depth +inf where nothing is visible.
+    /// With MSAA: of the triangle covering most samples of the pixel, at
+    /// its shading point.
     pub fn gbuffer(&self, vis: &Visibility, out: &mut [GPixel]) {
         let rect = vis.rect;
         let tw = rect.width();
+        let n = vis.samples();
         let mut cache = InterpolatorCache::default();
         for (i, g) in out.iter_mut().enumerate() {
-            let id = vis.id[i];
+            let (id, mask) = if n == 1 {
+                (vis.id[i], 1)
+            } else {
+                fragments(&vis.id[i * n..(i + 1) * n])
+                    .into_iter()
+                    .filter(|f| f.0 != NO_TRIANGLE)
+                    .fold((NO_TRIANGLE, 0u32), |best, f| {
+                        if f.1.count_ones() > best.1.count_ones() {
+                            f
+                        } else {
+                            best
+                        }
+                    })
+            };
             if id == NO_TRIANGLE {
                 *g = GPixel::EMPTY;
                 continue;
@@ -115,7 +145,7 @@ impl FrameData<'_> {
             let t = &self.tris[id as usize];
             let it = cache.get(id, t);
             let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
-            let frag = it.at_pixel(px, py);
+            let frag = self.shading_point(it, px, py, mask);
             let p = self.point(t, frag);
             *g = GPixel {
                 depth: p.view_depth,
@@ -206,6 +236,13 @@ impl FrameData<'_> {
             if self.reverse { -mean } else { mean }
         };
         ids.sort_by(|a, b| far_key(b).total_cmp(&far_key(a)).then(a.cmp(b)));
+        let n = vis.samples();
+        if n > 1 {
+            for id in ids {
+                self.blend_msaa(vis, id, color);
+            }
+            return;
+        }
         for id in ids {
             let t = &self.tris[id as usize];
             let it = Interpolator::new(t);
@@ -231,6 +268,140 @@ impl FrameData<'_> {
                 color[i] = (c * a + dst.truncate() * (1.0 - a)).extend(a + dst.w * (1.0 - a));
             });
         }
+    }
+
+    /// One blended triangle with MSAA: shaded once per pixel over the
+    /// samples where it is in front of the opaque surface, and composited
+    /// with its opacity times the fraction of samples it covers (exact
+    /// where the surface behind is one color).
+    fn blend_msaa(&self, vis: &Visibility, id: u32, color: &mut [Vec4]) {
+        let rect = vis.rect;
+        let tw = rect.width();
+        let n = vis.samples();
+        let t = &self.tris[id as usize];
+        let it = Interpolator::new(t);
+        raster_samples(t, rect, self.pattern, |px, py, mask, z| {
+            let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
+            let mut m = 0u32;
+            for (s, &zs) in z.iter().enumerate().take(n) {
+                if mask & (1 << s) != 0 && in_front(zs, vis.depth[i * n + s], self.reverse) {
+                    m |= 1 << s;
+                }
+            }
+            if m == 0 {
+                return;
+            }
+            let g = if self.grads {
+                self.gradients(t, &it, (px & !1, py & !1))
+            } else {
+                [Gradients::default(); 2]
+            };
+            let frag = self.shading_point(&it, px, py, m);
+            let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
+            let (mat, uv, vcolor) = self.material_uv(t, frag.lambda);
+            let tc = TexCoords { uv, grads: g };
+            let a = self.ctx.opacity(mat, &tc, vcolor).clamp(0.0, 1.0) * m.count_ones() as f32
+                / n as f32;
+            if !c.is_finite() {
+                return;
+            }
+            let dst = color[i];
+            color[i] = (c * a + dst.truncate() * (1.0 - a)).extend(a + dst.w * (1.0 - a));
+        });
+    }
+
+    /// Shades each pixel's fragments once (MSAA), quad by quad so that a
+    /// triangle's texture derivatives are computed once per quad, and
+    /// resolves: the fragments' colors weighted by their sample counts,
+    /// plus the background over the uncovered samples. Depth: the nearest
+    /// fragment's.
+    fn shade_visible_msaa(
+        &self,
+        vis: &Visibility,
+        ao: Option<&[f32]>,
+        color: &mut [Vec4],
+        depth: &mut [f32],
+    ) {
+        let rect = vis.rect;
+        let (tw, th) = (rect.width(), rect.height());
+        let n = vis.samples();
+        let inv_n = 1.0 / n as f32;
+        let mut cache = InterpolatorCache::default();
+        for qy in (0..th).step_by(2) {
+            for qx in (0..tw).step_by(2) {
+                let mut quad: smallvec::SmallVec<[(u32, [Gradients; 2]); 4]> =
+                    smallvec::SmallVec::new();
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (x, y) = (qx + dx, qy + dy);
+                    if x >= tw || y >= th {
+                        continue;
+                    }
+                    let i = y * tw + x;
+                    let ids = &vis.id[i * n..(i + 1) * n];
+                    if ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE) {
+                        color[i] = self.bg;
+                        depth[i] = f32::INFINITY;
+                        continue;
+                    }
+                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
+                    let occlusion = ao.map_or(1.0, |a| a[i]);
+                    let mut acc = Vec4::ZERO;
+                    let mut nearest = f32::INFINITY;
+                    for (id, mask) in fragments(ids) {
+                        let count = mask.count_ones() as f32;
+                        if id == NO_TRIANGLE {
+                            acc += self.bg * count;
+                            continue;
+                        }
+                        let t = &self.tris[id as usize];
+                        let it = cache.get(id, t);
+                        let g = if self.grads {
+                            match quad.iter().find(|q| q.0 == id) {
+                                Some(q) => q.1,
+                                None => {
+                                    let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
+                                    let g = self.gradients(t, it, q0);
+                                    quad.push((id, g));
+                                    g
+                                }
+                            }
+                        } else {
+                            [Gradients::default(); 2]
+                        };
+                        let frag = self.shading_point(it, px, py, mask);
+                        let (c, d) = self.shade(t, it, frag, (px, py), g, occlusion);
+                        let c = if c.is_finite() { c } else { Vec3::ZERO };
+                        acc += c.extend(1.0) * count;
+                        nearest = nearest.min(d);
+                    }
+                    color[i] = acc * inv_n;
+                    depth[i] = nearest;
+                }
+            }
+        }
+    }
+
+    /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
+    /// is interpolated: the pixel center when it is inside the triangle,
+    /// otherwise the centroid of the covered samples.
+    #[inline]
+    fn shading_point(&self, it: &Interpolator, px: i32, py: i32, mask: u32) -> Fragment {
+        if self.pattern.len() == 1 || it.covers_center(px, py) {
+            return it.at_pixel(px, py);
+        }
+        let (mut sx, mut sy, mut k) = (0i32, 0i32, 0i32);
+        for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
+            if mask & (1 << s) != 0 {
+                sx += ox as i32;
+                sy += oy as i32;
+                k += 1;
+            }
+        }
+        let k = (16 * k.max(1)) as f64;
+        it.at(
+            px as f64 + 0.5 + sx as f64 / k,
+            py as f64 + 0.5 + sy as f64 / k,
+        )
     }
 
     /// The material of `t`, its texture coordinates (both sets) and vertex
@@ -411,12 +582,28 @@ struct Point {
     view_depth: f32,
 }
 
+/// The distinct triangle ids among one pixel's samples, each with the mask
+/// of the samples it holds, in order of first sample.
+fn fragments(ids: &[u32]) -> smallvec::SmallVec<[(u32, u32); 4]> {
+    let mut out: smallvec::SmallVec<[(u32, u32); 4]> = smallvec::SmallVec::new();
+    debug_assert!(ids.len() <= MAX_SAMPLES);
+    for (s, &id) in ids.iter().enumerate() {
+        match out.iter_mut().find(|f| f.0 == id) {
+            Some(f) => f.1 |= 1 << s,
+            None => out.push((id, 1 << s)),
+        }
+    }
+    out
+}
+
 /// Screen-space distance (pixels) from the pixel center to the nearest edge
 /// of the original triangle: each barycentric over the length of its
 /// screen-space gradient.
 fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
-    let dx = it.at_pixel(px + 1, py).lambda - l;
-    let dy = it.at_pixel(px, py + 1).lambda - l;
+    // Gradients per pixel step; `l` may be off the center (MSAA centroid).
+    let c = it.at_pixel(px, py).lambda;
+    let dx = it.at_pixel(px + 1, py).lambda - c;
+    let dy = it.at_pixel(px, py + 1).lambda - c;
     let mut best = f32::INFINITY;
     for k in 0..3 {
         let g = Vec2::new(dx[k], dy[k]).length();

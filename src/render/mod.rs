@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
+use crate::raster::coverage::sample_pattern;
 use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
 use crate::raytrace::Tracer;
 use crate::scene::Scene;
@@ -160,14 +161,79 @@ pub fn render_setup(fs: &FrameSetup) -> Frame {
 }
 
 /// Renders into `frame`, reusing its buffers (resized to the scene's
-/// output size); every pixel is written.
+/// output size); every pixel is written. With supersampling the frame is
+/// rendered at `ssaa` times the size per axis and box-filtered down.
 pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
+    let s = &fs.scene.settings;
+    let k = s.ssaa.max(1);
+    if k == 1 {
+        render_at(fs, s.width, s.height, frame);
+        return;
+    }
+    let mut big = Frame::new(0, 0);
+    render_at(fs, s.width * k, s.height * k, &mut big);
+    downsample(&big, k, frame);
+}
+
+/// Box filter of `k` x `k` blocks: the mean color (linear, before tone
+/// mapping) and AO, the nearest depth.
+fn downsample(big: &Frame, k: u32, out: &mut Frame) {
+    let (w, h) = (big.width / k, big.height / k);
+    out.resize(w, h);
+    let k = k as usize;
+    let bw = big.width as usize;
+    let inv = 1.0 / (k * k) as f32;
+    let has_ao = !big.ao.is_empty();
+    if has_ao {
+        out.ao.resize(w as usize * h as usize, 1.0);
+    } else {
+        out.ao.clear();
+    }
+    let w = w as usize;
+    out.color
+        .par_chunks_mut(w)
+        .zip(out.depth.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (color, depth))| {
+            for x in 0..w {
+                let mut c = Vec4::ZERO;
+                let mut d = f32::INFINITY;
+                for sy in 0..k {
+                    let row = (y * k + sy) * bw + x * k;
+                    for sx in 0..k {
+                        c += big.color[row + sx];
+                        d = d.min(big.depth[row + sx]);
+                    }
+                }
+                color[x] = c * inv;
+                depth[x] = d;
+            }
+        });
+    if has_ao {
+        out.ao.par_chunks_mut(w).enumerate().for_each(|(y, ao)| {
+            for (x, a) in ao.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for sy in 0..k {
+                    let row = (y * k + sy) * bw + x * k;
+                    sum += big.ao[row..row + k].iter().sum::<f32>();
+                }
+                *a = sum * inv;
+            }
+        });
+    }
+}
+
+/// Renders the frame at `width` x `height` pixels.
+fn render_at(fs: &FrameSetup, width: u32, height: u32, frame: &mut Frame) {
     let scene = fs.scene;
     let s = &scene.settings;
-    frame.resize(s.width, s.height);
+    frame.resize(width, height);
+    let pattern = sample_pattern(s.msaa).unwrap_or(&[(0, 0)]);
+    let msaa = pattern.len() > 1;
     let vp = Viewport {
-        width: s.width,
-        height: s.height,
+        width,
+        height,
+        msaa,
     };
 
     // Vertex stage, then the shadow pass over the placed vertices.
@@ -207,7 +273,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
     }
 
     // Clip, set up and bin, chunk by chunk; merged in submission order.
-    let grid = TileGrid::bands(s.width, s.height);
+    let grid = TileGrid::bands(width, height);
     let (gx, gy) = vp.guard_band();
     let cull = s.cull;
     let filtered = matches!(
@@ -261,7 +327,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
                     }
                 }
             }
-            let bins = bin(&tris, &grid);
+            let bins = bin(&tris, &grid, msaa);
             (tris, bins, max_density)
         })
         .collect();
@@ -301,7 +367,9 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         .filter(|t| mips[t.id])
         .for_each(|t| t.ensure_mips());
 
-    let ctx = shade_context(fs, &mips, &shadows);
+    let mut ctx = shade_context(fs, &mips, &shadows);
+    // Wireframe lines keep their width in output pixels.
+    ctx.pixel_scale = width as f32 / s.width as f32;
     let alpha: Vec<AlphaMode> = draws
         .iter()
         .map(|d| scene.models[d.model].materials[d.material].alpha)
@@ -313,6 +381,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
         draws: &draws,
         alpha: &alpha,
         tris: &tris,
+        pattern,
         reverse: s.depth == DepthMode::ReverseZ,
         bg: background(s.background),
         grads: filtered,
@@ -353,7 +422,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
             (vis, blended)
         })
         .collect();
-    let view = AoView::new(&fs.camera, s.width, s.height);
+    let view = AoView::new(&fs.camera, width, height);
     frame.ao = match s.ao.method {
         AoMethod::Raytraced => {
             // Ray-traced shadows already placed the scene for this frame.
@@ -365,7 +434,7 @@ pub fn render_into(fs: &FrameSetup, frame: &mut Frame) {
                     &own
                 }
             };
-            ao::raytraced(tracer, &gbuf, s.width, s.ao.samples, s.ao.radius)
+            ao::raytraced(tracer, &gbuf, width, s.ao.samples, s.ao.radius)
         }
         _ => {
             let radius = s.ao.radius.unwrap_or(scene.bounds_radius * 0.2);
@@ -502,5 +571,6 @@ fn shade_context<'a>(
         mips,
         depth_range: (lo, hi),
         shadows,
+        pixel_scale: 1.0,
     }
 }

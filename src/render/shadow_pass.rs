@@ -202,6 +202,7 @@ fn render_map(
     let vp = Viewport {
         width: size,
         height: size,
+        msaa: false,
     };
     let (gx, gy) = vp.guard_band();
     let grid = TileGrid::bands(size, size);
@@ -245,7 +246,7 @@ fn render_map(
                     }
                 }
             }
-            let bins = bin(&tris, &grid);
+            let bins = bin(&tris, &grid, false);
             (tris, bins)
         })
         .collect();

@@ -32,8 +32,6 @@ pub struct LoadOptions {
     pub out_dir: Option<PathBuf>,
 }
 
-const WORKFLOW_ISSUE: &str = "it comes with anti-aliasing and GIF output";
-
 impl Scene {
     /// Reads, parses, validates and loads a scene file.
     pub fn load(path: &Path, opts: &LoadOptions) -> Result<Scene, Error> {
@@ -60,28 +58,6 @@ impl Scene {
 
 fn get<T: Clone>(v: &Option<S<T>>, default: T) -> T {
     v.as_ref().map(|s| s.get_ref().clone()).unwrap_or(default)
-}
-
-fn unsupported<T>(ctx: &Ctx, v: &S<T>, what: &str, note: &str) -> Error {
-    Error::Unsupported {
-        location: ctx.location(v.span()),
-        what: what.to_string(),
-        note: note.to_string(),
-    }
-}
-
-fn refuse_unsupported(d: &SceneDesc, ctx: &Ctx) -> Result<(), Error> {
-    let r = &d.render;
-    if let Some(m) = &r.msaa
-        && *m.get_ref() > 1
-    {
-        return Err(unsupported(ctx, m, "render.msaa > 1", WORKFLOW_ISSUE));
-    }
-    let o = &d.output;
-    if let Some(g) = &o.gif {
-        return Err(unsupported(ctx, g, "output.gif", WORKFLOW_ISSUE));
-    }
-    Ok(())
 }
 
 fn shadow_bias(r: &desc::RenderDesc) -> super::ShadowBias {
@@ -124,7 +100,6 @@ fn ao_settings(r: &desc::RenderDesc) -> super::AoSettings {
 }
 
 fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
-    refuse_unsupported(d, ctx)?;
     let scene_dir = ctx.file.parent().unwrap_or(Path::new("")).to_path_buf();
     let stem = ctx
         .file
@@ -150,6 +125,8 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
         shadow_bias: shadow_bias(r),
         ao: ao_settings(r),
+        msaa: get(&r.msaa, 1) as u32,
+        ssaa: get(&r.ssaa, 1) as u32,
     };
     if let Some(v) = &o.ao
         && *v.get_ref()
@@ -176,7 +153,18 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         color: get(&o.color, true),
         depth: get(&o.depth, false),
         ao: get(&o.ao, false),
+        gif: o.gif.as_ref().map(|g| g.get_ref().clone()),
+        gif_delay_ms: get(&o.gif_delay_ms, 40) as u32,
+        gif_dither: get(&o.gif_dither, Default::default()),
     };
+    if let (Some(g), Some(c)) = (&o.gif, &o.color)
+        && !*c.get_ref()
+    {
+        return Err(ctx.err(
+            g.span(),
+            "output.gif is assembled from the color frames: it needs output.color = true",
+        ));
+    }
 
     // Models: each file parsed once, even if several [[model]] use it.
     let textured = !matches!(

@@ -47,7 +47,23 @@ pub struct OutputDesc {
     pub ao: Option<S<bool>>,
     pub gif: Option<S<String>>,
     pub gif_delay_ms: Option<S<i64>>,
+    /// Extension: "none" (default), "ordered" or "floyd-steinberg".
+    pub gif_dither: Option<S<GifDither>>,
     pub background: Option<S<Background>>,
+}
+
+/// How GIF frames are dithered to the shared palette.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum GifDither {
+    /// Nearest palette color.
+    #[default]
+    None,
+    /// An 8x8 Bayer pattern: stable from frame to frame where the image is.
+    Ordered,
+    /// Error diffusion: smoothest gradients, but its noise moves with the
+    /// image.
+    FloydSteinberg,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,6 +162,9 @@ pub enum Tonemap {
 pub struct RenderDesc {
     pub shading: Option<S<ShadingMode>>,
     pub msaa: Option<S<i64>>,
+    /// Extension: supersampling, the frame rendered at this many times the
+    /// output size per axis and box-filtered down (default 1).
+    pub ssaa: Option<S<i64>>,
     pub texture_filter: Option<S<TextureFilter>>,
     pub max_anisotropy: Option<S<i64>>,
     pub address: Option<S<AddressMode>>,
@@ -448,6 +467,20 @@ impl SceneDesc {
                 ),
             ));
         }
+        c.int_range(&r.ssaa, "render.ssaa", 1, 16)?;
+        if let Some(k) = &r.ssaa {
+            let side = get_i64(&o.width, 800).max(get_i64(&o.height, 800));
+            if side * k.get_ref() > 16384 {
+                return Err(c.err(
+                    k.span(),
+                    format!(
+                        "render.ssaa = {}: the supersampled frame ({} px per side) may not exceed 16384",
+                        k.get_ref(),
+                        side * k.get_ref()
+                    ),
+                ));
+            }
+        }
         c.int_range(&r.max_anisotropy, "render.max_anisotropy", 1, 16)?;
         c.int_range(&r.shadow_map_size, "render.shadow_map_size", 16, 16384)?;
         c.float_range(&r.exposure, "render.exposure", -64.0, 64.0)?;
@@ -487,6 +520,10 @@ impl SceneDesc {
         }
         Ok(())
     }
+}
+
+fn get_i64(v: &Option<S<i64>>, default: i64) -> i64 {
+    v.as_ref().map(|v| *v.get_ref()).unwrap_or(default)
 }
 
 fn validate_model(c: &Ctx, m: &ModelDesc) -> Result<(), Error> {

@@ -47,6 +47,10 @@ pub struct RenderSettings {
     pub shadow_map_size: u32,
     pub shadow_bias: ShadowBias,
     pub ao: AoSettings,
+    /// Samples per pixel: 1, 2, 4, 8 or 16 (standard D3D positions).
+    pub msaa: u32,
+    /// Supersampling factor per axis (1: off).
+    pub ssaa: u32,
 }
 
 /// Shadow-map bias, in texels of the map at the receiver.
@@ -95,6 +99,11 @@ pub struct OutputSettings {
     pub depth: bool,
     /// `<name>_ao.exr`, channel `AO`.
     pub ao: bool,
+    /// The GIF's file name (in `dir`; `{camera}`, or `_<camera>` added
+    /// before the extension when the scene has several cameras).
+    pub gif: Option<String>,
+    pub gif_delay_ms: u32,
+    pub gif_dither: desc::GifDither,
 }
 
 #[derive(Debug, Clone)]

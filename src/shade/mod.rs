@@ -35,6 +35,9 @@ pub struct ShadeContext<'a> {
     pub depth_range: (f32, f32),
     /// This frame's shadow maps or ray tracer.
     pub shadows: &'a shadow::Shadows<'a>,
+    /// Rendered pixels per output pixel along an axis (the supersampling
+    /// factor): wireframe lines keep their width in output pixels.
+    pub pixel_scale: f32,
 }
 
 /// Texture coordinates of a point in both sets (None where the mesh has
@@ -107,8 +110,13 @@ impl ShadeContext<'_> {
                 Vec3::splat(1.0 - ((s.view_depth - lo) / (hi - lo)).clamp(0.0, 1.0))
             }
             ShadingMode::Wireframe => {
-                // A one-pixel line with a one-pixel soft edge, white on the fill.
-                let a = (1.5 - s.edge_distance).clamp(0.0, 1.0);
+                // Lines two output pixels wide centered on the edges (each
+                // triangle draws its half), box-filtered: the fraction of
+                // a pixel at distance d that lies within one pixel of the
+                // edge is clamp(1.5 - d). With MSAA the silhouettes are
+                // also filtered by sample coverage.
+                let d = s.edge_distance / self.pixel_scale;
+                let a = (1.5 - d).clamp(0.0, 1.0);
                 Vec3::splat(0.04).lerp(Vec3::ONE, a)
             }
             ShadingMode::Unlit => {
