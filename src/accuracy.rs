@@ -250,3 +250,136 @@ fn ao_error(got: &[Frame], reference: &[Frame]) -> (f64, f64) {
     }
     ((sum / n.max(1) as f64).sqrt(), worst)
 }
+
+/// One anti-aliasing setting's row of the edge-accuracy table.
+#[derive(Debug, Clone)]
+pub struct EdgeRow {
+    pub method: String,
+    /// Median frame time (render and resolve), milliseconds.
+    pub ms: f64,
+    /// Mean absolute error of linear RGB against the reference (the scene
+    /// is white on black and unlit, so this is the coverage error).
+    pub mae: f64,
+    /// Root-mean-square error of linear RGB.
+    pub rmse: f64,
+    /// Mean FLIP error of the 8-bit frames (`softraster compare`).
+    pub flip: f64,
+}
+
+/// The edge-accuracy scene, written into `dir`: white unlit shapes on
+/// black seen by an orthographic camera, each a known hard case for
+/// coverage: a star of 12 thin wedges meeting at a point, sub-pixel wires
+/// (0.2 to 0.6 pixels wide at 160x120) at three angles, and a sphere's
+/// silhouette. Returns the scene text with `{render}` for the settings.
+pub fn edge_scene(dir: &Path) -> Result<String, Error> {
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut star = String::from("# softraster edge-accuracy star (generated)\n");
+    let (cx, cy, r, wedges) = (-0.75f32, 0.05f32, 0.8f32, 24);
+    let _ = writeln!(star, "v {cx} {cy} 0");
+    for k in 0..=wedges {
+        let a = k as f32 / wedges as f32 * std::f32::consts::TAU;
+        let _ = writeln!(star, "v {} {} 0", cx + r * a.cos(), cy + r * a.sin());
+    }
+    for k in (0..wedges).step_by(2) {
+        let _ = writeln!(star, "f 1 {} {}", k + 2, k + 3);
+    }
+    let mut wires = String::from("# softraster edge-accuracy wires (generated)\n");
+    for (i, (deg, width)) in [(8.0f32, 0.004f32), (33.0, 0.008), (71.0, 0.012)]
+        .iter()
+        .enumerate()
+    {
+        let (s, c) = deg.to_radians().sin_cos();
+        let (ox, oy) = (0.35 + 0.35 * i as f32, -0.55);
+        let (hl, hw) = (0.55, width * 0.5);
+        let corners = [(-hl, -hw), (hl, -hw), (hl, hw), (-hl, hw)];
+        for (x, y) in corners {
+            let _ = writeln!(wires, "v {} {} 0", ox + x * c - y * s, oy + x * s + y * c);
+        }
+        let b = i * 4;
+        let _ = writeln!(wires, "f {} {} {}", b + 1, b + 2, b + 3);
+        let _ = writeln!(wires, "f {} {} {}", b + 1, b + 3, b + 4);
+    }
+    let sphere = crate::procedural::sphere(0.45, 64, 32)
+        .to_obj("sphere", "none.mtl", "m")
+        .text
+        .replace("mtllib none.mtl\n", "")
+        .replace("usemtl m\n", "");
+    for (name, text) in [
+        ("star.obj", star),
+        ("wires.obj", wires),
+        ("sphere.obj", sphere),
+    ] {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| Error::io(&p, e))?;
+    }
+    Ok("[output]\nwidth = {width}\nheight = {height}\n\
+        [render]\nshading = \"unlit\"\ncull = \"none\"\n{render}\n\
+        [[model]]\npath = \"star.obj\"\n[model.material]\nkd = [1.0, 1.0, 1.0]\n\
+        [[model]]\npath = \"wires.obj\"\n[model.material]\nkd = [1.0, 1.0, 1.0]\n\
+        [[model]]\npath = \"sphere.obj\"\ntranslate = [0.85, 0.3, 0.0]\n[model.material]\nkd = [1.0, 1.0, 1.0]\n\
+        [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.4\n"
+        .to_string())
+}
+
+/// MSAA 1, 2, 4, 8, 16 and SSAA 2x2, 4x4 on the edge scene at
+/// `width` x `height`, each against 16x16 supersampling (256 samples per
+/// pixel on a regular grid). Times are medians of `runs` renders. With
+/// `images`, every frame is also written there as PNG.
+pub fn edges(
+    dir: &Path,
+    width: u32,
+    height: u32,
+    runs: usize,
+    images: Option<&Path>,
+) -> Result<Vec<EdgeRow>, Error> {
+    let text = edge_scene(dir)?
+        .replace("{width}", &width.to_string())
+        .replace("{height}", &height.to_string());
+    let scene = |render: &str| load(dir, &text.replace("{render}", render));
+    let frames = vec![0; runs.max(1)];
+    let reference_scene = scene("ssaa = 16")?;
+    let (reference, _) = timed(&reference_scene, &[0]);
+    let reference_img = output::resolve(&reference[0], &reference_scene.settings);
+    let save = |name: &str, img: &output::Image8| -> Result<(), Error> {
+        match images {
+            Some(d) => output::png::write(&d.join(format!("{}.png", name.replace(' ', "_"))), img),
+            None => Ok(()),
+        }
+    };
+    save("reference_ssaa_16x16", &reference_img)?;
+    let mut rows = Vec::new();
+    let methods = [
+        ("msaa 1", "msaa = 1"),
+        ("msaa 2", "msaa = 2"),
+        ("msaa 4", "msaa = 4"),
+        ("msaa 8", "msaa = 8"),
+        ("msaa 16", "msaa = 16"),
+        ("ssaa 2x2", "ssaa = 2"),
+        ("ssaa 4x4", "ssaa = 4"),
+    ];
+    for (name, render) in methods {
+        let s = scene(render)?;
+        let (got, ms) = timed(&s, &frames);
+        let (mut abs, mut sq) = (0.0f64, 0.0f64);
+        for (a, b) in got[0].color.iter().zip(&reference[0].color) {
+            let d = (a.truncate() - b.truncate()).abs();
+            abs += d.element_sum() as f64 / 3.0;
+            sq += d.length_squared() as f64 / 3.0;
+        }
+        let n = got[0].color.len().max(1) as f64;
+        let img = output::resolve(&got[0], &s.settings);
+        save(name, &img)?;
+        let flip = output::compare::score(&reference_img, &img, output::compare::Metric::Flip)
+            .map_err(|e| Error::Argument(format!("edge accuracy: {e}")))?
+            .value;
+        rows.push(EdgeRow {
+            method: name.to_string(),
+            ms,
+            mae: abs / n,
+            rmse: (sq / n).sqrt(),
+            flip,
+        });
+    }
+    Ok(rows)
+}

@@ -24,8 +24,9 @@ pub struct BenchArgs {
     #[arg(long, default_value = "../shared/assets")]
     pub assets: PathBuf,
     /// Which workloads: diablo3, nefertiti, flighthelmet (glTF, pbr),
-    /// diablo3-4k, diablo3-4k-aniso, filters, shadows, ao (time and error
-    /// of each method, CSV), or all (the first three).
+    /// diablo3-4k, diablo3-4k-aniso, filters, shadows, ao, edges (time and
+    /// error of each method, CSV; edges at --size x 3/4 --size), or all
+    /// (the first three).
     #[arg(long, default_value = "all")]
     pub case: String,
     #[arg(long, default_value_t = 72)]
@@ -38,6 +39,9 @@ pub struct BenchArgs {
     /// Also write the frames as PNG here (to look at them).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// MSAA samples for the turntable cases (1, 2, 4, 8 or 16).
+    #[arg(long, default_value_t = 1)]
+    pub msaa: u32,
 }
 
 #[derive(Debug, Clone)]
@@ -52,7 +56,13 @@ pub struct BenchResult {
     pub png_ms: f64,
 }
 
-fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<String, Error> {
+fn scene_text(
+    case: &str,
+    assets: &Path,
+    size: u32,
+    frames: u32,
+    msaa: u32,
+) -> Result<String, Error> {
     let d3 = assets.join("tinyrenderer/diablo3_pose");
     let p = |p: PathBuf| -> Result<String, Error> {
         if !p.is_file() {
@@ -66,7 +76,7 @@ fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<Strin
     };
     let common = format!(
         "[output]\nwidth = {size}\nheight = {size}\nbackground = [0.02, 0.02, 0.025]\n\
-         [render]\ntexture_filter = \"bilinear\"\n[ambient]\ncolor = [0.06, 0.06, 0.07]\n\
+         [render]\nmsaa = {msaa}\ntexture_filter = \"bilinear\"\n[ambient]\ncolor = [0.06, 0.06, 0.07]\n\
          [animation]\nframes = {frames}\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = {} }}\n",
         5.0 * frames as f32
     );
@@ -109,7 +119,7 @@ fn scene_text(case: &str, assets: &Path, size: u32, frames: u32) -> Result<Strin
         }
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters, shadows, ao or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters, shadows, ao, edges or all"
             )));
         }
     })
@@ -174,7 +184,7 @@ fn anchor_lights(scene: &Scene) -> Vec<Light> {
 }
 
 pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
-    let text = scene_text(case, &args.assets, args.size, args.frames)?;
+    let text = scene_text(case, &args.assets, args.size, args.frames, args.msaa)?;
     let t0 = Instant::now();
     let mut scene = Scene::from_text(
         Path::new(&format!("bench-{case}.toml")),
@@ -234,6 +244,21 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         println!("filter,mean_abs_error_linear,ms_per_frame_320x240");
         for f in r? {
             println!("{},{:.5},{:.2}", f.filter, f.mean_error, f.ms);
+        }
+        return Ok(());
+    }
+    if args.case == "edges" {
+        let dir = std::env::temp_dir().join(format!("softraster-edges-{}", std::process::id()));
+        let pool = thread_pool(args)?;
+        let (w, h) = (args.size, args.size * 3 / 4);
+        let r = pool.install(|| crate::accuracy::edges(&dir, w, h, 5, args.out.as_deref()));
+        let _ = std::fs::remove_dir_all(&dir);
+        println!("method,ms_per_frame_{w}x{h},mae_linear,rmse_linear,flip_mean");
+        for row in r? {
+            println!(
+                "{},{:.2},{:.5},{:.5},{:.5}",
+                row.method, row.ms, row.mae, row.rmse, row.flip
+            );
         }
         return Ok(());
     }
