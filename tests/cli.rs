@@ -52,6 +52,24 @@ fn frames_are_byte_identical_whatever_the_thread_count() {
             .concat(),
             3,
         ),
+        (
+            "msaa-ssaa",
+            [
+                &shadows[..],
+                &[
+                    "render.msaa=8",
+                    "render.ssaa=2",
+                    "render.ao={method=\"ssao\"}",
+                ],
+            ]
+            .concat(),
+            3,
+        ),
+        (
+            "msaa-blend",
+            vec!["render.msaa=4", "model.1.material.d=0.5"],
+            1,
+        ),
     ] {
         let mut outputs = Vec::new();
         for threads in ["1", "4"] {

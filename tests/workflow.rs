@@ -1,0 +1,332 @@
+//! The turntable workflow end to end, through the binary: render-farm
+//! shards against one run, --skip-existing, JSON progress, frame lists,
+//! the GIF (decoded back), and `softraster compare` exit codes, reports and
+//! diff images.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_softraster"))
+}
+
+fn bin_path() -> &'static str {
+    env!("CARGO_BIN_EXE_softraster")
+}
+
+/// Runs the binary: exit status, stdout, stderr.
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The showcase as a 72-frame turntable, 5 degrees a frame, small and with
+/// MSAA 4 and a GIF, as a scene file in `dir`.
+fn turntable(dir: &Path) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("scenes/showcase.toml"))
+        .unwrap()
+        .replace("../assets/", &format!("{}/assets/", root.display()));
+    let text = format!(
+        "{text}\n",
+        text = text
+            .replace("width = 640", "width = 64")
+            .replace("height = 480", "height = 48")
+    );
+    let p = dir.join("turntable.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn listing(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+fn sets() -> Vec<&'static str> {
+    vec![
+        "--set",
+        "animation.frames=72",
+        "--set",
+        "animation.turntable={axis=[0.0,1.0,0.0],degrees=360.0}",
+        "--set",
+        "render.msaa=4",
+        "--set",
+        "output.gif=\"turntable.gif\"",
+        "--set",
+        "output.gif_delay_ms=60",
+    ]
+}
+
+#[test]
+fn four_shards_in_separate_processes_match_one_run() {
+    let dir = common::scratch("shards");
+    let scene = turntable(&dir);
+    let (one, sharded) = (dir.join("one"), dir.join("sharded"));
+
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        one.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend(sets());
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+
+    // Four shards as separate processes, four at a time (xargs -P), the
+    // way a farm or GNU parallel runs them.
+    let quoted: Vec<String> = sets().iter().map(|s| format!("'{s}'")).collect();
+    let script = format!(
+        "printf '0..18\\n18..36\\n36-53\\n54,55,56..72\\n' | xargs -P 4 -I RANGE '{}' render '{}' --out '{}' --frames RANGE --quiet {}",
+        bin_path(),
+        scene.display(),
+        sharded.display(),
+        quoted.join(" ")
+    );
+    let status = Command::new("sh").arg("-c").arg(&script).status().unwrap();
+    assert!(status.success(), "{script}");
+    // The shards each had part of the animation: no GIF yet.
+    assert!(!sharded.join("turntable.gif").exists());
+    let png_count = |d: &Path| {
+        listing(d)
+            .iter()
+            .filter(|(n, _)| n.ends_with(".png"))
+            .count()
+    };
+    assert_eq!(png_count(&sharded), 72);
+
+    // A final pass with --skip-existing renders nothing and writes the GIF.
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        sharded.to_str().unwrap(),
+        "--skip-existing",
+        "--progress",
+        "json",
+    ];
+    args.extend(sets());
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{l}: {e}")))
+        .collect();
+    let frames: Vec<_> = lines.iter().filter(|l| l["event"] == "frame").collect();
+    assert_eq!(frames.len(), 72);
+    for (i, f) in frames.iter().enumerate() {
+        assert_eq!(f["frame"], i as u64);
+        assert_eq!(f["skipped"], true);
+        assert!(f["seconds"].is_number());
+        assert_eq!(f["files"].as_array().unwrap().len(), 1);
+    }
+    assert!(lines.iter().any(|l| l["event"] == "gif"));
+
+    let (a, b) = (listing(&one), listing(&sharded));
+    assert_eq!(a.len(), 73, "72 frames and the GIF");
+    assert_eq!(
+        a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        b.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    for (fa, fb) in a.iter().zip(&b) {
+        assert!(fa.1 == fb.1, "{} differs between one run and shards", fa.0);
+    }
+
+    // The GIF decodes to 72 frames of the right size and delay, sharing
+    // one palette, looping forever.
+    let g = softraster::output::gif::decode(&one.join("turntable.gif")).unwrap();
+    assert_eq!((g.width, g.height), (64, 48));
+    assert_eq!(g.frames.len(), 72);
+    assert!(g.repeat_infinite);
+    assert!(g.global_palette.as_ref().is_some_and(|p| p.len() >= 3 * 64));
+    assert!(g.frames.iter().all(|&(delay, local)| delay == 6 && !local));
+
+    // `softraster gif` on the same PNGs writes the same bytes.
+    let pngs: Vec<String> = (0..72)
+        .map(|f| one.join(format!("front_{f:04}.png")).display().to_string())
+        .collect();
+    let again = dir.join("again.gif");
+    let mut args = vec!["gif"];
+    args.extend(pngs.iter().map(|s| s.as_str()));
+    args.extend(["-o", again.to_str().unwrap(), "--delay-ms", "60"]);
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read(&again).unwrap() == std::fs::read(one.join("turntable.gif")).unwrap());
+}
+
+#[test]
+fn frame_lists_and_skip_existing() {
+    let dir = common::scratch("frame_lists");
+    let scene = turntable(&dir);
+    let out = dir.join("out");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--progress",
+            "json",
+        ];
+        args.extend(extra);
+        run(&args)
+    };
+    let (code, json, err) = render(&["--frames", "1-3,7"]);
+    assert_eq!(code, 0, "{err}");
+    let names: Vec<_> = listing(&out).into_iter().map(|f| f.0).collect();
+    assert_eq!(
+        names,
+        [
+            "front_0001.png",
+            "front_0002.png",
+            "front_0003.png",
+            "front_0007.png"
+        ]
+    );
+    assert_eq!(json.lines().count(), 4);
+    // The frames exist: only frame 4 is rendered.
+    let (code, json, _) = render(&["--frames", "2..5", "--skip-existing"]);
+    assert_eq!(code, 0);
+    let skipped: Vec<bool> = json
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["skipped"] == true)
+        .collect();
+    assert_eq!(skipped, [true, true, false]);
+    for bad in ["5..5", "70..80", "x", "3-1", "1,,2"] {
+        let (code, _, err) = render(&["--frames", bad]);
+        assert_eq!(code, 2, "--frames {bad}: {err}");
+        assert!(err.contains("--frames"), "{err}");
+    }
+}
+
+/// Writes an RGB PNG of 96x64 made by `f`.
+fn png(path: &Path, f: impl Fn(u32, u32) -> [u8; 3]) {
+    let img = image::RgbImage::from_fn(96, 64, |x, y| image::Rgb(f(x, y)));
+    img.save(path).unwrap();
+}
+
+#[test]
+fn compare_exit_codes_reports_and_diff_images() {
+    let dir = common::scratch("compare");
+    let base = |x: u32, y: u32| [(x * 2) as u8, (y * 3) as u8, 120];
+    let (r, same, slight, very) = (
+        dir.join("ref.png"),
+        dir.join("same.png"),
+        dir.join("slight.png"),
+        dir.join("very.png"),
+    );
+    png(&r, base);
+    png(&same, base);
+    // Two levels brighter in a 16x16 block: below the default threshold.
+    png(&slight, |x, y| {
+        let mut p = base(x, y);
+        if (40..56).contains(&x) && (20..36).contains(&y) {
+            p[1] += 2;
+        }
+        p
+    });
+    png(&very, |x, y| [255 - (x * 2) as u8, 30, (y * 3) as u8]);
+    let cmp = |test: &Path, extra: &[&str]| {
+        let mut args = vec!["compare", r.to_str().unwrap(), test.to_str().unwrap()];
+        args.extend(extra);
+        run(&args)
+    };
+    assert_eq!(cmp(&same, &[]).0, 0);
+    assert_eq!(cmp(&slight, &[]).0, 0);
+    assert_eq!(cmp(&very, &[]).0, 1);
+    // The threshold decides: the slight difference fails a strict one.
+    assert_eq!(cmp(&slight, &["--threshold", "0.00001"]).0, 1);
+    for metric in ["ssim", "psnr", "mae"] {
+        assert_eq!(cmp(&same, &["--metric", metric]).0, 0, "{metric}");
+        assert_eq!(cmp(&slight, &["--metric", metric]).0, 0, "{metric}");
+        assert_eq!(cmp(&very, &["--metric", metric]).0, 1, "{metric}");
+    }
+    // A missing file fails (1); an unreadable one is an error (2); so is a
+    // bad metric.
+    assert_eq!(cmp(&dir.join("nope.png"), &[]).0, 1);
+    let corrupt = dir.join("corrupt.png");
+    std::fs::write(&corrupt, b"not a png").unwrap();
+    assert_eq!(cmp(&corrupt, &[]).0, 2);
+    assert_eq!(cmp(&same, &["--metric", "nope"]).0, 2);
+
+    // JSON report and the diff image: bright in the changed block only.
+    let diff = dir.join("diff.png");
+    let (code, out, _) = cmp(
+        &slight,
+        &[
+            "--json",
+            "--diff",
+            diff.to_str().unwrap(),
+            "--metric",
+            "mae",
+        ],
+    );
+    assert_eq!(code, 0);
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(report["metric"], "mae");
+    assert_eq!(report["pass"], true);
+    assert_eq!(report["files"][0]["status"], "pass");
+    let d = image::open(&diff).unwrap().to_rgb8();
+    let brightness = |x: u32, y: u32| d.get_pixel(x, y).0.iter().map(|&v| v as u32).sum::<u32>();
+    for y in 0..64 {
+        for x in 0..96 {
+            let inside = (40..56).contains(&x) && (20..36).contains(&y);
+            assert_eq!(brightness(x, y) > 20, inside, "diff at ({x}, {y})");
+        }
+    }
+
+    // Directories: paired by name; a missing and an extra file fail.
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    for d in [&a, &b] {
+        png(&d.join("f0.png"), base);
+        png(&d.join("f1.png"), base);
+    }
+    let dirs = |extra: &[&str]| {
+        let mut args = vec!["compare", a.to_str().unwrap(), b.to_str().unwrap()];
+        args.extend(extra);
+        run(&args)
+    };
+    assert_eq!(dirs(&[]).0, 0);
+    png(&b.join("f2.png"), base);
+    let (code, out, _) = dirs(&["--json"]);
+    assert_eq!(code, 1);
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(report["files"][2]["status"], "extra");
+    std::fs::remove_file(b.join("f2.png")).unwrap();
+    std::fs::remove_file(b.join("f1.png")).unwrap();
+    let (code, out, _) = dirs(&[]);
+    assert_eq!(code, 1);
+    assert!(out.contains("MISSING f1.png"), "{out}");
+    let diffs = dir.join("diffs");
+    png(&b.join("f1.png"), |x, y| {
+        [255 - (x * 2) as u8, 30, (y * 3) as u8]
+    });
+    let (code, out, _) = dirs(&["--diff", diffs.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("FAIL f1.png") && out.contains("PASS f0.png"),
+        "{out}"
+    );
+    assert!(diffs.join("f0.png").is_file() && diffs.join("f1.png").is_file());
+}
