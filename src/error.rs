@@ -49,15 +49,6 @@ pub enum Error {
     #[error("{file}: {message}")]
     SceneGlobal { file: PathBuf, message: String },
 
-    /// A feature the scene format defines but this build does not implement
-    /// yet. Never silently ignored.
-    #[error("{location}: {what} is not supported yet ({note})")]
-    Unsupported {
-        location: Location,
-        what: String,
-        note: String,
-    },
-
     /// A model, material library or texture that cannot be read or is
     /// malformed. `line` is set when the format is text and the line is known.
     #[error("{}{}: {message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
@@ -91,7 +82,6 @@ impl Error {
         match self {
             Error::Scene { .. }
             | Error::SceneGlobal { .. }
-            | Error::Unsupported { .. }
             | Error::Asset { .. }
             | Error::Argument(_) => 2,
             Error::Io { .. } | Error::Encode { .. } => 1,

@@ -167,7 +167,15 @@ fn four_shards_in_separate_processes_match_one_run() {
     let again = dir.join("again.gif");
     let mut args = vec!["gif"];
     args.extend(pngs.iter().map(|s| s.as_str()));
-    args.extend(["-o", again.to_str().unwrap(), "--delay-ms", "60"]);
+    // (The showcase scene dithers with Floyd-Steinberg.)
+    args.extend([
+        "-o",
+        again.to_str().unwrap(),
+        "--delay-ms",
+        "60",
+        "--dither",
+        "floyd-steinberg",
+    ]);
     let (code, _, err) = run(&args);
     assert_eq!(code, 0, "{err}");
     assert!(std::fs::read(&again).unwrap() == std::fs::read(one.join("turntable.gif")).unwrap());
@@ -329,4 +337,60 @@ fn compare_exit_codes_reports_and_diff_images() {
         "{out}"
     );
     assert!(diffs.join("f0.png").is_file() && diffs.join("f1.png").is_file());
+}
+
+#[test]
+fn gifs_per_camera_and_their_keys_are_checked() {
+    let dir = common::scratch("gif_cameras");
+    let scene = turntable(&dir);
+    let text = std::fs::read_to_string(&scene).unwrap()
+        + "\n[[camera]]\nname = \"top\"\neye = [0.0, 6.0, 0.5]\ntarget = [0.0, 0.0, 0.0]\n";
+    std::fs::write(&scene, text).unwrap();
+    let render = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out,
+            "--quiet",
+            "--set",
+            "animation.frames=3",
+        ];
+        args.extend(extra);
+        run(&args)
+    };
+    let out = dir.join("a");
+    let (code, _, err) = render(out.to_str().unwrap(), &["--set", "output.gif=\"t.gif\""]);
+    assert_eq!(code, 0, "{err}");
+    for cam in ["front", "top"] {
+        let g = softraster::output::gif::decode(&out.join(format!("t_{cam}.gif"))).unwrap();
+        assert_eq!((g.width, g.height, g.frames.len()), (64, 48, 3));
+    }
+    let out = dir.join("b");
+    let (code, _, err) = render(
+        out.to_str().unwrap(),
+        &[
+            "--set",
+            "output.gif=\"{camera}-spin.gif\"",
+            "--camera",
+            "top",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.join("top-spin.gif").is_file() && !out.join("front-spin.gif").exists());
+    // The GIF is made of the PNGs: without them it is an error at the key.
+    let (code, _, err) = render(
+        dir.join("c").to_str().unwrap(),
+        &["--set", "output.color=false"],
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("output.gif") && err.contains("turntable.toml:"),
+        "{err}"
+    );
+    let (code, _, err) = render(
+        dir.join("c").to_str().unwrap(),
+        &["--set", "output.gif_delay_ms=5"],
+    );
+    assert_eq!(code, 2, "{err}");
 }
