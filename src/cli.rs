@@ -33,6 +33,9 @@ enum Command {
     /// Compare two images, or two directories of images paired by name.
     /// Exit status: 0 pass, 1 fail (or a missing/extra file), 2 error.
     Compare(CompareArgs),
+    /// Time against error of every method (anti-aliasing, texture filter,
+    /// shadows, AO, depth mode) on one frame of a scene: CSV and chart.
+    Chart(ChartArgs),
     /// Time the reference turntables (load, per-frame, total).
     Bench(softraster::bench::BenchArgs),
     /// Write the procedural showcase assets (meshes, textures) to a directory.
@@ -78,6 +81,33 @@ struct RenderArgs {
 enum Progress {
     Auto,
     Json,
+}
+
+#[derive(clap::Args)]
+struct ChartArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// The frame to measure.
+    #[arg(long, default_value_t = 0)]
+    frame: u32,
+    /// Where chart.csv, chart.png and chart.svg go (default out/<stem>-chart).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Timed renders per setting (fewer for settings that take seconds).
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
+    /// Comma-separated knobs: aa, texture, shadows, ao, depth (default all).
+    #[arg(long)]
+    knobs: Option<String>,
+    /// Fewer settings and smaller references (a quick look, and the tests).
+    #[arg(long)]
+    quick: bool,
+    /// Override a scene key (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    sets: Vec<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -128,6 +158,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Gif(args) => gif(args),
+        Command::Chart(args) => chart(args),
         Command::Compare(args) => return compare(args),
         Command::Bench(args) => softraster::bench::run(&args),
         Command::GenerateAssets { dir } => softraster::procedural::write_showcase_assets(&dir),
@@ -180,6 +211,101 @@ fn compare(args: CompareArgs) -> i32 {
             e.exit_code()
         }
     }
+}
+
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err(Error::Argument("--threads must be at least 1".into()));
+        }
+        builder = builder.num_threads(n);
+    }
+    builder
+        .build()
+        .map_err(|e| Error::Argument(format!("cannot start {threads:?} threads: {e}")))
+}
+
+fn chart(args: ChartArgs) -> Result<(), Error> {
+    use softraster::chart::{self, ChartOptions, Knob};
+    let knobs = match &args.knobs {
+        None => Knob::ALL.to_vec(),
+        Some(list) => list
+            .split(',')
+            .map(|k| {
+                Knob::parse(k.trim()).ok_or_else(|| {
+                    Error::Argument(format!(
+                        "--knobs {list}: `{k}` is not one of aa, texture, shadows, ao, depth"
+                    ))
+                })
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    if args.runs == 0 {
+        return Err(Error::Argument("--runs must be at least 1".into()));
+    }
+    let sets = args
+        .sets
+        .iter()
+        .map(|s| s.parse::<SetOverride>())
+        .collect::<Result<Vec<_>, _>>()?;
+    let opts = LoadOptions {
+        sets,
+        out_dir: None,
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| chart::default_out(&args.scene));
+    let pool = thread_pool(args.threads)?;
+    pool.install(|| {
+        let mut scene = Scene::load(&args.scene, &opts)?;
+        let title = format!(
+            "{} frame {}, {}x{}, {} thread(s): time against error",
+            args.scene
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            args.frame,
+            scene.settings.width,
+            scene.settings.height,
+            rayon::current_num_threads()
+        );
+        eprintln!("{title}");
+        let rows = chart::run(
+            &mut scene,
+            &ChartOptions {
+                frame: args.frame,
+                runs: args.runs,
+                knobs,
+                quick: args.quick,
+            },
+            &out,
+            &title,
+        )?;
+        println!("| knob | setting | ms (median, min-max) | error | pareto |");
+        println!("|---|---|---|---|---|");
+        for r in &rows {
+            println!(
+                "| {} | {}{}{} | {:.1} ({:.1}-{:.1}) | {:.5} {} | {} |",
+                r.knob.name(),
+                r.setting,
+                if r.default { " (default)" } else { "" },
+                if r.reference { " (reference)" } else { "" },
+                r.time.median_ms,
+                r.time.min_ms,
+                r.time.max_ms,
+                r.error,
+                r.knob.metric(),
+                if r.pareto { "yes" } else { "" }
+            );
+        }
+        eprintln!(
+            "wrote {}, chart.png and chart.svg",
+            out.join("chart.csv").display()
+        );
+        Ok(())
+    })
 }
 
 fn gif(args: GifArgs) -> Result<(), Error> {

@@ -9,6 +9,7 @@ pub mod accuracy;
 pub mod assets;
 pub mod batch;
 pub mod bench;
+pub mod chart;
 pub mod error;
 pub mod output;
 pub mod procedural;
