@@ -42,6 +42,12 @@ pub struct BenchArgs {
     /// MSAA samples for the turntable cases (1, 2, 4, 8 or 16).
     #[arg(long, default_value_t = 1)]
     pub msaa: u32,
+    /// Instead of timing, write the case's scene (with its lights) to this
+    /// file, e.g. for `softraster chart`. Also `--case bunny-plane`: the
+    /// Stanford bunny on a plane under a directional light that casts
+    /// shadows.
+    #[arg(long)]
+    pub write_scene: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone)]
@@ -236,7 +242,72 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     })
 }
 
+/// TOML for `lights` (the ones the benchmark sets in code).
+fn lights_toml(lights: &[Light]) -> String {
+    let v = |v: Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+    let mut s = String::new();
+    for l in lights {
+        s.push_str("\n[[light]]\n");
+        match l.kind {
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => s.push_str(&format!(
+                "kind = \"directional\"\ndirection = {}\nirradiance = {irradiance}\n",
+                v(direction)
+            )),
+            LightKind::Point {
+                position,
+                intensity,
+            } => s.push_str(&format!(
+                "kind = \"point\"\nposition = {}\nintensity = {intensity}\n",
+                v(position)
+            )),
+            _ => continue,
+        }
+        s.push_str(&format!("color = {}\n", v(l.color)));
+        if l.shadows {
+            s.push_str("shadows = true\n");
+        }
+    }
+    s
+}
+
+/// Writes the scene of `args.case` to `path` (absolute model paths).
+fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    // The scene lives elsewhere: model paths must not depend on the cwd.
+    let assets = std::fs::canonicalize(&args.assets).map_err(|e| Error::io(&args.assets, e))?;
+    let args = &BenchArgs {
+        assets,
+        ..args.clone()
+    };
+    let text = if args.case == "bunny-plane" {
+        let (name, model, eye) = crate::accuracy::AO_SCENES[0];
+        debug_assert!(name.starts_with("bunny"));
+        let (text, _) =
+            crate::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
+        text.replace("ao = {ao}", "msaa = 1")
+            + "\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, -0.8, -0.35]\nirradiance = 2.0\nshadows = true\n\
+               \n[ambient]\ncolor = [0.08, 0.08, 0.09]\n"
+    } else {
+        let text = scene_text(&args.case, &args.assets, args.size, args.frames, args.msaa)?;
+        let scene = Scene::from_text(path, &text, &LoadOptions::default())?;
+        text + &lights_toml(&anchor_lights(&scene))
+    };
+    crate::output::write_atomic(path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| Error::io(path, e))
+    })?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
 pub fn run(args: &BenchArgs) -> Result<(), Error> {
+    if let Some(p) = &args.write_scene {
+        return write_scene(args, p);
+    }
     if args.case == "filters" {
         let dir = std::env::temp_dir().join(format!("softraster-filters-{}", std::process::id()));
         let r = filter_accuracy(&dir, 320, 240);

@@ -107,12 +107,17 @@ fn reduced_sweep_has_its_shape_and_references_score_zero() {
     };
     assert!(depth("standard") > 0.2 && depth("reverse-z") == 0.0);
     // Pareto flags: a row is on the front exactly when no row of its knob
-    // is at least as fast and as accurate, and better in one.
+    // and reference is at least as fast and as accurate, and better in one.
     for r in &rows {
         let (t, e): (f64, f64) = (r[4].parse().unwrap(), r[8].parse().unwrap());
         let dominated = rows.iter().any(|o| {
             let (ot, oe): (f64, f64) = (o[4].parse().unwrap(), o[8].parse().unwrap());
-            o[0] == r[0] && o[1] != r[1] && ot <= t && oe <= e && (ot < t || oe < e)
+            o[0] == r[0]
+                && o[11] == r[11]
+                && o[1] != r[1]
+                && ot <= t
+                && oe <= e
+                && (ot < t || oe < e)
         });
         assert_eq!(r[10] == "true", !dominated, "{r:?}");
     }

@@ -37,7 +37,11 @@ fn frames_are_byte_identical_whatever_the_thread_count() {
         ("plain", vec![], 1),
         (
             "pcf-ssao",
-            [&shadows[..], &["render.ao={method=\"ssao\"}"]].concat(),
+            [
+                &shadows[..],
+                &["render.shadows=\"pcf\"", "render.ao={method=\"ssao\"}"],
+            ]
+            .concat(),
             3,
         ),
         (

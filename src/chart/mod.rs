@@ -95,8 +95,9 @@ pub struct Row {
     pub error: f64,
     /// What the error was measured against.
     pub against: String,
-    /// Not dominated within its knob (no other setting is at least as fast
-    /// and at least as accurate, and better in one).
+    /// Not dominated among the settings of its knob measured against the
+    /// same reference (no other is at least as fast and at least as
+    /// accurate, and better in one). AO has one reference per radius.
     pub pareto: bool,
 }
 
@@ -212,13 +213,14 @@ fn ao_rmse(got: &Frame, reference: &Frame, rays: u32) -> (f64, f64) {
     ((sum / n).sqrt(), (var / n).sqrt())
 }
 
-/// Marks each knob's Pareto front.
+/// Marks the Pareto front of each knob and reference.
 fn mark_pareto(rows: &mut [Row]) {
     for i in 0..rows.len() {
         let r = &rows[i];
         let dominated = rows.iter().enumerate().any(|(j, o)| {
             j != i
                 && o.knob == r.knob
+                && o.against == r.against
                 && o.time.median_ms <= r.time.median_ms
                 && o.error <= r.error
                 && (o.time.median_ms < r.time.median_ms || o.error < r.error)
@@ -352,7 +354,7 @@ fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     let settings: &[(TextureFilter, f32, &str)] = if opts.quick {
         &[
             (TextureFilter::Nearest, 1.0, "nearest"),
-            (TextureFilter::Trilinear, 1.0, "trilinear"),
+            (TextureFilter::Anisotropic, 16.0, "anisotropic 16"),
         ]
     } else {
         &[
@@ -372,7 +374,7 @@ fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
         let (f, img, t) = timed(scene, opts.frame, opts.runs);
         let m = mask.get_or_insert_with(|| interior_mask(&f));
         let e = flip(&reference, &img, Some(m))?;
-        let default = filter == TextureFilter::Trilinear;
+        let default = filter == TextureFilter::Anisotropic && aniso == 16.0;
         rows.push(row(Knob::Texture, name, default, false, t, e, &against));
     }
     Ok(())
@@ -396,7 +398,7 @@ fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     let (_, reference, t) = timed(scene, opts.frame, opts.runs);
     let against = format!("raytraced{note}");
     let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference, img, None))?;
-    rows.push(row(Knob::Shadows, "raytraced", false, true, t, e, &against));
+    rows.push(row(Knob::Shadows, "raytraced", true, true, t, e, &against));
     let sizes: &[u32] = if opts.quick {
         &[512, 2048]
     } else {
@@ -408,11 +410,10 @@ fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
             scene.settings.shadow_map_size = size;
             let (_, img, t) = timed(scene, opts.frame, opts.runs);
             let e = flip(&reference, &img, None)?;
-            let default = method == ShadowMethod::Pcf && size == 2048;
             rows.push(row(
                 Knob::Shadows,
                 format!("{name} {size}"),
-                default,
+                false,
                 false,
                 t,
                 e,

@@ -110,19 +110,28 @@ where
             .map_err(|e| err(&e))?
             .label(label(k))
             .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
-        // Pareto front: a dashed staircase through the non-dominated points.
-        let mut front: Vec<(f64, f64)> = ks.iter().filter(|r| r.pareto).map(|r| at(r)).collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut stairs = Vec::new();
-        for (i, p) in front.iter().enumerate() {
-            if i > 0 {
-                stairs.push((p.0, front[i - 1].1));
+        // Pareto fronts (one per reference: AO has one per radius): dashed
+        // staircases through the non-dominated points.
+        let mut groups: Vec<&str> = ks.iter().map(|r| r.against.as_str()).collect();
+        groups.dedup();
+        for g in groups {
+            let mut front: Vec<(f64, f64)> = ks
+                .iter()
+                .filter(|r| r.pareto && r.against == g)
+                .map(|r| at(r))
+                .collect();
+            front.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut stairs = Vec::new();
+            for (i, p) in front.iter().enumerate() {
+                if i > 0 {
+                    stairs.push((p.0, front[i - 1].1));
+                }
+                stairs.push(*p);
             }
-            stairs.push(*p);
+            chart
+                .draw_series(DashedLineSeries::new(stairs, 6, 4, c.stroke_width(2)))
+                .map_err(|e| err(&e))?;
         }
-        chart
-            .draw_series(DashedLineSeries::new(stairs, 6, 4, c.stroke_width(2)))
-            .map_err(|e| err(&e))?;
         // Time spread bars.
         chart
             .draw_series(ks.iter().map(|r| {
