@@ -286,8 +286,7 @@ fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
     let text = if args.case == "bunny-plane" {
         let (name, model, eye) = crate::accuracy::AO_SCENES[0];
         debug_assert!(name.starts_with("bunny"));
-        let (text, _) =
-            crate::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
+        let (text, _) = crate::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
         text.replace("ao = {ao}", "msaa = 1")
             + "\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, -0.8, -0.35]\nirradiance = 2.0\nshadows = true\n\
                \n[ambient]\ncolor = [0.08, 0.08, 0.09]\n"

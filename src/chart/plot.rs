@@ -1,6 +1,7 @@
 //! The chart: time (x, log) against error (y, log), one series per knob in
 //! the order of its settings, each knob's Pareto front as a dashed line,
-//! softraster's defaults ringed and labelled. Errors of 0 (the references,
+//! softraster's defaults ringed and labelled, the settings on a front
+//! named. Errors of 0 (the references,
 //! and exact settings) sit on the bottom edge as triangles. Drawn with
 //! plotters into a PNG (text in DejaVu Sans, embedded by the dejavu crate)
 //! and an SVG.
@@ -164,9 +165,10 @@ where
                     .map(|r| TriangleMarker::new(at(r), 7, c.filled())),
             )
             .map_err(|e| err(&e))?;
-        // Settings' names, and the default ringed.
+        // Names of the settings on a front and of the default (the
+        // dominated ones are in the CSV), and the default ringed.
         chart
-            .draw_series(ks.iter().map(|r| {
+            .draw_series(ks.iter().filter(|r| r.pareto || r.default).map(|r| {
                 let name = if r.default {
                     format!("{} (default)", r.setting)
                 } else {
