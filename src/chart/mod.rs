@@ -196,8 +196,11 @@ fn interior_mask(f: &Frame) -> Vec<bool> {
     m
 }
 
-/// RMSE of the AO buffers over the reference's covered pixels, and the
-/// reference's own noise: sqrt(mean p(1-p)/rays) for its `rays` rays.
+/// RMSE of the AO buffers over the reference's covered pixels, and a bound
+/// on the reference's own noise: sqrt(mean p(1-p)/rays), the RMSE of
+/// `rays` independent rays. Its rays are stratified (Hammersley), which is
+/// far less noisy: 1024 of them are within 0.0011 RMSE of the analytic AO
+/// in tests/shadows.rs, against a bound of about 0.01.
 fn ao_rmse(got: &Frame, reference: &Frame, rays: u32) -> (f64, f64) {
     let (mut sum, mut var, mut n) = (0.0f64, 0.0f64, 0usize);
     for i in 0..reference.ao.len().min(got.ao.len()) {
@@ -447,7 +450,8 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
         };
         let (reference, _, t) = timed(scene, opts.frame, 1);
         let (_, noise) = ao_rmse(&reference, &reference, rays);
-        let against = format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE {noise:.4})");
+        let against =
+            format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE below {noise:.4})");
         let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference, rays).0))?;
         rows.push(row(
             Knob::Ao,
