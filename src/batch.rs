@@ -49,6 +49,20 @@ pub struct JobSummary {
     pub gif_skipped: Option<String>,
 }
 
+/// A worker pool of `threads` threads (all cores when None).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err(Error::Argument("--threads must be at least 1".into()));
+        }
+        builder = builder.num_threads(n);
+    }
+    builder
+        .build()
+        .map_err(|e| Error::Argument(format!("cannot start {threads:?} threads: {e}")))
+}
+
 /// Frame selection for `--frames`: `a..b` (half-open), `a..` (to the end),
 /// `a-b` (inclusive), `n`, or a comma-separated list of those, e.g.
 /// `0..36` or `1-100,120`. The result is sorted and without repeats.
@@ -266,17 +280,18 @@ impl RenderJob {
                 }
                 let t0 = Instant::now();
                 render_into(&FrameSetup::new(scene, cam, frame), &mut buffer);
-                let stem = scene.file_stem(name, frame);
-                let file = |suffix: &str| scene.output.dir.join(format!("{stem}{suffix}"));
+                // The files in `frame_files` order: PNG, depth, AO.
+                let mut files = self.frame_files(cam, frame).into_iter();
+                let mut file = || files.next().unwrap_or_default();
                 let (width, height) = (buffer.width, buffer.height);
                 let mut outputs = Vec::new();
                 if scene.output.color {
                     let img = output::resolve(&buffer, &scene.settings);
-                    outputs.push(Output::Png(file(".png"), img));
+                    outputs.push(Output::Png(file(), img));
                 }
                 if scene.output.depth {
                     let z = buffer.depth.clone();
-                    outputs.push(Output::Exr(file("_depth.exr"), width, height, "Z", z));
+                    outputs.push(Output::Exr(file(), width, height, "Z", z));
                 }
                 if scene.output.ao {
                     let ao = if buffer.ao.is_empty() {
@@ -284,7 +299,7 @@ impl RenderJob {
                     } else {
                         buffer.ao.clone()
                     };
-                    outputs.push(Output::Exr(file("_ao.exr"), width, height, "AO", ao));
+                    outputs.push(Output::Exr(file(), width, height, "AO", ao));
                 }
                 let render_seconds = t0.elapsed().as_secs_f64();
                 let done = FrameDone {

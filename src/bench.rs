@@ -363,13 +363,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
 
 /// The worker pool `--threads` asks for (all cores by default).
 fn thread_pool(args: &BenchArgs) -> Result<rayon::ThreadPool, Error> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        builder = builder.num_threads(n.max(1));
-    }
-    builder
-        .build()
-        .map_err(|e| Error::Argument(format!("cannot start threads: {e}")))
+    crate::batch::thread_pool(args.threads)
 }
 
 /// `--case shadows | ao`: time and error of each method (CSV on stdout).

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use softraster::batch::{RenderJob, parse_frames};
+use softraster::batch::{RenderJob, parse_frames, thread_pool};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
@@ -213,19 +213,6 @@ fn compare(args: CompareArgs) -> i32 {
     }
 }
 
-fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        if n == 0 {
-            return Err(Error::Argument("--threads must be at least 1".into()));
-        }
-        builder = builder.num_threads(n);
-    }
-    builder
-        .build()
-        .map_err(|e| Error::Argument(format!("cannot start {threads:?} threads: {e}")))
-}
-
 fn chart(args: ChartArgs) -> Result<(), Error> {
     use softraster::chart::{self, ChartOptions, Knob};
     let knobs = match &args.knobs {
@@ -360,16 +347,7 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         sets,
         out_dir: args.out.clone(),
     };
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(Error::Argument("--threads must be at least 1".into()));
-        }
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| Error::Argument(format!("cannot start {:?} threads: {e}", args.threads)))?;
+    let pool = thread_pool(args.threads)?;
     pool.install(|| {
         let t0 = std::time::Instant::now();
         let scene = Scene::load(&args.scene, &opts)?;
