@@ -213,18 +213,20 @@ impl Visibility {
     /// triangle (submission order decides coplanar ties, deterministically).
     #[inline]
     pub fn draw<const REVERSE_Z: bool>(&mut self, t: &Tri, id: u32) {
-        self.draw_if::<REVERSE_Z>(t, id, |_, _| true);
+        self.draw_if::<REVERSE_Z>(t, id, |_, _, _| true);
     }
 
-    /// As `draw`, for pixels that also pass `keep(px, py)` (the alpha test
-    /// of cutout materials, once per pixel), asked only where the depth
-    /// test passes.
+    /// As `draw`, for samples that also pass `keep(px, py, offset)` (the
+    /// alpha test of cutout materials, at the sample: `offset` from the
+    /// pixel center in 1/16 pixel, (0, 0) without MSAA), asked only where
+    /// the depth test passes. With MSAA, cutout edges are thereby resolved
+    /// by coverage like triangle edges.
     #[inline]
     pub fn draw_if<const REVERSE_Z: bool>(
         &mut self,
         t: &Tri,
         id: u32,
-        mut keep: impl FnMut(i32, i32) -> bool,
+        mut keep: impl FnMut(i32, i32, (i8, i8)) -> bool,
     ) {
         let rect = self.rect;
         let stride = rect.width();
@@ -233,21 +235,21 @@ impl Visibility {
         if n == 1 {
             raster_triangle(t, rect, |px, py, z| {
                 let i = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
-                if in_front(z, depth[i], REVERSE_Z) && keep(px, py) {
+                if in_front(z, depth[i], REVERSE_Z) && keep(px, py, (0, 0)) {
                     depth[i] = z;
                     ids[i] = id;
                 }
             });
             return;
         }
-        raster_samples(t, rect, self.pattern, |px, py, mask, z| {
+        let pattern = self.pattern;
+        raster_samples(t, rect, pattern, |px, py, mask, z| {
             let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * n;
-            let mut kept: Option<bool> = None;
             for (s, &zs) in z.iter().enumerate().take(n) {
                 let i = base + s;
                 if mask & (1 << s) != 0
                     && in_front(zs, depth[i], REVERSE_Z)
-                    && *kept.get_or_insert_with(|| keep(px, py))
+                    && keep(px, py, pattern[s])
                 {
                     depth[i] = zs;
                     ids[i] = id;

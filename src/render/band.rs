@@ -70,8 +70,15 @@ impl FrameData<'_> {
                     AlphaMode::Opaque => self.draw_opaque(&mut vis, t, id),
                     AlphaMode::Mask(cutoff) => {
                         let it = Interpolator::new(t);
-                        let keep = |px: i32, py: i32| {
-                            let f = it.at_pixel(px, py);
+                        let keep = |px: i32, py: i32, (ox, oy): (i8, i8)| {
+                            let f = if (ox, oy) == (0, 0) {
+                                it.at_pixel(px, py)
+                            } else {
+                                it.at(
+                                    px as f64 + 0.5 + ox as f64 / 16.0,
+                                    py as f64 + 0.5 + oy as f64 / 16.0,
+                                )
+                            };
                             let (m, uv, color) = self.material_uv(t, f.lambda);
                             let tc = TexCoords {
                                 uv,
