@@ -5,7 +5,7 @@
 //! exactly once afterwards.
 
 use super::bin::TileRect;
-use super::setup::{SUBPIXEL, Tri};
+use super::setup::{Edge, SUBPIXEL, Tri};
 
 /// The standard Direct3D sample positions for 1, 2, 4, 8 and 16 samples:
 /// offsets from the pixel center in 1/16 pixel, x right and y down (the
@@ -56,17 +56,45 @@ pub fn sample_pattern(samples: u32) -> Option<&'static [(i8, i8)]> {
 /// Most samples per pixel.
 pub const MAX_SAMPLES: usize = 16;
 
-/// Calls `visit(px, py, mask, z)` for every pixel of `rect` where `t`
-/// covers at least one sample of `pattern` (top-left rule at each sample):
-/// bit s of `mask` is set when sample s is covered, and `z[s]` is the
-/// depth there. `t` must come from a multisampling setup (its pixel bounds
-/// reach half a pixel further).
+/// Depth (z/w) across a triangle as a function of its biased edge values.
+struct DepthPlane {
+    z0: f32,
+    dz1: f32,
+    dz2: f32,
+    bias1: i64,
+    bias2: i64,
+}
+
+impl DepthPlane {
+    fn new(t: &Tri, e: &[Edge; 3]) -> DepthPlane {
+        let inv_area = 1.0 / t.area2 as f64;
+        DepthPlane {
+            z0: t.z[0],
+            dz1: ((t.z[1] - t.z[0]) as f64 * inv_area) as f32,
+            dz2: ((t.z[2] - t.z[0]) as f64 * inv_area) as f32,
+            bias1: e[1].bias,
+            bias2: e[2].bias,
+        }
+    }
+
+    /// At biased edge values `w1`, `w2` (the bias is only for the fill rule).
+    #[inline]
+    fn at(&self, w1: i64, w2: i64) -> f32 {
+        self.z0 + (w1 - self.bias1) as f32 * self.dz1 + (w2 - self.bias2) as f32 * self.dz2
+    }
+}
+
+/// Walks the pixels of `rect` within `t`'s bounds, row by row, calling
+/// `visit(px, py, w)` where every biased edge value `w[k]` plus `reach[k]`
+/// is >= 0 (`reach` 0: the pixel center is inside). Such pixels form one
+/// run per row (a convex region), so a row ends at its first pixel past it.
 #[inline]
-pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
+fn walk(
     t: &Tri,
+    e: &[Edge; 3],
     rect: TileRect,
-    pattern: &[(i8, i8)],
-    mut visit: F,
+    reach: [i64; 3],
+    mut visit: impl FnMut(i32, i32, [i64; 3]),
 ) {
     let x0 = t.min_x.max(rect.x0);
     let x1 = t.max_x.min(rect.x1 - 1);
@@ -75,52 +103,15 @@ pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
     if x0 > x1 || y0 > y1 {
         return;
     }
-    let n = pattern.len().min(MAX_SAMPLES);
-    let e = t.edges();
-    // Edge-function offsets of each sample from the pixel center: exact,
-    // as a and b are multiples of SUBPIXEL (a 1/16 pixel step is a/16).
-    let mut off = [[0i64; MAX_SAMPLES]; 3];
-    let mut reach = [i64::MIN; 3];
-    for k in 0..3 {
-        for (s, &(ox, oy)) in pattern.iter().take(n).enumerate() {
-            let o = (e[k].a * ox as i64 + e[k].b * oy as i64) / 16;
-            off[k][s] = o;
-            reach[k] = reach[k].max(o);
-        }
-    }
-    debug_assert!(e.iter().all(|e| e.a % SUBPIXEL == 0 && e.b % SUBPIXEL == 0));
-    let inv_area = 1.0 / t.area2 as f64;
-    let dz1 = ((t.z[1] - t.z[0]) as f64 * inv_area) as f32;
-    let dz2 = ((t.z[2] - t.z[0]) as f64 * inv_area) as f32;
-    let z0 = t.z[0];
     let (x0l, y0l) = (x0 as i64, y0 as i64);
-    let mut row = [
-        e[0].at(x0l, y0l) + e[0].bias,
-        e[1].at(x0l, y0l) + e[1].bias,
-        e[2].at(x0l, y0l) + e[2].bias,
-    ];
-    let mut z = [0f32; MAX_SAMPLES];
+    let mut row = [0, 1, 2].map(|k| e[k].at(x0l, y0l) + e[k].bias);
     for py in y0..=y1 {
         let mut w = row;
         let mut inside_seen = false;
         for px in x0..=x1 {
-            // Some sample of the pixel can be inside every edge: the pixels
-            // passing this form a convex run along the row.
-            if w[0] + reach[0] >= 0 && w[1] + reach[1] >= 0 && w[2] + reach[2] >= 0 {
+            if (w[0] + reach[0]) | (w[1] + reach[1]) | (w[2] + reach[2]) >= 0 {
                 inside_seen = true;
-                let mut mask = 0u32;
-                for s in 0..n {
-                    let (a, b, c) = (w[0] + off[0][s], w[1] + off[1][s], w[2] + off[2][s]);
-                    if (a | b | c) >= 0 {
-                        mask |= 1 << s;
-                        let e1 = (b - e[1].bias) as f32;
-                        let e2 = (c - e[2].bias) as f32;
-                        z[s] = z0 + e1 * dz1 + e2 * dz2;
-                    }
-                }
-                if mask != 0 {
-                    visit(px, py, mask, &z);
-                }
+                visit(px, py, w);
             } else if inside_seen {
                 break;
             }
@@ -134,50 +125,59 @@ pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
     }
 }
 
+/// Calls `visit(px, py, mask, z)` for every pixel of `rect` where `t`
+/// covers at least one sample of `pattern` (top-left rule at each sample):
+/// bit s of `mask` is set when sample s is covered, and `z[s]` is the
+/// depth there. `t` must come from a multisampling setup (its pixel bounds
+/// reach half a pixel further).
+#[inline]
+pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
+    t: &Tri,
+    rect: TileRect,
+    pattern: &[(i8, i8)],
+    mut visit: F,
+) {
+    let n = pattern.len().min(MAX_SAMPLES);
+    let e = t.edges();
+    // Edge-function offsets of each sample from the pixel center: exact,
+    // as a and b are multiples of SUBPIXEL (a 1/16 pixel step is a/16).
+    debug_assert!(e.iter().all(|e| e.a % SUBPIXEL == 0 && e.b % SUBPIXEL == 0));
+    let mut off = [[0i64; MAX_SAMPLES]; 3];
+    let mut reach = [i64::MIN; 3];
+    for k in 0..3 {
+        for (s, &(ox, oy)) in pattern.iter().take(n).enumerate() {
+            let o = (e[k].a * ox as i64 + e[k].b * oy as i64) / 16;
+            off[k][s] = o;
+            reach[k] = reach[k].max(o);
+        }
+    }
+    let plane = DepthPlane::new(t, &e);
+    let mut z = [0f32; MAX_SAMPLES];
+    // Pixels where some sample may be inside every edge.
+    walk(t, &e, rect, reach, |px, py, w| {
+        let mut mask = 0u32;
+        for s in 0..n {
+            let (a, b, c) = (w[0] + off[0][s], w[1] + off[1][s], w[2] + off[2][s]);
+            if (a | b | c) >= 0 {
+                mask |= 1 << s;
+                z[s] = plane.at(b, c);
+            }
+        }
+        if mask != 0 {
+            visit(px, py, mask, &z);
+        }
+    });
+}
+
 /// Calls `visit(px, py, z)` for every pixel center inside `rect` covered by
 /// `t` (top-left rule), row by row.
 #[inline]
 pub fn raster_triangle<F: FnMut(i32, i32, f32)>(t: &Tri, rect: TileRect, mut visit: F) {
-    let x0 = t.min_x.max(rect.x0);
-    let x1 = t.max_x.min(rect.x1 - 1);
-    let y0 = t.min_y.max(rect.y0);
-    let y1 = t.max_y.min(rect.y1 - 1);
-    if x0 > x1 || y0 > y1 {
-        return;
-    }
     let e = t.edges();
-    let inv_area = 1.0 / t.area2 as f64;
-    let dz1 = ((t.z[1] - t.z[0]) as f64 * inv_area) as f32;
-    let dz2 = ((t.z[2] - t.z[0]) as f64 * inv_area) as f32;
-    let z0 = t.z[0];
-    let (x0l, y0l) = (x0 as i64, y0 as i64);
-    let mut row = [
-        e[0].at(x0l, y0l) + e[0].bias,
-        e[1].at(x0l, y0l) + e[1].bias,
-        e[2].at(x0l, y0l) + e[2].bias,
-    ];
-    for py in y0..=y1 {
-        let mut w = row;
-        let mut inside_seen = false;
-        for px in x0..=x1 {
-            if (w[0] | w[1] | w[2]) >= 0 {
-                inside_seen = true;
-                // Unbiased weights for depth: bias is only for the rule.
-                let e1 = (w[1] - e[1].bias) as f32;
-                let e2 = (w[2] - e[2].bias) as f32;
-                visit(px, py, z0 + e1 * dz1 + e2 * dz2);
-            } else if inside_seen {
-                // Convex: once out again, the rest of the row is outside.
-                break;
-            }
-            w[0] += e[0].a;
-            w[1] += e[1].a;
-            w[2] += e[2].a;
-        }
-        row[0] += e[0].b;
-        row[1] += e[1].b;
-        row[2] += e[2].b;
-    }
+    let plane = DepthPlane::new(t, &e);
+    walk(t, &e, rect, [0; 3], |px, py, w| {
+        visit(px, py, plane.at(w[1], w[2]))
+    });
 }
 
 pub const NO_TRIANGLE: u32 = u32::MAX;
