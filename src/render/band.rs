@@ -110,11 +110,7 @@ impl FrameData<'_> {
         color: &mut [Vec4],
         depth: &mut [f32],
     ) {
-        if vis.samples() > 1 {
-            self.shade_visible_msaa(vis, ao, color, depth);
-        } else {
-            self.shade_visible(vis, ao, color, depth);
-        }
+        self.shade_visible(vis, ao, color, depth);
         if !blended.is_empty() {
             self.blend(vis, blended, color);
         }
@@ -169,65 +165,6 @@ impl FrameData<'_> {
             vis.draw::<true>(t, id);
         } else {
             vis.draw::<false>(t, id);
-        }
-    }
-
-    /// Shades every visible pixel once, quad by quad.
-    fn shade_visible(
-        &self,
-        vis: &Visibility,
-        ao: Option<&[f32]>,
-        color: &mut [Vec4],
-        depth: &mut [f32],
-    ) {
-        let rect = vis.rect;
-        let (tw, th) = (rect.width(), rect.height());
-        color.fill(self.bg);
-        depth.fill(f32::INFINITY);
-        let mut cache = InterpolatorCache::default();
-        for qy in (0..th).step_by(2) {
-            for qx in (0..tw).step_by(2) {
-                // Derivatives of the (at most four) triangles in this quad.
-                let mut quad: [(u32, [Gradients; 2]); 4] =
-                    [(NO_TRIANGLE, [Gradients::default(); 2]); 4];
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let (x, y) = (qx + dx, qy + dy);
-                    if x >= tw || y >= th {
-                        continue;
-                    }
-                    let i = y * tw + x;
-                    let id = vis.id[i];
-                    if id == NO_TRIANGLE {
-                        continue;
-                    }
-                    let t = &self.tris[id as usize];
-                    let it = cache.get(id, t);
-                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
-                    let g = if self.grads {
-                        let slot = quad
-                            .iter()
-                            .position(|q| q.0 == id || q.0 == NO_TRIANGLE)
-                            .unwrap_or(0);
-                        if quad[slot].0 != id {
-                            let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
-                            quad[slot] = (id, self.gradients(t, it, q0));
-                        }
-                        quad[slot].1
-                    } else {
-                        [Gradients::default(); 2]
-                    };
-                    let frag = it.at_pixel(px, py);
-                    let occlusion = ao.map_or(1.0, |a| a[i]);
-                    let (c, d) = self.shade(t, it, frag, (px, py), g, occlusion);
-                    // A NaN from degenerate input must not poison the frame.
-                    color[i] = if c.is_finite() {
-                        c.extend(1.0)
-                    } else {
-                        Vec4::W
-                    };
-                    depth[i] = d;
-                }
-            }
         }
     }
 
@@ -317,12 +254,12 @@ impl FrameData<'_> {
         });
     }
 
-    /// Shades each pixel's fragments once (MSAA), quad by quad so that a
-    /// triangle's texture derivatives are computed once per quad, and
-    /// resolves: the fragments' colors weighted by their sample counts,
-    /// plus the background over the uncovered samples. Depth: the nearest
-    /// fragment's.
-    fn shade_visible_msaa(
+    /// Shades each triangle visible in a pixel once (one per pixel without
+    /// MSAA), quad by quad so that a triangle's texture derivatives are
+    /// computed once per quad, and resolves: the fragments' colors weighted
+    /// by their sample counts, plus the background over the uncovered
+    /// samples. Depth: the nearest fragment's.
+    fn shade_visible(
         &self,
         vis: &Visibility,
         ao: Option<&[f32]>,
@@ -377,6 +314,8 @@ impl FrameData<'_> {
                         };
                         let frag = self.shading_point(it, px, py, mask);
                         let (c, d) = self.shade(t, it, frag, (px, py), g, occlusion);
+                        // A NaN from degenerate input must not poison the
+                        // frame: such a fragment is black.
                         let c = if c.is_finite() { c } else { Vec3::ZERO };
                         acc += c.extend(1.0) * count;
                         nearest = nearest.min(d);
