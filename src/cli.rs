@@ -231,15 +231,7 @@ fn chart(args: ChartArgs) -> Result<(), Error> {
     if args.runs == 0 {
         return Err(Error::Argument("--runs must be at least 1".into()));
     }
-    let sets = args
-        .sets
-        .iter()
-        .map(|s| s.parse::<SetOverride>())
-        .collect::<Result<Vec<_>, _>>()?;
-    let opts = LoadOptions {
-        sets,
-        out_dir: None,
-    };
+    let opts = load_options(&args.sets, None)?;
     let out = args
         .out
         .clone()
@@ -337,16 +329,17 @@ fn gif(args: GifArgs) -> Result<(), Error> {
     Ok(())
 }
 
-fn render(args: RenderArgs) -> Result<(), Error> {
-    let sets = args
-        .sets
+/// `--set` overrides (parsed) and `--out`, for loading a scene.
+fn load_options(sets: &[String], out_dir: Option<PathBuf>) -> Result<LoadOptions, Error> {
+    let sets = sets
         .iter()
         .map(|s| s.parse::<SetOverride>())
         .collect::<Result<Vec<_>, _>>()?;
-    let opts = LoadOptions {
-        sets,
-        out_dir: args.out.clone(),
-    };
+    Ok(LoadOptions { sets, out_dir })
+}
+
+fn render(args: RenderArgs) -> Result<(), Error> {
+    let opts = load_options(&args.sets, args.out.clone())?;
     let pool = thread_pool(args.threads)?;
     pool.install(|| {
         let t0 = std::time::Instant::now();

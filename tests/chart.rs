@@ -5,29 +5,25 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
 fn chart(out: &Path) -> Vec<Vec<String>> {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
-    let o = Command::new(env!("CARGO_BIN_EXE_softraster"))
-        .args([
-            "chart",
-            scene.to_str().unwrap(),
-            "--frame",
-            "3",
-            "--quick",
-            "--runs",
-            "2",
-            "--out",
-            out.to_str().unwrap(),
-            "--set",
-            "output.width=96",
-            "--set",
-            "output.height=72",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (code, _, err) = common::run(&[
+        "chart",
+        scene.to_str().unwrap(),
+        "--frame",
+        "3",
+        "--quick",
+        "--runs",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "output.width=96",
+        "--set",
+        "output.height=72",
+    ]);
+    assert_eq!(code, 0, "{err}");
     let text = std::fs::read_to_string(out.join("chart.csv")).unwrap();
     let mut lines = text.lines();
     assert_eq!(

@@ -8,23 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_softraster"))
-}
-
-fn bin_path() -> &'static str {
-    env!("CARGO_BIN_EXE_softraster")
-}
-
-/// Runs the binary: exit status, stdout, stderr.
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = bin().args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::run;
 
 /// The showcase as a 72-frame turntable, 5 degrees a frame, small and with
 /// MSAA 4 and a GIF, as a scene file in `dir`.
@@ -97,7 +81,7 @@ fn four_shards_in_separate_processes_match_one_run() {
     let quoted: Vec<String> = sets().iter().map(|s| format!("'{s}'")).collect();
     let script = format!(
         "printf '0..18\\n18..36\\n36-53\\n54,55,56..72\\n' | xargs -P 4 -I RANGE '{}' render '{}' --out '{}' --frames RANGE --quiet {}",
-        bin_path(),
+        common::BIN,
         scene.display(),
         sharded.display(),
         quoted.join(" ")

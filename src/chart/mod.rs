@@ -462,45 +462,34 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
             e,
             &against,
         ));
-        for &n in samples {
+        // SSAO at every radius; ray-traced with fewer rays at the scene's.
+        let mut methods: Vec<(AoMethod, u32)> =
+            samples.iter().map(|&n| (AoMethod::Ssao, n)).collect();
+        if (scale - 1.0).abs() < 1e-6 {
+            let rt: &[u32] = if opts.quick { &[16] } else { &[16, 64, 256] };
+            methods.extend(rt.iter().map(|&n| (AoMethod::Raytraced, n)));
+        }
+        for (method, n) in methods {
             scene.settings.ao = AoSettings {
-                method: AoMethod::Ssao,
+                method,
                 radius: Some(radius),
                 samples: n,
             };
             let (f, _, t) = timed(scene, opts.frame, opts.runs);
             let (e, _) = ao_rmse(&f, &reference, rays);
-            let default = n == 16 && (radius - default_r).abs() <= 1e-6 * default_r.max(1e-6);
+            let ssao = method == AoMethod::Ssao;
+            let default =
+                ssao && n == 16 && (radius - default_r).abs() <= 1e-6 * default_r.max(1e-6);
+            let name = if ssao { "ssao" } else { "raytraced" };
             rows.push(row(
                 Knob::Ao,
-                format!("ssao {n} r{scale}"),
+                format!("{name} {n} r{scale}"),
                 default,
                 false,
                 t,
                 e,
                 &against,
             ));
-        }
-        if (scale - 1.0).abs() < 1e-6 {
-            let rt: &[u32] = if opts.quick { &[16] } else { &[16, 64, 256] };
-            for &n in rt {
-                scene.settings.ao = AoSettings {
-                    method: AoMethod::Raytraced,
-                    radius: Some(radius),
-                    samples: n,
-                };
-                let (f, _, t) = timed(scene, opts.frame, opts.runs);
-                let (e, _) = ao_rmse(&f, &reference, rays);
-                rows.push(row(
-                    Knob::Ao,
-                    format!("raytraced {n} r{scale}"),
-                    false,
-                    false,
-                    t,
-                    e,
-                    &against,
-                ));
-            }
         }
     }
     Ok(())

@@ -241,31 +241,27 @@ fn ssim_map(x: &[f32], y: &[f32], w: usize, h: usize) -> Vec<f32> {
         let s: f32 = k.iter().sum();
         k.into_iter().map(|v| v / s).collect()
     };
-    let blur = |img: &[f32]| -> Vec<f32> {
-        let mut tmp = vec![0f32; w * h];
-        tmp.par_chunks_mut(w).enumerate().for_each(|(yy, row)| {
-            for (xx, o) in row.iter_mut().enumerate() {
-                let mut acc = 0.0;
-                for (t, &k) in taps.iter().enumerate() {
-                    let sx = (xx as i32 + t as i32 - 5).clamp(0, w as i32 - 1) as usize;
-                    acc += k * img[yy * w + sx];
-                }
-                *o = acc;
-            }
-        });
+    // One 11-tap pass along x or y, clamped at the borders.
+    let pass = |src: &[f32], along_x: bool| -> Vec<f32> {
         let mut out = vec![0f32; w * h];
         out.par_chunks_mut(w).enumerate().for_each(|(yy, row)| {
             for (xx, o) in row.iter_mut().enumerate() {
                 let mut acc = 0.0;
                 for (t, &k) in taps.iter().enumerate() {
-                    let sy = (yy as i32 + t as i32 - 5).clamp(0, h as i32 - 1) as usize;
-                    acc += k * tmp[sy * w + xx];
+                    let d = t as i32 - 5;
+                    let (sx, sy) = if along_x {
+                        ((xx as i32 + d).clamp(0, w as i32 - 1) as usize, yy)
+                    } else {
+                        (xx, (yy as i32 + d).clamp(0, h as i32 - 1) as usize)
+                    };
+                    acc += k * src[sy * w + sx];
                 }
                 *o = acc;
             }
         });
         out
     };
+    let blur = |img: &[f32]| pass(&pass(img, true), false);
     let prod = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(p, q)| p * q).collect::<Vec<f32>>();
     let (mx, my) = (blur(x), blur(y));
     let (sxx, syy, sxy) = (blur(&prod(x, x)), blur(&prod(y, y)), blur(&prod(x, y)));
@@ -299,9 +295,23 @@ pub struct FileResult {
     pub name: String,
     pub status: Status,
     pub value: Option<f64>,
-    /// Why a comparison failed beyond the value (a size difference).
+    /// Why a comparison failed beyond the value: a size difference, the
+    /// side a file is missing from.
     pub message: Option<String>,
     pub diff: Option<PathBuf>,
+}
+
+impl FileResult {
+    /// The status's name and what to say about it.
+    fn describe(&self) -> (&'static str, Option<String>) {
+        match &self.status {
+            Status::Pass => ("pass", None),
+            Status::Fail => ("fail", self.message.clone()),
+            Status::Missing => ("missing", self.message.clone()),
+            Status::Extra => ("extra", self.message.clone()),
+            Status::Error(e) => ("error", Some(e.clone())),
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -333,13 +343,7 @@ impl Report {
             .files
             .iter()
             .map(|f| {
-                let (status, error) = match &f.status {
-                    Status::Pass => ("pass", None),
-                    Status::Fail => ("fail", f.message.clone()),
-                    Status::Missing => ("missing", Some("not in the test set".to_string())),
-                    Status::Extra => ("extra", Some("not in the reference set".to_string())),
-                    Status::Error(e) => ("error", Some(e.clone())),
-                };
+                let (status, error) = f.describe();
                 serde_json::json!({
                     "name": f.name,
                     "status": status,
@@ -361,13 +365,8 @@ impl Report {
     pub fn to_text(&self) -> String {
         let mut out = String::new();
         for f in &self.files {
-            let (tag, detail) = match &f.status {
-                Status::Pass => ("PASS", String::new()),
-                Status::Fail => ("FAIL", f.message.clone().unwrap_or_default()),
-                Status::Missing => ("MISSING", "not in the test set".into()),
-                Status::Extra => ("EXTRA", "not in the reference set".into()),
-                Status::Error(e) => ("ERROR", e.clone()),
-            };
+            let (tag, detail) = f.describe();
+            let (tag, detail) = (tag.to_uppercase(), detail.unwrap_or_default());
             let value = f
                 .value
                 .map(|v| {
@@ -436,11 +435,11 @@ fn compare_pair(
         message,
         diff,
     };
-    if !reference.exists() {
-        return result(Status::Missing, None, None, None);
-    }
-    if !test.exists() {
-        return result(Status::Missing, None, None, None);
+    for (path, side) in [(reference, "reference"), (test, "test")] {
+        if !path.exists() {
+            let msg = format!("{side} {} not found", path.display());
+            return result(Status::Missing, None, Some(msg), None);
+        }
     }
     let (a, b) = match (read_image(reference), read_image(test)) {
         (Ok(a), Ok(b)) => (a, b),
@@ -500,18 +499,18 @@ pub fn compare_paths(
         names
             .par_iter()
             .map(|name| {
-                let only = |status| FileResult {
+                let only = |status, message: &str| FileResult {
                     name: (*name).clone(),
                     status,
                     value: None,
-                    message: None,
+                    message: Some(message.to_string()),
                     diff: None,
                 };
                 if !t.contains(*name) {
-                    return only(Status::Missing);
+                    return only(Status::Missing, "not in the test set");
                 }
                 if !r.contains(*name) {
-                    return only(Status::Extra);
+                    return only(Status::Extra, "not in the reference set");
                 }
                 let d = diff.map(|d| {
                     let stem = Path::new(name.as_str()).file_stem().unwrap_or_default();

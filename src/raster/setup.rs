@@ -164,21 +164,21 @@ pub fn setup(
     }
     let (lo_x, hi_x) = (*x.iter().min()? as i64, *x.iter().max()? as i64);
     let (lo_y, hi_y) = (*y.iter().min()? as i64, *y.iter().max()? as i64);
-    // Pixel px is a candidate when lo <= SUBPIXEL px + HALF + o <= hi for
+    // Pixel p is a candidate when lo <= SUBPIXEL p + HALF + o <= hi for
     // a sample offset o: 0, or within half a pixel with MSAA.
     let reach = if vp.msaa { HALF } else { 0 };
-    let min_x = (lo_x - HALF - reach + SUBPIXEL - 1)
-        .div_euclid(SUBPIXEL)
-        .max(0);
-    let max_x = (hi_x - HALF + reach)
-        .div_euclid(SUBPIXEL)
-        .min(vp.width as i64 - 1);
-    let min_y = (lo_y - HALF - reach + SUBPIXEL - 1)
-        .div_euclid(SUBPIXEL)
-        .max(0);
-    let max_y = (hi_y - HALF + reach)
-        .div_euclid(SUBPIXEL)
-        .min(vp.height as i64 - 1);
+    let range = |lo: i64, hi: i64, size: u32| {
+        (
+            (lo - HALF - reach + SUBPIXEL - 1)
+                .div_euclid(SUBPIXEL)
+                .max(0),
+            (hi - HALF + reach)
+                .div_euclid(SUBPIXEL)
+                .min(size as i64 - 1),
+        )
+    };
+    let (min_x, max_x) = range(lo_x, hi_x, vp.width);
+    let (min_y, max_y) = range(lo_y, hi_y, vp.height);
     if min_x > max_x || min_y > max_y {
         return None;
     }

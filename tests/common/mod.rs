@@ -6,6 +6,19 @@ use std::path::{Path, PathBuf};
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 
+/// The softraster binary under test.
+pub const BIN: &str = env!("CARGO_BIN_EXE_softraster");
+
+/// Runs the binary: exit status, stdout, stderr.
+pub fn run(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(BIN).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// A fresh directory under the target dir for one test's files.
 pub fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
