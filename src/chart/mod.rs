@@ -196,24 +196,9 @@ fn interior_mask(f: &Frame) -> Vec<bool> {
     m
 }
 
-/// RMSE of the AO buffers over the reference's covered pixels, and a bound
-/// on the reference's own noise: sqrt(mean p(1-p)/rays), the RMSE of
-/// `rays` independent rays. Its rays are stratified (Hammersley), which is
-/// far less noisy: 1024 of them are within 0.0011 RMSE of the analytic AO
-/// in tests/shadows.rs, against a bound of about 0.01.
-fn ao_rmse(got: &Frame, reference: &Frame, rays: u32) -> (f64, f64) {
-    let (mut sum, mut var, mut n) = (0.0f64, 0.0f64, 0usize);
-    for i in 0..reference.ao.len().min(got.ao.len()) {
-        if reference.depth[i].is_finite() {
-            let e = (got.ao[i] - reference.ao[i]) as f64;
-            sum += e * e;
-            let p = reference.ao[i] as f64;
-            var += p * (1.0 - p) / rays as f64;
-            n += 1;
-        }
-    }
-    let n = n.max(1) as f64;
-    ((sum / n).sqrt(), (var / n).sqrt())
+/// RMSE of the AO buffer against the reference's, over covered pixels.
+fn ao_rmse(got: &Frame, reference: &Frame) -> f64 {
+    crate::accuracy::ao_error([(got, reference)]).0
 }
 
 /// Marks the Pareto front of each knob and reference.
@@ -449,10 +434,10 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
             samples: rays,
         };
         let (reference, _, t) = timed(scene, opts.frame, 1);
-        let (_, noise) = ao_rmse(&reference, &reference, rays);
+        let noise = crate::accuracy::ao_noise_bound(&reference, rays);
         let against =
             format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE below {noise:.4})");
-        let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference, rays).0))?;
+        let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;
         rows.push(row(
             Knob::Ao,
             format!("raytraced {rays} r{scale}"),
@@ -476,7 +461,7 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
                 samples: n,
             };
             let (f, _, t) = timed(scene, opts.frame, opts.runs);
-            let (e, _) = ao_rmse(&f, &reference, rays);
+            let e = ao_rmse(&f, &reference);
             let ssao = method == AoMethod::Ssao;
             let default =
                 ssao && n == 16 && (radius - default_r).abs() <= 1e-6 * default_r.max(1e-6);
