@@ -374,3 +374,44 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
         "{err}"
     );
 }
+
+#[test]
+fn keys_without_effect_warn_and_map_keys_mean_shadow_maps() {
+    use softraster::scene::desc::ShadowMethod;
+    let dir = common::scratch("no_effect");
+    let tri = ("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let scene = |text: &str| {
+        common::scene_in(
+            &dir,
+            &format!("[[model]]\npath = \"m.obj\"\n{text}"),
+            &[tri],
+        )
+    };
+    // No shadow key: the default, ray-traced; a map key without a method
+    // asks for maps.
+    assert_eq!(scene("").settings.shadows, ShadowMethod::Raytraced);
+    assert_eq!(
+        scene("[render]\nshadow_map_size = 4096\n").settings.shadows,
+        ShadowMethod::Pcf
+    );
+    assert!(scene("").warnings.is_empty());
+    for (text, key) in [
+        (
+            "[render]\nshadows = \"raytraced\"\nshadow_map_size = 4096\n",
+            "render.shadow_map_size",
+        ),
+        (
+            "[render]\ntexture_filter = \"trilinear\"\nmax_anisotropy = 4\n",
+            "render.max_anisotropy",
+        ),
+        ("[render]\nao = { radius = 0.5 }\n", "render.ao"),
+        ("[output]\ngif_delay_ms = 80\n", "output.gif_delay_ms"),
+    ] {
+        let w = scene(text).warnings;
+        assert!(
+            w.iter()
+                .any(|w| w.contains(key) && w.contains("scene.toml:")),
+            "{key}: {w:?}"
+        );
+    }
+}

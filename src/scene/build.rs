@@ -75,6 +75,67 @@ fn shadow_bias(r: &desc::RenderDesc) -> super::ShadowBias {
     }
 }
 
+/// `render.shadows`, or without it: pcf when the scene sets a shadow-map
+/// key (it asked for maps), otherwise the default (raytraced).
+fn shadow_method(r: &desc::RenderDesc) -> desc::ShadowMethod {
+    match &r.shadows {
+        Some(m) => *m.get_ref(),
+        None if r.shadow_map_size.is_some() || r.shadow_bias.is_some() => desc::ShadowMethod::Pcf,
+        None => desc::ShadowMethod::default(),
+    }
+}
+
+/// Keys that are valid but do nothing with the rest of the scene: said as
+/// warnings naming where they are, never silently dropped.
+fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -> Vec<String> {
+    use desc::{AoMethod, ShadowMethod, TextureFilter};
+    let (r, o) = (&d.render, &d.output);
+    let mut out = Vec::new();
+    let mut warn = |span: Option<std::ops::Range<usize>>, what: &str| {
+        if let Some(span) = span {
+            out.push(format!("{}: {what}", ctx.location(span)));
+        }
+    };
+    if !matches!(s.shadows, ShadowMethod::Hard | ShadowMethod::Pcf) {
+        let why = "has no effect: render.shadows is not hard or pcf";
+        warn(
+            r.shadow_map_size.as_ref().map(|v| v.span()),
+            &format!("render.shadow_map_size {why}"),
+        );
+        warn(
+            r.shadow_bias.as_ref().map(|v| v.span()),
+            &format!("render.shadow_bias {why}"),
+        );
+    }
+    if s.texture_filter != TextureFilter::Anisotropic {
+        warn(
+            r.max_anisotropy.as_ref().map(|v| v.span()),
+            "render.max_anisotropy has no effect: render.texture_filter is not anisotropic",
+        );
+    }
+    if s.ao.method == AoMethod::Off
+        && let Some(ao) = &r.ao
+        && (ao.get_ref().radius.is_some() || ao.get_ref().samples.is_some())
+    {
+        warn(
+            Some(ao.span()),
+            "render.ao radius/samples have no effect without a method (ssao or raytraced)",
+        );
+    }
+    if o.gif.is_none() {
+        let why = "has no effect without output.gif";
+        warn(
+            o.gif_delay_ms.as_ref().map(|v| v.span()),
+            &format!("output.gif_delay_ms {why}"),
+        );
+        warn(
+            o.gif_dither.as_ref().map(|v| v.span()),
+            &format!("output.gif_dither {why}"),
+        );
+    }
+    out
+}
+
 fn ao_settings(r: &desc::RenderDesc) -> super::AoSettings {
     let (method, radius, samples) = match &r.ao {
         Some(a) => {
@@ -121,7 +182,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         exposure: get(&r.exposure, 0.0),
         background: get(&o.background, desc::Background::Color([0.0; 3])),
         ambient: Vec3::from(get(&d.ambient.color, [0.03; 3])),
-        shadows: get(&r.shadows, Default::default()),
+        shadows: shadow_method(r),
         shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
         shadow_bias: shadow_bias(r),
         ao: ao_settings(r),
@@ -199,7 +260,8 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         .par_iter()
         .map(|p| SourceModel::load(p))
         .collect::<Result<_, _>>()?;
-    let mut warnings: Vec<String> = loaded.iter().flat_map(|m| m.warnings.clone()).collect();
+    let mut warnings = no_effect_warnings(d, ctx, &settings);
+    warnings.extend(loaded.iter().flat_map(|m| m.warnings.clone()));
     let source = |md: &desc::ModelDesc| &loaded[files[&resolve(&scene_dir, md.path.get_ref())]];
 
     // Materials (with overrides), then the set of textures they need.
