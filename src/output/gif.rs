@@ -6,7 +6,7 @@
 //! sequence length: the first trains a NeuQuant palette (color_quant, MIT)
 //! on pixels from every frame, the second maps each frame to it and
 //! encodes (gif crate, MIT/Apache). Frames with any alpha below 128 make
-//! palette entry 255 transparent.
+//! one palette entry, after the colors, transparent.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -105,7 +105,9 @@ pub fn assemble(frames: &[PathBuf], out: &Path, opts: GifOptions) -> Result<GifI
         training.extend_from_slice(&[0, 0, 0, 255]);
     }
     let colors = if transparent { 255 } else { 256 };
-    let palette = Palette::train(&training, colors);
+    let mut palette = Palette::train(&training, colors);
+    // The transparent entry follows the colors (at most 255 of them).
+    palette.transparent = transparent.then_some((palette.rgb.len() / 3) as u8);
 
     // Pass 2: map and encode, a batch of frames at a time.
     let delay = (opts.delay_ms as f64 / 10.0)
@@ -142,8 +144,8 @@ pub fn assemble(frames: &[PathBuf], out: &Path, opts: GifOptions) -> Result<GifI
                     delay,
                     ..Default::default()
                 };
-                if transparent {
-                    f.transparent = Some(255);
+                if let Some(t) = palette.transparent {
+                    f.transparent = Some(t);
                     f.dispose = gif::DisposalMethod::Background;
                 }
                 enc.write_frame(&f).map_err(enc_err)?;
@@ -164,6 +166,8 @@ pub fn assemble(frames: &[PathBuf], out: &Path, opts: GifOptions) -> Result<GifI
 /// distance) over it.
 struct Palette {
     rgb: Vec<u8>,
+    /// The index pixels with alpha below 128 get, if any.
+    transparent: Option<u8>,
 }
 
 impl Palette {
@@ -181,7 +185,10 @@ impl Palette {
         } else {
             color_quant::NeuQuant::new(10, colors, rgba).color_map_rgb()
         };
-        Palette { rgb }
+        Palette {
+            rgb,
+            transparent: None,
+        }
     }
 
     fn nearest(&self, c: [i32; 3]) -> u8 {
@@ -196,8 +203,8 @@ impl Palette {
         best.1 as u8
     }
 
-    /// Palette indices of one RGBA frame (255 where alpha < 128 when the
-    /// palette has a transparent entry).
+    /// Palette indices of one RGBA frame (the transparent index where
+    /// alpha < 128, when the palette has one).
     fn map(&self, rgba: &[u8], width: usize, dither: GifDither) -> Vec<u8> {
         let n = rgba.len() / 4;
         let mut out = vec![0u8; n];
@@ -208,7 +215,7 @@ impl Palette {
                 .entry(key)
                 .or_insert_with(|| self.nearest(key.map(i32::from)))
         };
-        let transparent_index = (self.rgb.len() / 3 < 256).then_some(255u8);
+        let transparent_index = self.transparent;
         match dither {
             GifDither::None | GifDither::Ordered => {
                 for i in 0..n {
@@ -328,6 +335,8 @@ mod tests {
         ] {
             let idx = p.map(&rgba, 8, d);
             assert_eq!(idx.len(), 64);
+            // Every index names a palette entry (64 here, none transparent).
+            assert!(idx.iter().all(|&k| (k as usize) < 64), "{d:?}: {idx:?}");
             if d == GifDither::None {
                 for (i, &k) in idx.iter().enumerate() {
                     assert_eq!(
@@ -337,5 +346,62 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn transparent_pixels_decode_transparent_with_few_colors() {
+        // Two frames of three colors with a transparent left half: the
+        // transparent entry must follow the three colors, inside the
+        // palette the encoder writes.
+        let dir = std::env::temp_dir().join(format!("softraster-gif-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let colors = [[200u8, 30, 30], [30, 200, 30], [30, 30, 200]];
+        let frames: Vec<PathBuf> = (0..2)
+            .map(|f| {
+                let img = image::RgbaImage::from_fn(8, 4, |x, y| {
+                    if x < 4 {
+                        image::Rgba([0, 0, 0, 0])
+                    } else {
+                        let c = colors[(x as usize + y as usize + f) % 3];
+                        image::Rgba([c[0], c[1], c[2], 255])
+                    }
+                });
+                let p = dir.join(format!("f{f}.png"));
+                img.save(&p).unwrap();
+                p
+            })
+            .collect();
+        let out = dir.join("t.gif");
+        let opts = GifOptions {
+            delay_ms: 40,
+            dither: GifDither::None,
+        };
+        let info = assemble(&frames, &out, opts).unwrap();
+        assert!(info.transparent);
+        assert_eq!(info.colors, 4);
+        let mut o = gif::DecodeOptions::new();
+        o.set_color_output(gif::ColorOutput::RGBA);
+        let mut dec = o.read_info(std::fs::File::open(&out).unwrap()).unwrap();
+        let entries = dec.global_palette().unwrap().len() / 3;
+        let mut n = 0;
+        while let Some(f) = dec.read_next_frame().unwrap() {
+            // The transparent index names an entry of the palette written.
+            let t = f.transparent.unwrap() as usize;
+            assert!(t < entries, "transparent index {t} of {entries} entries");
+            for y in 0..4usize {
+                for x in 0..8usize {
+                    let p = &f.buffer[(y * 8 + x) * 4..(y * 8 + x) * 4 + 4];
+                    if x < 4 {
+                        assert_eq!(p[3], 0, "frame {n} ({x},{y}) should be transparent");
+                    } else {
+                        let c = colors[(x + y + n) % 3];
+                        assert_eq!(p, &[c[0], c[1], c[2], 255][..], "frame {n} ({x},{y})");
+                    }
+                }
+            }
+            n += 1;
+        }
+        assert_eq!(n, 2);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
