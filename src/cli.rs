@@ -37,7 +37,7 @@ enum Command {
     /// shadows, AO, depth mode) on one frame of a scene: CSV and chart.
     Chart(ChartArgs),
     /// Time the reference turntables (load, per-frame, total).
-    Bench(softraster::bench::BenchArgs),
+    Bench(softraster::tools::bench::BenchArgs),
     /// Write the procedural showcase assets (meshes, textures) to a directory.
     GenerateAssets {
         /// Output directory (the repository keeps them in assets/showcase).
@@ -160,7 +160,7 @@ pub fn main() -> i32 {
         Command::Gif(args) => gif(args),
         Command::Chart(args) => chart(args),
         Command::Compare(args) => return compare(args),
-        Command::Bench(args) => softraster::bench::run(&args),
+        Command::Bench(args) => softraster::tools::bench::run(&args),
         Command::GenerateAssets { dir } => softraster::procedural::write_showcase_assets(&dir),
     };
     match result {
@@ -178,7 +178,7 @@ pub fn main() -> i32 {
 }
 
 fn compare(args: CompareArgs) -> i32 {
-    use softraster::output::compare::{Metric, compare_paths};
+    use softraster::tools::compare::{Metric, compare_paths};
     let Some(metric) = Metric::parse(&args.metric) else {
         eprintln!(
             "error: --metric {}: expected flip, ssim, psnr or mae",
@@ -214,7 +214,7 @@ fn compare(args: CompareArgs) -> i32 {
 }
 
 fn chart(args: ChartArgs) -> Result<(), Error> {
-    use softraster::chart::{self, ChartOptions, Knob};
+    use softraster::tools::chart::{self, ChartOptions, Knob};
     let knobs = match &args.knobs {
         None => Knob::ALL.to_vec(),
         Some(list) => list

@@ -5,11 +5,8 @@
 //! ([`raster`]) and shading ([`shade`]) -> [`render::Frame`] -> writers
 //! ([`output`]).
 
-pub mod accuracy;
 pub mod assets;
 pub mod batch;
-pub mod bench;
-pub mod chart;
 pub mod error;
 pub mod output;
 pub mod procedural;
@@ -18,5 +15,7 @@ pub mod raytrace;
 pub mod render;
 pub mod scene;
 pub mod shade;
+#[cfg(feature = "tools")]
+pub mod tools;
 
 pub use error::{Error, Result};

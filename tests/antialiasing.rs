@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use softraster::accuracy;
+use softraster::tools::accuracy;
 use softraster::raster::coverage::sample_pattern;
 use softraster::render::{Frame, render_frame};
 use softraster::scene::Scene;

@@ -13,7 +13,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use softraster::output::compare::{Metric, score};
+use softraster::tools::compare::{Metric, score};
 use softraster::output::{png, resolve};
 use softraster::render::render_frame;
 use softraster::scene::Scene;

@@ -579,9 +579,9 @@ fn ssao_matches_raytraced_ao_on_bunny_and_diablo3() {
     let dir = common::scratch("ssao_vs_raytraced");
     let size = 160u32;
     // The scenes of `bench --case ao`.
-    for (name, model, eye) in softraster::accuracy::AO_SCENES {
+    for (name, model, eye) in softraster::tools::accuracy::AO_SCENES {
         let (scene, radius) =
-            softraster::accuracy::ao_scene(&dir, &assets.join(model), eye, size).unwrap();
+            softraster::tools::accuracy::ao_scene(&dir, &assets.join(model), eye, size).unwrap();
         let (rmse, n) = ssao_rmse(&dir, &scene, radius);
         println!(
             "{name}: SSAO (16 samples, radius {radius:.3}) vs ray-traced AO (512 rays): RMSE {rmse:.4} over {n} pixels"

@@ -14,7 +14,7 @@ use common::{scene_in, scratch, shared_assets};
 #[test]
 fn filters_rank_by_error_against_a_supersampled_reference() {
     let dir = scratch("filters");
-    let r = softraster::bench::filter_accuracy(&dir, 160, 120).unwrap();
+    let r = softraster::tools::bench::filter_accuracy(&dir, 160, 120).unwrap();
     println!("filter,mean_abs_error_linear,ms");
     for f in &r {
         println!("{},{:.5},{:.2}", f.filter, f.mean_error, f.ms);

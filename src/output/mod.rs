@@ -3,7 +3,6 @@
 //! directory and renamed into place, so an interrupted render never leaves a
 //! half-written frame under the final name.
 
-pub mod compare;
 pub mod exr;
 pub mod gif;
 pub mod png;

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Error;
-use crate::output::compare::{Metric, score};
+use crate::tools::compare::{Metric, score};
 use crate::output::{self, Image8};
 use crate::render::{Frame, FrameSetup, render_into};
 use crate::scene::desc::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
@@ -198,7 +198,7 @@ fn interior_mask(f: &Frame) -> Vec<bool> {
 
 /// RMSE of the AO buffer against the reference's, over covered pixels.
 fn ao_rmse(got: &Frame, reference: &Frame) -> f64 {
-    crate::accuracy::ao_error([(got, reference)]).0
+    crate::tools::accuracy::ao_error([(got, reference)]).0
 }
 
 /// Marks the Pareto front of each knob and reference.
@@ -434,7 +434,7 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
             samples: rays,
         };
         let (reference, _, t) = timed(scene, opts.frame, 1);
-        let noise = crate::accuracy::ao_noise_bound(&reference, rays);
+        let noise = crate::tools::accuracy::ao_noise_bound(&reference, rays);
         let against =
             format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE below {noise:.4})");
         let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;

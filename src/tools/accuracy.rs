@@ -388,7 +388,7 @@ pub fn edges(
         let n = got[0].color.len().max(1) as f64;
         let img = output::resolve(&got[0], &s.settings);
         save(name, &img)?;
-        let flip = output::compare::score(&reference_img, &img, output::compare::Metric::Flip)
+        let flip = crate::tools::compare::score(&reference_img, &img, crate::tools::compare::Metric::Flip)
             .map_err(|e| Error::Argument(format!("edge accuracy: {e}")))?
             .value;
         rows.push(EdgeRow {

@@ -284,9 +284,9 @@ fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
         ..args.clone()
     };
     let text = if args.case == "bunny-plane" {
-        let (name, model, eye) = crate::accuracy::AO_SCENES[0];
+        let (name, model, eye) = crate::tools::accuracy::AO_SCENES[0];
         debug_assert!(name.starts_with("bunny"));
-        let (text, _) = crate::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
+        let (text, _) = crate::tools::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
         text.replace("ao = {ao}", "msaa = 1")
             + "\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, -0.8, -0.35]\nirradiance = 2.0\nshadows = true\n\
                \n[ambient]\ncolor = [0.08, 0.08, 0.09]\n"
@@ -321,7 +321,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         let dir = std::env::temp_dir().join(format!("softraster-edges-{}", std::process::id()));
         let pool = thread_pool(args)?;
         let (w, h) = (args.size, args.size * 3 / 4);
-        let r = pool.install(|| crate::accuracy::edges(&dir, w, h, 5, args.out.as_deref()));
+        let r = pool.install(|| crate::tools::accuracy::edges(&dir, w, h, 5, args.out.as_deref()));
         let _ = std::fs::remove_dir_all(&dir);
         println!("method,ms_per_frame_{w}x{h},mae_linear,rmse_linear,flip_mean");
         for row in r? {
@@ -375,7 +375,7 @@ fn accuracy_tables(args: &BenchArgs) -> Result<(), Error> {
         if args.case == "shadows" {
             // Every 9th frame of the turntable (8 frames of 72).
             let frames: Vec<u32> = (0..args.frames).step_by(9).collect();
-            let rows = crate::accuracy::shadows(&assets, args.size, &frames)?;
+            let rows = crate::tools::accuracy::shadows(&assets, args.size, &frames)?;
             println!(
                 "# diablo3 on the floor, one directional light, {}x{}, frames {frames:?}, {threads} thread(s); reference: raytraced",
                 args.size, args.size
@@ -390,7 +390,7 @@ fn accuracy_tables(args: &BenchArgs) -> Result<(), Error> {
         } else {
             // Every 18th frame (4 of 72): the reference is 1024 rays a pixel.
             let frames: Vec<u32> = (0..args.frames).step_by(18).collect();
-            let tables = crate::accuracy::ao(&assets, args.size, &frames, 1024)?;
+            let tables = crate::tools::accuracy::ao(&assets, args.size, &frames, 1024)?;
             println!(
                 "# {}x{}, frames {frames:?}, {threads} thread(s); reference: raytraced, 1024 rays, same radius",
                 args.size, args.size
