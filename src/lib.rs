@@ -7,6 +7,7 @@
 
 pub mod assets;
 pub mod batch;
+pub mod color;
 pub mod error;
 pub mod output;
 pub mod procedural;

@@ -13,7 +13,7 @@ use glam::Vec4;
 use rayon::prelude::*;
 
 use super::texture::{Level, Texture};
-use crate::shade::tonemap::{encode_linear, encode_srgb};
+use crate::color::{encode_linear, encode_srgb};
 
 /// Levels 1.. of `t` (empty for a 1x1 texture).
 pub fn build_chain(t: &Texture) -> Vec<Level> {
@@ -125,7 +125,7 @@ mod tests {
         assert_eq!(sizes, vec![(2, 1), (1, 1)]);
         // 3/5 white in linear: the 1x1 level is linear 0.6, sRGB ~203.
         let top = chain[1].texel(0, 0);
-        let lin = crate::assets::texture::srgb_to_linear_table()[top[0] as usize];
+        let lin = crate::color::srgb_to_linear_table()[top[0] as usize];
         assert!((lin - 0.6).abs() < 0.01, "{top:?} {lin}");
     }
 }

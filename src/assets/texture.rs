@@ -18,6 +18,7 @@ use std::sync::OnceLock;
 
 use glam::{Affine2, Vec2, Vec4};
 
+use crate::color::srgb_to_linear_table;
 use crate::error::Error;
 use crate::scene::desc::{AddressMode, TextureFilter};
 
@@ -96,34 +97,6 @@ pub struct Filtering {
 pub struct Gradients {
     pub dx: Vec2,
     pub dy: Vec2,
-}
-
-/// sRGB-encoded byte -> linear float.
-pub fn srgb_to_linear_table() -> &'static [f32; 256] {
-    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        let mut t = [0.0f32; 256];
-        for (i, v) in t.iter_mut().enumerate() {
-            *v = srgb_to_linear(i as f32 / 255.0);
-        }
-        t
-    })
-}
-
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-pub fn linear_to_srgb(c: f32) -> f32 {
-    if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 /// Border color for `address = "border"` and NaN coordinates: transparent black.
@@ -493,18 +466,6 @@ mod tests {
             vec![[255; 4], [0, 0, 0, 255], [0, 0, 0, 255], [255; 4]],
             false,
         )
-    }
-
-    #[test]
-    fn srgb_tables_round_trip() {
-        let lut = srgb_to_linear_table();
-        assert_eq!(lut[0], 0.0);
-        assert!((lut[255] - 1.0).abs() < 1e-6);
-        assert!((lut[188] - 0.5029).abs() < 1e-3);
-        for i in 0..=255u8 {
-            let back = (linear_to_srgb(lut[i as usize]) * 255.0).round() as u8;
-            assert_eq!(back, i);
-        }
     }
 
     #[test]

@@ -6,6 +6,7 @@
 pub mod exr;
 pub mod gif;
 pub mod png;
+pub mod tonemap;
 
 use std::io::Write;
 use std::path::Path;
@@ -16,7 +17,8 @@ use crate::error::Error;
 use crate::render::Frame;
 use crate::scene::RenderSettings;
 use crate::scene::desc::{Background, ShadingMode};
-use crate::shade::tonemap::{encode_linear, encode_srgb, tonemap};
+use crate::color::{encode_linear, encode_srgb};
+use tonemap::tonemap;
 
 /// 8-bit display image: RGB, or RGBA for a transparent background.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -5,7 +5,6 @@ pub mod ao;
 pub mod blinn_phong;
 pub mod pbr;
 pub mod shadow;
-pub mod tonemap;
 
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
