@@ -288,7 +288,7 @@ fn chart(args: ChartArgs) -> Result<(), Error> {
 }
 
 fn gif(args: GifArgs) -> Result<(), Error> {
-    use softraster::scene::desc::GifDither;
+    use softraster::scene::settings::GifDither;
     let dither = match args.dither.as_str() {
         "none" => GifDither::None,
         "ordered" => GifDither::Ordered,

@@ -8,10 +8,10 @@ mod common;
 
 use std::path::Path;
 
-use softraster::tools::accuracy;
 use softraster::raster::coverage::sample_pattern;
 use softraster::render::{Frame, render_frame};
 use softraster::scene::Scene;
+use softraster::tools::accuracy;
 
 /// A white unlit rectangle seen by an orthographic camera at 64x48 pixels
 /// of 0.1 world units: x from pixel 21.7 to 45.1, y from 14.45 to 32.7

@@ -377,7 +377,7 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
 
 #[test]
 fn keys_without_effect_warn_and_map_keys_mean_shadow_maps() {
-    use softraster::scene::desc::ShadowMethod;
+    use softraster::scene::settings::ShadowMethod;
     let dir = common::scratch("no_effect");
     let tri = ("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     let scene = |text: &str| {

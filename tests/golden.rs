@@ -13,12 +13,12 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use softraster::tools::compare::{Metric, score};
 use softraster::output::{png, resolve};
 use softraster::render::render_frame;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 use softraster::scene::overrides::SetOverride;
+use softraster::tools::compare::{Metric, score};
 
 const MEAN_FLIP: f64 = 0.001;
 const LOCAL_FLIP: f32 = 0.1;

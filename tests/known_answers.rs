@@ -4,13 +4,13 @@
 mod common;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use softraster::raster::CullMode;
 use softraster::raster::bin::TileRect;
 use softraster::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use softraster::raster::coverage::raster_triangle;
 use softraster::raster::interp;
 use softraster::raster::setup::{Viewport, setup};
 use softraster::render::render_frame;
-use softraster::scene::desc::CullMode;
 
 /// A whole (unclipped) triangle: each vertex is its own barycentric corner.
 fn corners(c: [Vec4; 3]) -> [ClipVertex; 3] {

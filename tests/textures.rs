@@ -214,7 +214,7 @@ fn tangent_and_object_space_maps_of_diablo3_agree() {
         return;
     };
     use softraster::assets::texture::Texture;
-    use softraster::scene::desc::AddressMode;
+    use softraster::scene::settings::AddressMode;
     let d3 = assets.join("tinyrenderer/diablo3_pose");
     let mut mesh = softraster::assets::obj::load(&d3.join("diablo3_pose.obj"))
         .unwrap()

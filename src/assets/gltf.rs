@@ -21,9 +21,8 @@ use gltf::mesh::Mode;
 
 use super::mesh::{Group, Mesh};
 use super::texture::Wrap;
+use super::texture::{AddressMode, TextureFilter};
 use crate::error::Error;
-use crate::scene::desc::{AddressMode, AlphaModeDesc, TextureFilter};
-use crate::scene::light::{Light, LightKind};
 
 /// Extensions that change how softraster draws a file; a file that
 /// requires any other one is refused.
@@ -66,6 +65,15 @@ pub struct TexInfo {
     pub mag_nearest: bool,
 }
 
+/// A material's `alphaMode`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GltfAlphaMode {
+    Opaque,
+    /// Cut out below `alphaCutoff`.
+    Mask,
+    Blend,
+}
+
 /// A glTF metallic-roughness material as the file states it.
 #[derive(Debug, Clone)]
 pub struct GltfMaterial {
@@ -82,7 +90,7 @@ pub struct GltfMaterial {
     /// emissiveFactor times KHR_materials_emissive_strength.
     pub emissive: Vec3,
     pub emissive_tex: Option<TexInfo>,
-    pub alpha_mode: AlphaModeDesc,
+    pub alpha_mode: GltfAlphaMode,
     pub alpha_cutoff: f32,
     pub double_sided: bool,
 }
@@ -103,7 +111,7 @@ impl GltfMaterial {
             occlusion_strength: 1.0,
             emissive: Vec3::ZERO,
             emissive_tex: None,
-            alpha_mode: AlphaModeDesc::Opaque,
+            alpha_mode: GltfAlphaMode::Opaque,
             alpha_cutoff: 0.5,
             double_sided: false,
         }
@@ -127,7 +135,27 @@ impl GltfMaterial {
 #[derive(Debug, Clone)]
 pub struct GltfLight {
     pub name: String,
-    pub light: Light,
+    pub kind: GltfLightKind,
+    /// Linear RGB.
+    pub color: Vec3,
+    /// Candela (point, spot) or lux (directional).
+    pub intensity: f32,
+    /// Point and spot: the distance where the light ends (None: unlimited).
+    pub range: Option<f32>,
+    pub position: Vec3,
+    /// Unit direction the light travels along (the node's -Z).
+    pub direction: Vec3,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GltfLightKind {
+    Directional,
+    Point,
+    /// Cone angles in radians from the axis.
+    Spot {
+        inner_cone_angle: f32,
+        outer_cone_angle: f32,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -636,9 +664,9 @@ fn material(
         emissive: Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
         emissive_tex,
         alpha_mode: match m.alpha_mode() {
-            gltf::material::AlphaMode::Opaque => AlphaModeDesc::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaModeDesc::Mask,
-            gltf::material::AlphaMode::Blend => AlphaModeDesc::Blend,
+            gltf::material::AlphaMode::Opaque => GltfAlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => GltfAlphaMode::Mask,
+            gltf::material::AlphaMode::Blend => GltfAlphaMode::Blend,
         },
         alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
         double_sided: m.double_sided(),
@@ -647,44 +675,31 @@ fn material(
 
 fn light(l: &gltf::khr_lights_punctual::Light, node: &gltf::Node, world: Mat4) -> GltfLight {
     use gltf::khr_lights_punctual::Kind;
-    let position = world.transform_point3(Vec3::ZERO);
-    let direction = world
-        .transform_vector3(Vec3::NEG_Z)
-        .try_normalize()
-        .unwrap_or(Vec3::NEG_Z);
-    let intensity = l.intensity();
-    let kind = match l.kind() {
-        Kind::Directional => LightKind::Directional {
-            direction,
-            irradiance: intensity,
-        },
-        Kind::Point => LightKind::Point {
-            position,
-            intensity,
-        },
-        Kind::Spot {
-            inner_cone_angle,
-            outer_cone_angle,
-        } => LightKind::Spot {
-            position,
-            direction,
-            intensity,
-            cos_inner: inner_cone_angle.cos(),
-            cos_outer: outer_cone_angle.cos(),
-        },
-    };
     GltfLight {
         name: l
             .name()
             .or(node.name())
             .map(str::to_string)
             .unwrap_or_else(|| format!("light{}", l.index())),
-        light: Light {
-            kind,
-            color: Vec3::from(l.color()),
-            shadows: false,
-            range: l.range(),
+        kind: match l.kind() {
+            Kind::Directional => GltfLightKind::Directional,
+            Kind::Point => GltfLightKind::Point,
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => GltfLightKind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            },
         },
+        color: Vec3::from(l.color()),
+        intensity: l.intensity(),
+        range: l.range(),
+        position: world.transform_point3(Vec3::ZERO),
+        direction: world
+            .transform_vector3(Vec3::NEG_Z)
+            .try_normalize()
+            .unwrap_or(Vec3::NEG_Z),
     }
 }
 

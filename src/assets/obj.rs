@@ -56,15 +56,6 @@ pub struct MtlMaterial {
     /// `norm`: always a normal map.
     pub norm: Option<MapSpec>,
     pub disp: Option<MapSpec>,
-    /// Scene-only keys (overrides), absent from MTL files.
-    pub bump_scale: Option<f32>,
-    pub normal_space: Option<crate::scene::desc::NormalSpace>,
-    pub alpha_mode: Option<crate::scene::desc::AlphaModeDesc>,
-    pub alpha_cutoff: Option<f32>,
-    pub disp_scale: Option<f32>,
-    /// Scene-only: pbr parameters when this material is shaded as pbr.
-    pub metallic: Option<f32>,
-    pub roughness: Option<f32>,
     /// Made up by the loader for faces without a material (no MTL, or no
     /// `usemtl`): the renderer's defaults apply rather than MTL's.
     pub synthetic: bool,

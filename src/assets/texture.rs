@@ -20,7 +20,32 @@ use glam::{Affine2, Vec2, Vec4};
 
 use crate::color::srgb_to_linear_table;
 use crate::error::Error;
-use crate::scene::desc::{AddressMode, TextureFilter};
+
+/// Texture filtering, ordered from the least to the most filtering (a
+/// sampler's limit lowers a scene's filter to it, never raises it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum TextureFilter {
+    Nearest,
+    Bilinear,
+    /// Mip level from the longer footprint axis, blended between levels.
+    Trilinear,
+    /// Up to `max_anisotropy` trilinear probes along the longer axis. The
+    /// default since `softraster chart` showed trilinear off the Pareto
+    /// front (docs/chart.md).
+    #[default]
+    Anisotropic,
+}
+
+/// What a lookup outside [0, 1] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AddressMode {
+    #[default]
+    Repeat,
+    Mirror,
+    Clamp,
+    /// Transparent black (`BORDER`).
+    Border,
+}
 
 /// One image of a mip chain: RGBA8 in 4x4 blocks (see the module notes).
 #[derive(Debug)]
@@ -445,7 +470,7 @@ impl TextureRef {
                     return t.sample_nearest(uv, mode);
                 }
             } else if let Some(limit) = self.min_limit
-                && (limit as u8) < (f.filter as u8)
+                && limit < f.filter
             {
                 f.filter = limit;
             }

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::write_atomic;
 use crate::error::Error;
-use crate::scene::desc::GifDither;
+use crate::scene::settings::GifDither;
 
 #[derive(Debug, Clone, Copy)]
 pub struct GifOptions {

@@ -13,11 +13,11 @@ use std::path::Path;
 
 use glam::Vec4;
 
+use crate::color::{encode_linear, encode_srgb};
 use crate::error::Error;
 use crate::render::Frame;
 use crate::scene::RenderSettings;
-use crate::scene::desc::{Background, ShadingMode};
-use crate::color::{encode_linear, encode_srgb};
+use crate::scene::settings::Background;
 use tonemap::tonemap;
 
 /// 8-bit display image: RGB, or RGBA for a transparent background.
@@ -36,10 +36,7 @@ pub struct Image8 {
 pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
     let alpha = s.background == Background::Transparent;
     let channels = if alpha { 4 } else { 3 };
-    let data_view = matches!(
-        s.shading,
-        ShadingMode::Normals | ShadingMode::Depth | ShadingMode::Wireframe
-    );
+    let data_view = s.shading.is_data_view();
     let scale = s.exposure.exp2();
     let mut data = vec![0u8; frame.color.len() * channels];
     use rayon::prelude::*;

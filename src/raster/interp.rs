@@ -110,9 +110,9 @@ pub fn at_pixel(t: &Tri, px: i32, py: i32) -> Fragment {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::CullMode;
     use crate::raster::clip::ClipVertex;
     use crate::raster::setup::{Viewport, setup};
-    use crate::scene::desc::CullMode;
     use glam::Vec4;
 
     #[test]

@@ -9,3 +9,23 @@ pub mod clip;
 pub mod coverage;
 pub mod interp;
 pub mod setup;
+
+/// Which triangles setup discards by their winding on screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CullMode {
+    /// Counter-clockwise triangles face the camera; clockwise ones go.
+    #[default]
+    Back,
+    Front,
+    None,
+}
+
+/// How view distance maps to stored depth.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DepthMode {
+    /// Near 1, far 0, in float: precision follows distance (the default).
+    #[default]
+    ReverseZ,
+    /// Near 0, far 1 (OpenGL-style, for comparison).
+    Standard,
+}

@@ -10,8 +10,8 @@
 
 use glam::Vec3;
 
+use super::CullMode;
 use super::clip::ClipVertex;
-use crate::scene::desc::CullMode;
 
 /// 1/32768 pixel. Coordinates stay within 2^14 pixels of the viewport center
 /// (guard band), so each edge-function product stays below 2^60: no

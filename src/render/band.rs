@@ -24,8 +24,8 @@ use crate::raster::coverage::{
 };
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
-use crate::scene::desc::ShadingMode;
 use crate::scene::material::AlphaMode;
+use crate::scene::settings::ShadingMode;
 use crate::shade::ao::GPixel;
 use crate::shade::{ShadeContext, Surface, TexCoords};
 

@@ -19,8 +19,8 @@ use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::coverage::raster_triangle;
 use crate::raster::setup::{Tri, Viewport, setup};
 use crate::raytrace::Tracer;
-use crate::scene::desc::{CullMode, ShadowMethod};
 use crate::scene::light::LightKind;
+use crate::scene::settings::{CullMode, ShadowMethod};
 use crate::shade::shadow::{Filter, LightShadow, MapProjection, ShadowMap, Shadows};
 
 const CHUNK: usize = 4096;

@@ -4,7 +4,15 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use super::desc::TurntableTarget;
+/// What a turntable turns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TurntableTarget {
+    /// The models, about the pivot; camera and lights stay.
+    #[default]
+    Models,
+    /// The cameras, about the pivot; models and lights stay.
+    Camera,
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Turntable {

@@ -7,7 +7,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::desc::DepthMode;
+use crate::raster::DepthMode;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Projection {

@@ -52,17 +52,12 @@ pub struct OutputDesc {
     pub background: Option<S<Background>>,
 }
 
-/// How GIF frames are dithered to the shared palette.
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::GifDither`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum GifDither {
-    /// Nearest palette color.
-    #[default]
     None,
-    /// An 8x8 Bayer pattern: stable from frame to frame where the image is.
     Ordered,
-    /// Error diffusion: smoothest gradients, but its noise moves with the
-    /// image.
     FloydSteinberg,
 }
 
@@ -72,14 +67,12 @@ pub enum Background {
     Transparent,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::ShadingMode`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadingMode {
-    /// Each material in its file's model: Blinn-Phong for MTL, pbr for glTF.
-    #[default]
     Auto,
     BlinnPhong,
-    /// glTF 2.0 metallic-roughness (appendix B BRDF) for every material.
     Pbr,
     Flat,
     Gouraud,
@@ -89,77 +82,73 @@ pub enum ShadingMode {
     Wireframe,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::TextureFilter`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum TextureFilter {
     Nearest,
     Bilinear,
     Trilinear,
-    /// The default since `softraster chart` showed trilinear off the Pareto
-    /// front (docs/chart.md).
-    #[default]
     Anisotropic,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::AddressMode`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum AddressMode {
-    #[default]
     Repeat,
     Mirror,
     Clamp,
     Border,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::CullMode`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum CullMode {
-    #[default]
     Back,
     Front,
     None,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::DepthMode`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum DepthMode {
-    #[default]
     ReverseZ,
     Standard,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::ShadowMethod`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowMethod {
     Off,
     Hard,
     Pcf,
-    /// The default: faster than 2048 maps on every charted scene, and exact.
-    #[default]
     Raytraced,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::AoMethod`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum AoMethod {
-    #[default]
     Off,
     Ssao,
     Raytraced,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::settings::Tonemap`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tonemap {
-    #[default]
     Clamp,
     Reinhard,
     Aces,
 }
 
-/// `[render]`. Defaults: auto shading, msaa 1, trilinear, anisotropy 16,
-/// repeat, back-face culling, reverse-Z, pcf (for lights that cast shadows),
-/// 2048 shadow maps, AO off, clamp tone mapping, exposure 0.
+/// `[render]`. The defaults are `scene::build::settings`'s (and the
+/// format's documentation).
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RenderDesc {
@@ -225,9 +214,10 @@ pub struct ModelDesc {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scale(pub [f32; 3]);
 
+/// The file's spelling of [`super::material::NormalSpace`].
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
-pub enum NormalSpace {
+pub enum NormalSpaceDesc {
     Tangent,
     Object,
 }
@@ -254,7 +244,7 @@ pub struct MaterialOverride {
     pub norm: Option<S<String>>,
     pub disp: Option<S<String>>,
     pub bump_scale: Option<S<f32>>,
-    pub normal_space: Option<S<NormalSpace>>,
+    pub normal_space: Option<S<NormalSpaceDesc>>,
     /// Extension: "opaque" | "mask" | "blend" (default: from d, map_d and
     /// the alpha of map_Kd).
     pub alpha_mode: Option<S<AlphaModeDesc>>,
@@ -269,6 +259,7 @@ pub struct MaterialOverride {
     pub roughness: Option<S<f32>>,
 }
 
+/// The file's spelling of [`super::material::AlphaMode`].
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum AlphaModeDesc {
@@ -277,10 +268,10 @@ pub enum AlphaModeDesc {
     Blend,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::light::LightKind`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum LightKind {
-    #[default]
     Point,
     Directional,
     Spot,
@@ -303,10 +294,10 @@ pub struct LightDesc {
     pub outer_angle: Option<S<f32>>,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::camera::Projection`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Projection {
-    #[default]
     Perspective,
     Orthographic,
 }
@@ -335,10 +326,10 @@ pub struct AnimationDesc {
     pub turntable: Option<S<TurntableDesc>>,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+/// The file's spelling of [`super::animation::TurntableTarget`].
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum TurntableTarget {
-    #[default]
     Models,
     Camera,
 }

@@ -7,7 +7,15 @@
 use glam::Vec3;
 
 use crate::assets::texture::TextureRef;
-pub use crate::scene::desc::NormalSpace;
+
+/// The space a normal map's vectors are in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NormalSpace {
+    /// Relative to the surface's tangent frame (the usual kind).
+    Tangent,
+    /// The model's object space.
+    Object,
+}
 
 /// How a material's opacity (d, map_d, alpha of map_Kd) is used.
 #[derive(Debug, Clone, Copy, PartialEq)]

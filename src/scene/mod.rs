@@ -8,8 +8,8 @@ pub mod camera;
 pub mod desc;
 pub mod light;
 pub mod material;
-pub mod materials;
 pub mod overrides;
+pub mod settings;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -19,92 +19,9 @@ use glam::{Mat4, Vec3};
 use crate::assets::mesh::Mesh;
 pub use animation::Animation;
 pub use camera::Camera;
-use desc::{
-    AddressMode, AoMethod, Background, CullMode, DepthMode, ShadingMode, ShadowMethod,
-    TextureFilter, Tonemap,
-};
 pub use light::Light;
 pub use material::Material;
-
-/// Everything that decides how a frame is rasterized and shaded.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub shading: ShadingMode,
-    pub texture_filter: TextureFilter,
-    pub max_anisotropy: f32,
-    pub address: AddressMode,
-    pub cull: CullMode,
-    pub depth: DepthMode,
-    pub tonemap: Tonemap,
-    pub exposure: f32,
-    pub background: Background,
-    pub ambient: Vec3,
-    /// How lights with `shadows = true` cast them (default pcf).
-    pub shadows: ShadowMethod,
-    /// Shadow map size in texels, per side (default 2048).
-    pub shadow_map_size: u32,
-    pub shadow_bias: ShadowBias,
-    pub ao: AoSettings,
-    /// Samples per pixel: 1, 2, 4, 8 or 16 (standard D3D positions).
-    pub msaa: u32,
-    /// Supersampling factor per axis (1: off).
-    pub ssaa: u32,
-}
-
-/// Shadow-map bias, in texels of the map at the receiver.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShadowBias {
-    /// Depth bias (default 1).
-    pub constant: f32,
-    /// Depth bias times the tangent of the angle between normal and light
-    /// (default 0.5; the tangent is capped at 10).
-    pub slope: f32,
-    /// Lookup point moved along the geometric normal, times the sine of
-    /// the angle between normal and light (default 1).
-    pub normal: f32,
-}
-
-impl Default for ShadowBias {
-    fn default() -> ShadowBias {
-        ShadowBias {
-            constant: 1.0,
-            slope: 0.5,
-            normal: 1.0,
-        }
-    }
-}
-
-/// `render.ao`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AoSettings {
-    pub method: AoMethod,
-    /// Occluders within this distance count; None (raytraced only): rays of
-    /// unbounded length. SSAO without a radius uses a fifth of the scene's
-    /// bounding radius.
-    pub radius: Option<f32>,
-    /// Rays per pixel (raytraced) or depth-buffer reads per pixel (ssao).
-    pub samples: u32,
-}
-
-#[derive(Debug, Clone, PartialEq)]
-pub struct OutputSettings {
-    pub dir: PathBuf,
-    /// File stem pattern with `{scene}`, `{camera}`, `{frame}` (`{frame:04}`
-    /// pads with zeros).
-    pub name: String,
-    pub color: bool,
-    /// `<name>_depth.exr`, channel `Z`.
-    pub depth: bool,
-    /// `<name>_ao.exr`, channel `AO`.
-    pub ao: bool,
-    /// The GIF's file name (in `dir`; `{camera}`, or `_<camera>` added
-    /// before the extension when the scene has several cameras).
-    pub gif: Option<String>,
-    pub gif_delay_ms: u32,
-    pub gif_dither: desc::GifDither,
-}
+pub use settings::{AoSettings, OutputSettings, RenderSettings, ShadowBias};
 
 #[derive(Debug, Clone)]
 pub struct Model {

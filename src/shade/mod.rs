@@ -9,8 +9,8 @@ pub mod shadow;
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
 use crate::assets::texture::{Filtering, Gradients, TextureRef};
-use crate::scene::desc::{AddressMode, ShadingMode, TextureFilter};
 use crate::scene::material::{Native, NormalMap, NormalSpace};
+use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
 use blinn_phong::SurfaceColor;
 use pbr::PbrColor;
@@ -339,9 +339,9 @@ impl ShadeContext<'_> {
 }
 
 /// Background pixel: linear color with alpha (0 for transparent).
-pub fn background(bg: crate::scene::desc::Background) -> Vec4 {
+pub fn background(bg: Background) -> Vec4 {
     match bg {
-        crate::scene::desc::Background::Color(c) => Vec3::from(c).extend(1.0),
-        crate::scene::desc::Background::Transparent => Vec4::ZERO,
+        Background::Color(c) => c.extend(1.0),
+        Background::Transparent => Vec4::ZERO,
     }
 }

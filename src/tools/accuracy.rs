@@ -388,9 +388,10 @@ pub fn edges(
         let n = got[0].color.len().max(1) as f64;
         let img = output::resolve(&got[0], &s.settings);
         save(name, &img)?;
-        let flip = crate::tools::compare::score(&reference_img, &img, crate::tools::compare::Metric::Flip)
-            .map_err(|e| Error::Argument(format!("edge accuracy: {e}")))?
-            .value;
+        let flip =
+            crate::tools::compare::score(&reference_img, &img, crate::tools::compare::Metric::Flip)
+                .map_err(|e| Error::Argument(format!("edge accuracy: {e}")))?
+                .value;
         rows.push(EdgeRow {
             method: name.to_string(),
             ms,

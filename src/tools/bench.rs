@@ -201,8 +201,8 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     // benchmark builds them up front and counts them as loading.
     if matches!(
         scene.settings.texture_filter,
-        crate::scene::desc::TextureFilter::Trilinear
-            | crate::scene::desc::TextureFilter::Anisotropic
+        crate::scene::settings::TextureFilter::Trilinear
+            | crate::scene::settings::TextureFilter::Anisotropic
     ) {
         use rayon::prelude::*;
         scene.textures.par_iter().for_each(|t| t.ensure_mips());
@@ -286,7 +286,8 @@ fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
     let text = if args.case == "bunny-plane" {
         let (name, model, eye) = crate::tools::accuracy::AO_SCENES[0];
         debug_assert!(name.starts_with("bunny"));
-        let (text, _) = crate::tools::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
+        let (text, _) =
+            crate::tools::accuracy::ao_scene(&dir, &args.assets.join(model), eye, args.size)?;
         text.replace("ao = {ao}", "msaa = 1")
             + "\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, -0.8, -0.35]\nirradiance = 2.0\nshadows = true\n\
                \n[ambient]\ncolor = [0.08, 0.08, 0.09]\n"

@@ -22,8 +22,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::output::{Image8, png};
 use crate::error::Error;
+use crate::output::{Image8, png};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Metric {

@@ -24,11 +24,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Error;
-use crate::tools::compare::{Metric, score};
 use crate::output::{self, Image8};
 use crate::render::{Frame, FrameSetup, render_into};
-use crate::scene::desc::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
+use crate::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use crate::scene::{AoSettings, Scene};
+use crate::tools::compare::{Metric, score};
 
 /// The knobs, in chart order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -449,7 +449,7 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
         ));
         // SSAO at every radius; ray-traced with fewer rays at the scene's.
         let mut methods: Vec<(AoMethod, u32)> =
-            samples.iter().map(|&n| (AoMethod::Ssao, n)).collect();
+            samples.iter().map(|&n| (AoMethod::Gtao, n)).collect();
         if (scale - 1.0).abs() < 1e-6 {
             let rt: &[u32] = if opts.quick { &[16] } else { &[16, 64, 256] };
             methods.extend(rt.iter().map(|&n| (AoMethod::Raytraced, n)));
@@ -462,7 +462,7 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
             };
             let (f, _, t) = timed(scene, opts.frame, opts.runs);
             let e = ao_rmse(&f, &reference);
-            let ssao = method == AoMethod::Ssao;
+            let ssao = method == AoMethod::Gtao;
             let default =
                 ssao && n == 16 && (radius - default_r).abs() <= 1e-6 * default_r.max(1e-6);
             let name = if ssao { "ssao" } else { "raytraced" };

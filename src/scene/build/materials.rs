@@ -8,26 +8,57 @@ use std::sync::Arc;
 
 use glam::{Affine2, Mat2, Vec2, Vec3, Vec4};
 
-use super::desc::{self, AlphaModeDesc, Ctx, MaterialOverride, NormalSpace, S};
-use super::material::{
-    AlphaMode, Material, Native, NormalMap, Pbr, ns_from_roughness, roughness_from_ns,
-};
-use crate::assets::gltf::{GltfMaterial, ImageSource, TexInfo};
+use crate::assets::gltf::{GltfAlphaMode, GltfMaterial, ImageSource, TexInfo};
 use crate::assets::obj::{self, MapSpec, MtlMaterial};
-use crate::assets::texture::{TextureRef, Wrap};
+use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
+use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, NormalSpaceDesc, S};
+use crate::scene::material::{
+    AlphaMode, Material, Native, NormalMap, NormalSpace, Pbr, ns_from_roughness, roughness_from_ns,
+};
 
 /// A material as its file states it, overrides applied.
 #[derive(Debug, Clone)]
 pub enum SourceMaterial {
-    Mtl(Box<MtlMaterial>),
+    Mtl(Box<MtlSource>),
     Gltf(Box<GltfMaterial>),
+}
+
+/// An MTL material and the scene-only keys its overrides set (MTL files
+/// have none of them).
+#[derive(Debug, Clone)]
+pub struct MtlSource {
+    pub mtl: MtlMaterial,
+    pub bump_scale: Option<f32>,
+    pub normal_space: Option<NormalSpaceDesc>,
+    pub alpha_mode: Option<AlphaModeDesc>,
+    pub alpha_cutoff: Option<f32>,
+    /// World units per unit of `disp` height.
+    pub disp_scale: Option<f32>,
+    /// pbr parameters when this material is shaded as pbr.
+    pub metallic: Option<f32>,
+    pub roughness: Option<f32>,
+}
+
+impl MtlSource {
+    pub fn new(mtl: MtlMaterial) -> MtlSource {
+        MtlSource {
+            mtl,
+            bump_scale: None,
+            normal_space: None,
+            alpha_mode: None,
+            alpha_cutoff: None,
+            disp_scale: None,
+            metallic: None,
+            roughness: None,
+        }
+    }
 }
 
 impl SourceMaterial {
     pub fn name(&self) -> &str {
         match self {
-            SourceMaterial::Mtl(m) => &m.name,
+            SourceMaterial::Mtl(m) => &m.mtl.name,
             SourceMaterial::Gltf(m) => &m.name,
         }
     }
@@ -36,7 +67,7 @@ impl SourceMaterial {
     /// `normals_only`, just the normal and bump maps (the normals view).
     pub fn images(&self, normals_only: bool) -> Vec<(ImageSource, bool)> {
         match self {
-            SourceMaterial::Mtl(m) => shading_maps(m)
+            SourceMaterial::Mtl(m) => shading_maps(&m.mtl)
                 .into_iter()
                 .enumerate()
                 .filter(|(k, _)| !normals_only || *k >= 6)
@@ -91,25 +122,20 @@ fn map_override(
 }
 
 fn apply_mtl_override(
-    m: &mut MtlMaterial,
+    x: &mut MtlSource,
     o: &MaterialOverride,
     scene_dir: &Path,
     ctx: &Ctx,
 ) -> Result<(), Error> {
     macro_rules! set {
-        ($($f:ident),*) => {$(
-            if let Some(v) = &o.$f { m.$f = Some(*v.get_ref()); }
+        ($to:ident: $($f:ident),*) => {$(
+            if let Some(v) = &o.$f { $to.$f = Some(*v.get_ref()); }
         )*};
     }
-    set!(ka, kd, ks, ke, ns, ni, d);
-    set!(
-        bump_scale,
-        normal_space,
-        alpha_mode,
-        alpha_cutoff,
-        disp_scale
-    );
-    set!(metallic, roughness);
+    set!(x: bump_scale, normal_space, alpha_mode, alpha_cutoff, disp_scale);
+    set!(x: metallic, roughness);
+    let m = &mut x.mtl;
+    set!(m: ka, kd, ks, ke, ns, ni, d);
     if let Some(v) = &o.illum {
         m.illum = Some(*v.get_ref() as u8);
     }
@@ -188,7 +214,11 @@ fn apply_gltf_override(
         g.normal_scale = *v.get_ref();
     }
     if let Some(v) = &o.alpha_mode {
-        g.alpha_mode = *v.get_ref();
+        g.alpha_mode = match v.get_ref() {
+            AlphaModeDesc::Opaque => GltfAlphaMode::Opaque,
+            AlphaModeDesc::Mask => GltfAlphaMode::Mask,
+            AlphaModeDesc::Blend => GltfAlphaMode::Blend,
+        };
     }
     if let Some(v) = &o.alpha_cutoff {
         g.alpha_cutoff = *v.get_ref();
@@ -198,9 +228,9 @@ fn apply_gltf_override(
         texcoord: 0,
         transform: mtl_transform(&spec),
         wrap: Wrap::from(if spec.clamp {
-            desc::AddressMode::Clamp
+            AddressMode::Clamp
         } else {
-            desc::AddressMode::Repeat
+            AddressMode::Repeat
         }),
         min_limit: None,
         mag_nearest: false,
@@ -261,13 +291,14 @@ pub fn to_material(src: &SourceMaterial, tex: &TextureLookup) -> Material {
     }
 }
 
-fn mtl_material(m: &MtlMaterial, textures: &TextureLookup) -> Material {
+fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
+    let m = &x.mtl;
     let tex = |map: &Option<MapSpec>, srgb: bool| -> Option<TextureRef> {
         let map = map.as_ref()?;
         let t = textures(&map.path, srgb)?;
         Some(TextureRef {
             transform: mtl_transform(map),
-            address: map.clamp.then_some(desc::AddressMode::Clamp.into()),
+            address: map.clamp.then_some(AddressMode::Clamp.into()),
             ..TextureRef::new(t)
         })
     };
@@ -281,11 +312,14 @@ fn mtl_material(m: &MtlMaterial, textures: &TextureLookup) -> Material {
     let map_d = tex(&m.map_d, false);
     let opacity = m.d.unwrap_or(1.0);
     let bump_scale = |spec: &Option<MapSpec>| {
-        m.bump_scale
+        x.bump_scale
             .or(spec.as_ref().and_then(|s| s.bump_scale))
             .unwrap_or(1.0)
     };
-    let space = m.normal_space.unwrap_or(NormalSpace::Tangent);
+    let space = match x.normal_space {
+        Some(NormalSpaceDesc::Object) => NormalSpace::Object,
+        Some(NormalSpaceDesc::Tangent) | None => NormalSpace::Tangent,
+    };
     let normal_map = if let Some(map) = tex(&m.norm, false) {
         Some(NormalMap::Normals {
             map,
@@ -295,7 +329,7 @@ fn mtl_material(m: &MtlMaterial, textures: &TextureLookup) -> Material {
     } else if let Some(map) = tex(&m.map_bump, false) {
         // map_Bump holds either: a grey image is heights, a colored one normals.
         let scale = bump_scale(&m.map_bump);
-        if map.texture.grey && m.normal_space.is_none() {
+        if map.texture.grey && x.normal_space.is_none() {
             Some(NormalMap::Height { map, scale })
         } else {
             Some(NormalMap::Normals { map, space, scale })
@@ -309,8 +343,8 @@ fn mtl_material(m: &MtlMaterial, textures: &TextureLookup) -> Material {
         .iter()
         .chain(map_kd.iter())
         .find(|t| t.texture.has_alpha);
-    let cutoff = m.alpha_cutoff.unwrap_or(0.5);
-    let alpha = match m.alpha_mode {
+    let cutoff = x.alpha_cutoff.unwrap_or(0.5);
+    let alpha = match x.alpha_mode {
         Some(AlphaModeDesc::Opaque) => AlphaMode::Opaque,
         Some(AlphaModeDesc::Mask) => AlphaMode::Mask(cutoff),
         Some(AlphaModeDesc::Blend) => AlphaMode::Blend,
@@ -332,8 +366,8 @@ fn mtl_material(m: &MtlMaterial, textures: &TextureLookup) -> Material {
     let pbr = Pbr {
         base_color: kd.extend(opacity),
         base_color_map: map_kd.clone(),
-        metallic: m.metallic.unwrap_or(0.0),
-        roughness: m.roughness.unwrap_or_else(|| roughness_from_ns(ns)),
+        metallic: x.metallic.unwrap_or(0.0),
+        roughness: x.roughness.unwrap_or_else(|| roughness_from_ns(ns)),
         metallic_roughness_map: None,
         occlusion_map: None,
         occlusion_strength: 1.0,
@@ -425,9 +459,9 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             scale: g.normal_scale,
         }),
         alpha: match g.alpha_mode {
-            AlphaModeDesc::Opaque => AlphaMode::Opaque,
-            AlphaModeDesc::Mask => AlphaMode::Mask(g.alpha_cutoff),
-            AlphaModeDesc::Blend => AlphaMode::Blend,
+            GltfAlphaMode::Opaque => AlphaMode::Opaque,
+            GltfAlphaMode::Mask => AlphaMode::Mask(g.alpha_cutoff),
+            GltfAlphaMode::Blend => AlphaMode::Blend,
         },
         pbr,
         native: Native::Pbr,

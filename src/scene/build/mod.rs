@@ -1,0 +1,124 @@
+//! `SceneDesc` -> `Scene`, in a fixed order (pbrt-v4's habit): the
+//! settings (`settings`), the models with their materials and textures
+//! (`models`, `materials`), the lights (`lights`), the cameras framing the
+//! models (`cameras`), the animation. Paths resolve against the scene
+//! file's directory; every error names the file, line and column of the key
+//! it comes from, or the asset's path.
+
+mod cameras;
+mod lights;
+mod materials;
+mod models;
+mod settings;
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::Scene;
+use super::animation::{Animation, Turntable, TurntableTarget};
+use super::desc::{self, Ctx, S, SceneDesc};
+use super::overrides::{self, SetOverride};
+use crate::error::Error;
+
+/// Options that come from outside the scene file.
+#[derive(Debug, Clone, Default)]
+pub struct LoadOptions {
+    /// `--set key=value`, applied in order before parsing.
+    pub sets: Vec<SetOverride>,
+    /// `--out`: wins over `output.dir`.
+    pub out_dir: Option<PathBuf>,
+}
+
+impl Scene {
+    /// Reads, parses, validates and loads a scene file.
+    pub fn load(path: &Path, opts: &LoadOptions) -> Result<Scene, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
+            location: crate::error::Location {
+                file: path.to_path_buf(),
+                line: 1,
+                column: 1,
+            },
+            message: format!("cannot read the scene file: {e}"),
+        })?;
+        let text = overrides::apply(&text, &opts.sets)?;
+        Scene::from_text(path, &text, opts)
+    }
+
+    /// Loads a scene from text; `path` names the file in errors and is the
+    /// base for relative paths.
+    pub fn from_text(path: &Path, text: &str, opts: &LoadOptions) -> Result<Scene, Error> {
+        let desc = SceneDesc::parse(path, text)?;
+        let ctx = Ctx { file: path, text };
+        build(&desc, &ctx, opts)
+    }
+}
+
+/// The value of an optional key, or its default.
+fn get<T: Clone>(v: &Option<S<T>>, default: T) -> T {
+    v.as_ref().map(|s| s.get_ref().clone()).unwrap_or(default)
+}
+
+fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
+    let scene_dir = ctx.file.parent().unwrap_or(Path::new("")).to_path_buf();
+    let stem = ctx
+        .file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    let settings = settings::render(d);
+    let output = settings::output(
+        d,
+        ctx,
+        &settings,
+        &scene_dir,
+        &stem,
+        opts.out_dir.as_deref(),
+    )?;
+    let mut warnings = settings::no_effect_warnings(d, ctx, &settings);
+    let models = models::build(d, ctx, &settings, &scene_dir, &mut warnings)?;
+    let bounds = models::bounds(&models.models);
+    let mut lights: Vec<_> = d
+        .lights
+        .iter()
+        .map(|l| lights::from_desc(l.get_ref()))
+        .collect();
+    lights.extend(models.lights);
+    let cameras = cameras::build(d, ctx, bounds, &models.cameras)?;
+    Ok(Scene {
+        file: ctx.file.to_path_buf(),
+        stem,
+        settings,
+        output,
+        models: models.models,
+        lights,
+        cameras,
+        animation: animation(&d.animation, bounds.center),
+        bounds_center: bounds.center,
+        bounds_radius: bounds.radius,
+        textures: models.textures,
+        warnings,
+    })
+}
+
+/// `[animation]`: one frame and no turntable by default; a turntable turns
+/// about +Y by 360 degrees over the frames, turning the models, about the
+/// models' center.
+fn animation(a: &desc::AnimationDesc, pivot: Vec3) -> Animation {
+    let turntable = a.turntable.as_ref().map(|t| {
+        let t = t.get_ref();
+        Turntable {
+            axis: Vec3::from(get(&t.axis, [0.0, 1.0, 0.0])).normalize(),
+            degrees: get(&t.degrees, 360.0),
+            rotate: match t.rotate.as_ref().map(|r| *r.get_ref()) {
+                None | Some(desc::TurntableTarget::Models) => TurntableTarget::Models,
+                Some(desc::TurntableTarget::Camera) => TurntableTarget::Camera,
+            },
+        }
+    });
+    Animation {
+        frames: get(&a.frames, 1) as u32,
+        turntable,
+        pivot,
+    }
+}

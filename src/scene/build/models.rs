@@ -1,0 +1,445 @@
+//! `[[model]]` tables to `Model`s: each model file read once (in parallel)
+//! however many models use it, materials with the scene's overrides, the
+//! textures that drawn materials read decoded once per (image, sRGB) in a
+//! fixed order, then per model its placement, displacement, tangents and
+//! the lights and cameras it imports.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::cameras::Bounds;
+use super::materials::{self, MtlSource, SourceMaterial};
+use super::{get, lights};
+use crate::assets::gltf::{GltfCamera, GltfModel, ImageSource};
+use crate::assets::mesh::Mesh;
+use crate::assets::obj::{self, MapSpec};
+use crate::assets::texture::{AddressMode, Texture};
+use crate::error::Error;
+use crate::scene::desc::{self, Ctx, SceneDesc};
+use crate::scene::light::Light;
+use crate::scene::material::{Material, NormalMap};
+use crate::scene::{Model, RenderSettings};
+
+/// What the models bring: themselves, the decoded textures (`Texture::id`
+/// indexes the list), and the lights and cameras of glTF files that asked
+/// for them (cameras with their model's placement).
+pub(super) struct Models {
+    pub models: Vec<Model>,
+    pub textures: Vec<Arc<Texture>>,
+    pub lights: Vec<Light>,
+    pub cameras: Vec<(GltfCamera, Mat4)>,
+}
+
+/// A model file as loaded: OBJ (+ MTL) or glTF.
+struct SourceModel {
+    mesh: Mesh,
+    materials: Vec<SourceMaterial>,
+    /// glTF only: lights, cameras.
+    gltf: Option<GltfModel>,
+    warnings: Vec<String>,
+}
+
+/// The model files, each once, in the order the scene first names them.
+struct Files {
+    index: BTreeMap<PathBuf, usize>,
+    loaded: Vec<SourceModel>,
+    scene_dir: PathBuf,
+}
+
+impl Files {
+    fn of(&self, md: &desc::ModelDesc) -> &SourceModel {
+        &self.loaded[self.index[&resolve(&self.scene_dir, md.path.get_ref())]]
+    }
+}
+
+pub(super) fn build(
+    d: &SceneDesc,
+    ctx: &Ctx,
+    settings: &RenderSettings,
+    scene_dir: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<Models, Error> {
+    let files = load_files(d, ctx, scene_dir)?;
+    warnings.extend(files.loaded.iter().flat_map(|m| m.warnings.clone()));
+    let model_mats = source_materials(d, ctx, &files, scene_dir)?;
+    // Depth and wireframe views read no texture; the normals view reads
+    // normal and bump maps only.
+    let textured = !matches!(
+        settings.shading,
+        crate::scene::settings::ShadingMode::Depth | crate::scene::settings::ShadingMode::Wireframe
+    );
+    let normals_view = settings.shading == crate::scene::settings::ShadingMode::Normals;
+    let (textures, by_key) = if textured {
+        decode_textures(d, &files, &model_mats, normals_view)?
+    } else {
+        (Vec::new(), BTreeMap::new())
+    };
+    let lookup = |p: &Path, srgb: bool| by_key.get(&(p.to_path_buf(), srgb)).cloned();
+
+    let mut out = Models {
+        models: Vec::new(),
+        textures,
+        lights: Vec::new(),
+        cameras: Vec::new(),
+    };
+    for (i, (m, mats)) in d.models.iter().zip(&model_mats).enumerate() {
+        let md = m.get_ref();
+        let src = files.of(md);
+        let materials: Vec<Material> = mats
+            .iter()
+            .map(|mm| materials::to_material(mm, &lookup))
+            .collect();
+        let world = placement(md, &src.mesh);
+        let mut mesh = src.mesh.clone();
+        for (gi, mm) in mats.iter().enumerate() {
+            if let SourceMaterial::Mtl(mm) = mm
+                && let Some(spec) = &mm.mtl.disp
+            {
+                displace(&mut mesh, gi, spec, mm.disp_scale)?;
+            }
+        }
+        if textured && let Some(set) = tangent_set(&materials) {
+            mesh.compute_tangents(set);
+        }
+        import_lights_and_cameras(md, ctx, src, world, &mut out, warnings)?;
+        out.models.push(Model {
+            name: md
+                .name
+                .as_ref()
+                .map(|n| n.get_ref().clone())
+                .unwrap_or_else(|| format!("model{i}")),
+            mesh: Arc::new(mesh),
+            materials,
+            world_from_object: world,
+        });
+    }
+    Ok(out)
+}
+
+/// Reads every model file once, in parallel; a missing file is an error
+/// naming the `path` key that points at it.
+fn load_files(d: &SceneDesc, ctx: &Ctx, scene_dir: &Path) -> Result<Files, Error> {
+    let mut index: BTreeMap<PathBuf, usize> = BTreeMap::new();
+    let mut list = Vec::new();
+    for m in &d.models {
+        let p = resolve(scene_dir, m.get_ref().path.get_ref());
+        if !p.is_file() {
+            return Err(Error::Asset {
+                path: p,
+                line: None,
+                message: format!(
+                    "model file not found: put the model there or change `path` (from {})",
+                    ctx.location(m.get_ref().path.span())
+                ),
+            });
+        }
+        index.entry(p.clone()).or_insert_with(|| {
+            list.push(p);
+            list.len() - 1
+        });
+    }
+    let loaded = list
+        .par_iter()
+        .map(|p| SourceModel::load(p))
+        .collect::<Result<_, _>>()?;
+    Ok(Files {
+        index,
+        loaded,
+        scene_dir: scene_dir.to_path_buf(),
+    })
+}
+
+/// Per model, its file's materials with `model.material` (all) and then
+/// `model.materials."name"` (one) applied; a name the file lacks is an
+/// error listing the names it has.
+fn source_materials(
+    d: &SceneDesc,
+    ctx: &Ctx,
+    files: &Files,
+    scene_dir: &Path,
+) -> Result<Vec<Vec<SourceMaterial>>, Error> {
+    let mut out = Vec::new();
+    for m in &d.models {
+        let md = m.get_ref();
+        let src = files.of(md);
+        for (name, ov) in &md.materials {
+            if !src.materials.iter().any(|mm| mm.name() == name) {
+                let names: Vec<_> = src.materials.iter().map(|m| m.name()).collect();
+                return Err(ctx.err(
+                    ov.span(),
+                    format!(
+                        "model.materials.\"{name}\": the model has no material of that name (it has: {})",
+                        names.join(", ")
+                    ),
+                ));
+            }
+        }
+        let mats = src
+            .materials
+            .iter()
+            .map(|mm| {
+                let mut mm = mm.clone();
+                if let Some(all) = &md.material {
+                    mm.apply_override(all.get_ref(), scene_dir, ctx)?;
+                }
+                if let Some(one) = md.materials.get(mm.name()) {
+                    mm.apply_override(one.get_ref(), scene_dir, ctx)?;
+                }
+                Ok(mm)
+            })
+            .collect::<Result<Vec<_>, Error>>()?;
+        out.push(mats);
+    }
+    Ok(out)
+}
+
+type TextureKeys = BTreeMap<(PathBuf, bool), Arc<Texture>>;
+
+/// Decodes, in parallel and once per (image, sRGB), the images that the
+/// materials of drawn triangles read; ids follow the images' sorted order.
+fn decode_textures(
+    d: &SceneDesc,
+    files: &Files,
+    model_mats: &[Vec<SourceMaterial>],
+    normals_view: bool,
+) -> Result<(Vec<Arc<Texture>>, TextureKeys), Error> {
+    let mut wanted: BTreeMap<(PathBuf, bool), ImageSource> = BTreeMap::new();
+    for (m, mats) in d.models.iter().zip(model_mats) {
+        let src = files.of(m.get_ref());
+        if !src.mesh.has_uvs() && src.mesh.uvs1.is_empty() {
+            continue;
+        }
+        for (i, mm) in mats.iter().enumerate() {
+            if !src.mesh.groups.iter().any(|g| g.material == i) {
+                continue;
+            }
+            for (img, srgb) in mm.images(normals_view) {
+                wanted.insert((img.key().to_path_buf(), srgb), img);
+            }
+        }
+    }
+    let keys: Vec<_> = wanted.iter().collect();
+    let decoded: Vec<Arc<Texture>> = keys
+        .par_iter()
+        .enumerate()
+        .map(|(id, ((_, srgb), img))| {
+            let t = match img {
+                ImageSource::File(p) => Texture::load(p, *srgb),
+                ImageSource::Memory { name, bytes } => Texture::from_bytes(bytes, name, *srgb),
+            };
+            t.map(|mut t| {
+                t.id = id;
+                Arc::new(t)
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let by_key = keys
+        .iter()
+        .map(|(k, _)| (*k).clone())
+        .zip(decoded.iter().cloned())
+        .collect();
+    Ok((decoded, by_key))
+}
+
+/// The texture-coordinate set of the first material whose normal or bump
+/// map needs per-corner tangents (None: no material needs them).
+fn tangent_set(materials: &[Material]) -> Option<usize> {
+    let nm = materials.iter().find(|m| m.needs_tangents())?;
+    Some(match &nm.normal_map {
+        Some(NormalMap::Normals { map, .. }) | Some(NormalMap::Height { map, .. }) => {
+            map.texcoord as usize
+        }
+        None => 0,
+    })
+}
+
+/// `model.lights` and `model.cameras`: glTF files only; an import that
+/// finds nothing is a warning.
+fn import_lights_and_cameras(
+    md: &desc::ModelDesc,
+    ctx: &Ctx,
+    src: &SourceModel,
+    world: Mat4,
+    out: &mut Models,
+    warnings: &mut Vec<String>,
+) -> Result<(), Error> {
+    for (v, key, what) in [
+        (&md.lights, "model.lights", "lights"),
+        (&md.cameras, "model.cameras", "cameras"),
+    ] {
+        if let Some(v) = v
+            && *v.get_ref()
+            && src.gltf.is_none()
+        {
+            return Err(ctx.err(
+                v.span(),
+                format!("{key} = true: only glTF models carry {what}; this one is OBJ"),
+            ));
+        }
+    }
+    let Some(g) = &src.gltf else { return Ok(()) };
+    if get(&md.lights, false) {
+        if g.lights.is_empty() {
+            warnings.push(format!(
+                "{}: model.lights = true, but the file has no KHR_lights_punctual lights",
+                md.path.get_ref()
+            ));
+        }
+        out.lights
+            .extend(g.lights.iter().map(|l| lights::from_gltf(l, world)));
+    }
+    if get(&md.cameras, false) {
+        if g.cameras.is_empty() {
+            warnings.push(format!(
+                "{}: model.cameras = true, but the file has no cameras",
+                md.path.get_ref()
+            ));
+        }
+        out.cameras
+            .extend(g.cameras.iter().map(|c| (c.clone(), world)));
+    }
+    Ok(())
+}
+
+/// The models' bounding sphere at rest: the box's center (the turntable's
+/// pivot) and the sphere around the box.
+pub(super) fn bounds(models: &[Model]) -> Bounds {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for m in models {
+        for p in &m.mesh.positions {
+            let w = m.world_from_object.transform_point3(*p);
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    Bounds {
+        center: (lo + hi) * 0.5,
+        radius: ((hi - lo).length() * 0.5).max(1e-6),
+    }
+}
+
+impl SourceModel {
+    fn load(path: &Path) -> Result<SourceModel, Error> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if ext == "gltf" || ext == "glb" {
+            let mut g = crate::assets::gltf::load(path)?;
+            Ok(SourceModel {
+                mesh: std::mem::take(&mut g.mesh),
+                materials: g
+                    .materials
+                    .drain(..)
+                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                    .collect(),
+                warnings: std::mem::take(&mut g.warnings),
+                gltf: Some(g),
+            })
+        } else {
+            let o = obj::load(path)?;
+            Ok(SourceModel {
+                mesh: o.mesh,
+                materials: o
+                    .materials
+                    .into_iter()
+                    .map(|m| SourceMaterial::Mtl(Box::new(MtlSource::new(m))))
+                    .collect(),
+                gltf: None,
+                warnings: Vec::new(),
+            })
+        }
+    }
+}
+
+fn resolve(base: &Path, p: &str) -> PathBuf {
+    base.join(p.replace('\\', "/"))
+}
+
+/// translate * rotate (XYZ Euler, degrees) * scale, then with `normalize`
+/// the mesh scaled to a unit box about its center.
+fn placement(m: &desc::ModelDesc, mesh: &Mesh) -> Mat4 {
+    let t = Vec3::from(get(&m.translate, [0.0; 3]));
+    let r = get(&m.rotate, [0.0; 3]);
+    let s = get(&m.scale, desc::Scale([1.0; 3])).0;
+    let q = Quat::from_euler(
+        EulerRot::XYZ,
+        r[0].to_radians(),
+        r[1].to_radians(),
+        r[2].to_radians(),
+    );
+    let world = Mat4::from_scale_rotation_translation(Vec3::from(s), q, t);
+    if !get(&m.normalize, false) {
+        return world;
+    }
+    let (lo, hi) = mesh.bounds();
+    let extent = (hi - lo).max_element().max(1e-20);
+    world * Mat4::from_scale(Vec3::splat(1.0 / extent)) * Mat4::from_translation(-(lo + hi) * 0.5)
+}
+/// Displacement at load time: every vertex of material `group_material`'s
+/// triangles moves along its normal by `base + gain * height` (MTL `-mm`,
+/// default 0 and 1) times `scale` (scene `disp_scale`, default 1), the height
+/// read bilinearly from the map. Vertices at one position (UV seams) move by
+/// their mean, so the surface does not crack; their normals are then
+/// recomputed from the displaced faces.
+fn displace(
+    mesh: &mut Mesh,
+    group_material: usize,
+    spec: &MapSpec,
+    scale: Option<f32>,
+) -> Result<(), Error> {
+    let used: Vec<bool> = {
+        let mut used = vec![false; mesh.positions.len()];
+        for g in mesh.groups.iter().filter(|g| g.material == group_material) {
+            for t in &mesh.triangles[g.triangles.start as usize..g.triangles.end as usize] {
+                for &i in t {
+                    used[i as usize] = true;
+                }
+            }
+        }
+        used
+    };
+    if !used.iter().any(|u| *u) {
+        return Ok(());
+    }
+    if !mesh.has_uvs() {
+        return Err(Error::asset(
+            &spec.path,
+            None,
+            "disp: the model has no texture coordinates to read heights with",
+        ));
+    }
+    let tex = Texture::load(&spec.path, false)?;
+    let (base, gain) = spec.mm.unwrap_or((0.0, 1.0));
+    let scale = scale.unwrap_or(1.0);
+    let mode = if spec.clamp {
+        AddressMode::Clamp
+    } else {
+        AddressMode::Repeat
+    };
+    let map = |uv: Vec2| {
+        let uv = uv * Vec2::new(spec.scale[0], spec.scale[1])
+            + Vec2::new(spec.offset[0], spec.offset[1]);
+        tex.sample_bilinear(uv, mode).x
+    };
+    // Mean offset per welded position.
+    let mut sums: std::collections::HashMap<[u32; 3], (f32, u32)> = Default::default();
+    let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
+        let h = (base + gain * map(mesh.uvs[i])) * scale;
+        let e = sums.entry(key(mesh.positions[i])).or_insert((0.0, 0));
+        e.0 += h;
+        e.1 += 1;
+    }
+    let old = mesh.positions.clone();
+    for (i, _) in used.iter().enumerate().filter(|u| *u.1) {
+        let (sum, n) = sums[&key(old[i])];
+        mesh.positions[i] = old[i] + mesh.normals[i] * (sum / n as f32);
+    }
+    crate::assets::mesh::smooth_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals, &used);
+    Ok(())
+}

@@ -1,0 +1,321 @@
+//! `[render]`, `[output]` and `[ambient]` to `RenderSettings` and
+//! `OutputSettings`: the file's values mapped to the renderer's types, the
+//! defaults filled in (each named once, here), and the keys that are valid
+//! but do nothing with the rest of the scene reported as warnings.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::get;
+use crate::error::Error;
+use crate::scene::desc::{self, Ctx, SceneDesc};
+use crate::scene::settings::{
+    AoMethod, AoSettings, Background, OutputSettings, RenderSettings, ShadowBias, ShadowMethod,
+    TextureFilter,
+};
+use crate::scene::{check_pattern, settings};
+
+/// `From<desc::X> for X` where the file's enum and the renderer's have the
+/// same variants.
+macro_rules! same_variants {
+    ($name:ident: $($v:ident),+) => {
+        impl From<desc::$name> for settings::$name {
+            fn from(v: desc::$name) -> settings::$name {
+                match v {
+                    $(desc::$name::$v => settings::$name::$v,)+
+                }
+            }
+        }
+    };
+}
+
+same_variants!(ShadingMode: Auto, BlinnPhong, Pbr, Flat, Gouraud, Unlit, Normals, Depth, Wireframe);
+same_variants!(TextureFilter: Nearest, Bilinear, Trilinear, Anisotropic);
+same_variants!(AddressMode: Repeat, Mirror, Clamp, Border);
+same_variants!(CullMode: Back, Front, None);
+same_variants!(DepthMode: ReverseZ, Standard);
+same_variants!(ShadowMethod: Off, Hard, Pcf, Raytraced);
+same_variants!(Tonemap: Clamp, Reinhard, Aces);
+same_variants!(GifDither: None, Ordered, FloydSteinberg);
+
+impl From<desc::AoMethod> for AoMethod {
+    fn from(v: desc::AoMethod) -> AoMethod {
+        match v {
+            desc::AoMethod::Off => AoMethod::Off,
+            desc::AoMethod::Ssao => AoMethod::Gtao,
+            desc::AoMethod::Raytraced => AoMethod::Raytraced,
+        }
+    }
+}
+
+impl From<desc::Background> for Background {
+    fn from(v: desc::Background) -> Background {
+        match v {
+            desc::Background::Color(c) => Background::Color(Vec3::from(c)),
+            desc::Background::Transparent => Background::Transparent,
+        }
+    }
+}
+
+/// A file enum mapped to the renderer's, or the renderer's default.
+fn pick<D: Copy + Into<R>, R: Default>(v: &Option<desc::S<D>>) -> R {
+    v.as_ref()
+        .map(|v| (*v.get_ref()).into())
+        .unwrap_or_default()
+}
+
+/// `[render]`, `output.width/height/background` and `[ambient]`.
+pub(super) fn render(d: &SceneDesc) -> RenderSettings {
+    let (r, o) = (&d.render, &d.output);
+    RenderSettings {
+        width: get(&o.width, 800) as u32,
+        height: get(&o.height, 800) as u32,
+        shading: pick(&r.shading),
+        texture_filter: pick(&r.texture_filter),
+        max_anisotropy: get(&r.max_anisotropy, 16) as f32,
+        address: pick(&r.address),
+        cull: pick(&r.cull),
+        depth: pick(&r.depth),
+        tonemap: pick(&r.tonemap),
+        exposure: get(&r.exposure, 0.0),
+        background: o
+            .background
+            .as_ref()
+            .map(|b| (*b.get_ref()).into())
+            .unwrap_or(Background::Color(Vec3::ZERO)),
+        ambient: Vec3::from(get(&d.ambient.color, [0.03; 3])),
+        shadows: shadow_method(r),
+        shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
+        shadow_bias: shadow_bias(r),
+        ao: ao_settings(r),
+        msaa: get(&r.msaa, 1) as u32,
+        ssaa: get(&r.ssaa, 1) as u32,
+    }
+}
+
+/// `[output]`: where the files go and what they are called. `out_dir`
+/// (`--out`) wins over `output.dir`; without either, `out/<scene stem>`.
+pub(super) fn output(
+    d: &SceneDesc,
+    ctx: &Ctx,
+    settings: &RenderSettings,
+    scene_dir: &Path,
+    stem: &str,
+    out_dir: Option<&Path>,
+) -> Result<OutputSettings, Error> {
+    let o = &d.output;
+    if let Some(v) = &o.ao
+        && *v.get_ref()
+        && settings.ao.method == AoMethod::Off
+    {
+        return Err(ctx.err(
+            v.span(),
+            "output.ao = true needs render.ao with method = \"ssao\" or \"raytraced\"",
+        ));
+    }
+    let name = get(&o.name, "{camera}_{frame:04}".to_string());
+    if let Err(msg) = check_pattern(&name) {
+        let span = o.name.as_ref().map(|n| n.span()).unwrap_or(0..0);
+        return Err(ctx.err(span, format!("output.name: {msg}")));
+    }
+    if let (Some(g), Some(c)) = (&o.gif, &o.color)
+        && !*c.get_ref()
+    {
+        return Err(ctx.err(
+            g.span(),
+            "output.gif is assembled from the color frames: it needs output.color = true",
+        ));
+    }
+    let dir = match (out_dir, &o.dir) {
+        (Some(out), _) => out.to_path_buf(),
+        (None, Some(dir)) => scene_dir.join(dir.get_ref()),
+        (None, None) => PathBuf::from("out").join(stem),
+    };
+    Ok(OutputSettings {
+        dir,
+        name,
+        color: get(&o.color, true),
+        depth: get(&o.depth, false),
+        ao: get(&o.ao, false),
+        gif: o.gif.as_ref().map(|g| g.get_ref().clone()),
+        gif_delay_ms: get(&o.gif_delay_ms, 40) as u32,
+        gif_dither: pick(&o.gif_dither),
+    })
+}
+
+fn shadow_bias(r: &desc::RenderDesc) -> ShadowBias {
+    let d = ShadowBias::default();
+    match &r.shadow_bias {
+        Some(b) => {
+            let b = b.get_ref();
+            ShadowBias {
+                constant: get(&b.constant, d.constant),
+                slope: get(&b.slope, d.slope),
+                normal: get(&b.normal, d.normal),
+            }
+        }
+        None => d,
+    }
+}
+
+/// `render.shadows`, or without it: pcf when the scene sets a shadow-map
+/// key (it asked for maps), otherwise the default (raytraced).
+fn shadow_method(r: &desc::RenderDesc) -> ShadowMethod {
+    match &r.shadows {
+        Some(m) => (*m.get_ref()).into(),
+        None if r.shadow_map_size.is_some() || r.shadow_bias.is_some() => ShadowMethod::Pcf,
+        None => ShadowMethod::default(),
+    }
+}
+
+/// `render.ao`: 64 rays a pixel ray-traced, 16 depth reads a pixel GTAO.
+fn ao_settings(r: &desc::RenderDesc) -> AoSettings {
+    let (method, radius, samples) = match &r.ao {
+        Some(a) => {
+            let a = a.get_ref();
+            (
+                pick(&a.method),
+                a.radius.as_ref().map(|r| *r.get_ref()),
+                a.samples.as_ref().map(|s| *s.get_ref() as u32),
+            )
+        }
+        None => (AoMethod::Off, None, None),
+    };
+    let default_samples = if method == AoMethod::Raytraced {
+        64
+    } else {
+        16
+    };
+    AoSettings {
+        method,
+        radius,
+        samples: samples.unwrap_or(default_samples),
+    }
+}
+
+/// Keys that are valid but do nothing with the rest of the scene: said as
+/// warnings naming where they are, never silently dropped.
+pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -> Vec<String> {
+    let (r, o) = (&d.render, &d.output);
+    let mut out = Vec::new();
+    let mut warn = |span: Option<std::ops::Range<usize>>, what: &str| {
+        if let Some(span) = span {
+            out.push(format!("{}: {what}", ctx.location(span)));
+        }
+    };
+    if !matches!(s.shadows, ShadowMethod::Hard | ShadowMethod::Pcf) {
+        let why = "has no effect: render.shadows is not hard or pcf";
+        warn(
+            r.shadow_map_size.as_ref().map(|v| v.span()),
+            &format!("render.shadow_map_size {why}"),
+        );
+        warn(
+            r.shadow_bias.as_ref().map(|v| v.span()),
+            &format!("render.shadow_bias {why}"),
+        );
+    }
+    if s.texture_filter != TextureFilter::Anisotropic {
+        warn(
+            r.max_anisotropy.as_ref().map(|v| v.span()),
+            "render.max_anisotropy has no effect: render.texture_filter is not anisotropic",
+        );
+    }
+    if s.ao.method == AoMethod::Off
+        && let Some(ao) = &r.ao
+        && (ao.get_ref().radius.is_some() || ao.get_ref().samples.is_some())
+    {
+        warn(
+            Some(ao.span()),
+            "render.ao radius/samples have no effect without a method (ssao or raytraced)",
+        );
+    }
+    if o.gif.is_none() {
+        let why = "has no effect without output.gif";
+        warn(
+            o.gif_delay_ms.as_ref().map(|v| v.span()),
+            &format!("output.gif_delay_ms {why}"),
+        );
+        warn(
+            o.gif_dither.as_ref().map(|v| v.span()),
+            &format!("output.gif_dither {why}"),
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::settings::{
+        AddressMode, CullMode, DepthMode, GifDither, ShadingMode, Tonemap,
+    };
+
+    fn parse(text: &str) -> SceneDesc {
+        SceneDesc::parse(Path::new("s.toml"), text).unwrap()
+    }
+
+    #[test]
+    fn defaults_when_the_file_says_nothing() {
+        let d = parse("[[model]]\npath = \"m.obj\"\n");
+        let s = render(&d);
+        assert_eq!((s.width, s.height, s.msaa, s.ssaa), (800, 800, 1, 1));
+        assert_eq!(s.shading, ShadingMode::Auto);
+        assert_eq!(s.texture_filter, TextureFilter::Anisotropic);
+        assert_eq!(s.max_anisotropy, 16.0);
+        assert_eq!(s.address, AddressMode::Repeat);
+        assert_eq!(s.cull, CullMode::Back);
+        assert_eq!(s.depth, DepthMode::ReverseZ);
+        assert_eq!(s.tonemap, Tonemap::Clamp);
+        assert_eq!(s.exposure, 0.0);
+        assert_eq!(s.background, Background::Color(Vec3::ZERO));
+        assert_eq!(s.ambient, Vec3::splat(0.03));
+        assert_eq!(s.shadows, ShadowMethod::Raytraced);
+        assert_eq!(s.shadow_map_size, 2048);
+        assert_eq!(s.shadow_bias, ShadowBias::default());
+        assert_eq!(s.ao.method, AoMethod::Off);
+        let ctx = Ctx {
+            file: Path::new("dir/s.toml"),
+            text: "",
+        };
+        let o = output(&d, &ctx, &s, Path::new("dir"), "s", None).unwrap();
+        assert_eq!(o.dir, PathBuf::from("out/s"));
+        assert_eq!(o.name, "{camera}_{frame:04}");
+        assert!(o.color && !o.depth && !o.ao && o.gif.is_none());
+        assert_eq!((o.gif_delay_ms, o.gif_dither), (40, GifDither::None));
+    }
+
+    #[test]
+    fn file_values_map_to_the_renderers_types() {
+        let d = parse(
+            "[[model]]\npath = \"m.obj\"\n[render]\nshading = \"blinn-phong\"\n\
+             texture_filter = \"trilinear\"\ncull = \"none\"\ndepth = \"standard\"\n\
+             tonemap = \"aces\"\nao = { method = \"ssao\" }\n\
+             [output]\nbackground = \"transparent\"\ngif = \"a.gif\"\ngif_dither = \"floyd-steinberg\"\n",
+        );
+        let s = render(&d);
+        assert_eq!(s.shading, ShadingMode::BlinnPhong);
+        assert_eq!(s.texture_filter, TextureFilter::Trilinear);
+        assert_eq!(s.cull, CullMode::None);
+        assert_eq!(s.depth, DepthMode::Standard);
+        assert_eq!(s.tonemap, Tonemap::Aces);
+        assert_eq!(s.background, Background::Transparent);
+        // The file's `ssao` is GTAO, 16 depth reads a pixel by default.
+        assert_eq!((s.ao.method, s.ao.samples), (AoMethod::Gtao, 16));
+        let ctx = Ctx {
+            file: Path::new("s.toml"),
+            text: "",
+        };
+        let o = output(&d, &ctx, &s, Path::new(""), "s", Some(Path::new("o"))).unwrap();
+        assert_eq!(o.dir, PathBuf::from("o"));
+        assert_eq!(o.gif_dither, GifDither::FloydSteinberg);
+    }
+
+    #[test]
+    fn a_shadow_map_key_without_a_method_selects_pcf() {
+        let d = parse("[[model]]\npath = \"m.obj\"\n[render]\nshadow_map_size = 1024\n");
+        assert_eq!(render(&d).shadows, ShadowMethod::Pcf);
+        let d = parse("[[model]]\npath = \"m.obj\"\n[render]\nao = { method = \"raytraced\" }\n");
+        assert_eq!(render(&d).ao.samples, 64);
+    }
+}

@@ -1,0 +1,185 @@
+//! The renderer's settings, as `scene::build` makes them from the file
+//! (`scene::desc`) and its defaults: the types every stage reads. The file's
+//! spelling of a value is `desc`'s business; a change to the file format
+//! stops at `build`.
+//!
+//! Stage-specific vocabularies live with their stage and are re-exported
+//! here: `CullMode` and `DepthMode` (raster), `TextureFilter` and
+//! `AddressMode` (texture sampling).
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+pub use crate::assets::texture::{AddressMode, TextureFilter};
+pub use crate::raster::{CullMode, DepthMode};
+
+/// `render.shading`: which shading model, or which data view, a frame shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadingMode {
+    /// Each material in its file's model: Blinn-Phong for MTL, pbr for glTF.
+    #[default]
+    Auto,
+    BlinnPhong,
+    /// glTF 2.0 metallic-roughness (appendix B BRDF) for every material.
+    Pbr,
+    /// Blinn-Phong with the triangle's plane normal.
+    Flat,
+    /// Blinn-Phong light summed at the vertices and interpolated.
+    Gouraud,
+    /// Surface color (and emission) without light.
+    Unlit,
+    /// Data view: the shading normal as n * 0.5 + 0.5.
+    Normals,
+    /// Data view: view depth, white (near) to black (far).
+    Depth,
+    /// Data view: anti-aliased triangle edges.
+    Wireframe,
+}
+
+impl ShadingMode {
+    /// The data views write values, not radiance: no tone map, no sRGB.
+    pub fn is_data_view(self) -> bool {
+        matches!(
+            self,
+            ShadingMode::Normals | ShadingMode::Depth | ShadingMode::Wireframe
+        )
+    }
+}
+
+/// `render.shadows`: how lights with `shadows = true` cast them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadowMethod {
+    Off,
+    /// One texel of a shadow map per lookup.
+    Hard,
+    /// A 3x3-texel area-weighted box of a shadow map.
+    Pcf,
+    /// A ray towards the light through the scene's BVHs: exact. The default
+    /// (faster than 2048 maps on every charted scene, docs/chart.md).
+    #[default]
+    Raytraced,
+}
+
+/// `render.ao.method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AoMethod {
+    #[default]
+    Off,
+    /// Screen-space ground-truth AO (GTAO: horizons per slice of the depth
+    /// buffer); the file calls it `ssao`.
+    Gtao,
+    /// Cosine-weighted rays through the scene's BVHs: the reference.
+    Raytraced,
+}
+
+/// `render.tonemap`: linear radiance to display range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tonemap {
+    #[default]
+    Clamp,
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve.
+    Aces,
+}
+
+/// `output.background`: linear RGB, or transparent (RGBA output).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Background {
+    Color(Vec3),
+    Transparent,
+}
+
+/// `output.gif_dither`: how GIF frames are mapped to the shared palette.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GifDither {
+    /// Nearest palette color.
+    #[default]
+    None,
+    /// An 8x8 Bayer pattern: stable from frame to frame where the image is.
+    Ordered,
+    /// Error diffusion: smoothest gradients, but its noise moves with the
+    /// image.
+    FloydSteinberg,
+}
+
+/// Everything that decides how a frame is rasterized and shaded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub shading: ShadingMode,
+    pub texture_filter: TextureFilter,
+    pub max_anisotropy: f32,
+    pub address: AddressMode,
+    pub cull: CullMode,
+    pub depth: DepthMode,
+    pub tonemap: Tonemap,
+    pub exposure: f32,
+    pub background: Background,
+    pub ambient: Vec3,
+    /// How lights with `shadows = true` cast them (default raytraced; pcf
+    /// when the scene sets a shadow-map key without a method).
+    pub shadows: ShadowMethod,
+    /// Shadow map size in texels, per side (default 2048).
+    pub shadow_map_size: u32,
+    pub shadow_bias: ShadowBias,
+    pub ao: AoSettings,
+    /// Samples per pixel: 1, 2, 4, 8 or 16 (standard D3D positions).
+    pub msaa: u32,
+    /// Supersampling factor per axis (1: off).
+    pub ssaa: u32,
+}
+
+/// Shadow-map bias, in texels of the map at the receiver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowBias {
+    /// Depth bias (default 1).
+    pub constant: f32,
+    /// Depth bias times the tangent of the angle between normal and light
+    /// (default 0.5; the tangent is capped at 10).
+    pub slope: f32,
+    /// Lookup point moved along the geometric normal, times the sine of
+    /// the angle between normal and light (default 1).
+    pub normal: f32,
+}
+
+impl Default for ShadowBias {
+    fn default() -> ShadowBias {
+        ShadowBias {
+            constant: 1.0,
+            slope: 0.5,
+            normal: 1.0,
+        }
+    }
+}
+
+/// `render.ao`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AoSettings {
+    pub method: AoMethod,
+    /// Occluders within this distance count; None (raytraced only): rays of
+    /// unbounded length. SSAO without a radius uses a fifth of the scene's
+    /// bounding radius.
+    pub radius: Option<f32>,
+    /// Rays per pixel (raytraced) or depth-buffer reads per pixel (ssao).
+    pub samples: u32,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputSettings {
+    pub dir: PathBuf,
+    /// File stem pattern with `{scene}`, `{camera}`, `{frame}` (`{frame:04}`
+    /// pads with zeros).
+    pub name: String,
+    pub color: bool,
+    /// `<name>_depth.exr`, channel `Z`.
+    pub depth: bool,
+    /// `<name>_ao.exr`, channel `AO`.
+    pub ao: bool,
+    /// The GIF's file name (in `dir`; `{camera}`, or `_<camera>` added
+    /// before the extension when the scene has several cameras).
+    pub gif: Option<String>,
+    pub gif_delay_ms: u32,
+    pub gif_dither: GifDither,
+}
