@@ -7,10 +7,10 @@
 
 use glam::Vec3;
 
+use super::light::for_each_lit;
 use crate::scene::Light;
-use crate::scene::light::for_each_lit;
 #[cfg(test)]
-use crate::scene::light::unshadowed;
+use crate::shade::light::unshadowed;
 
 /// A material evaluated at one point (constants times texture lookups).
 #[derive(Debug, Clone, Copy)]

@@ -3,6 +3,7 @@
 
 pub mod ao;
 pub mod blinn_phong;
+pub mod light;
 pub mod pbr;
 pub mod shadow;
 

@@ -24,8 +24,8 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use super::light::for_each_lit;
 use crate::scene::Light;
-use crate::scene::light::for_each_lit;
 
 /// A material evaluated at one point (factors times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -134,7 +134,7 @@ pub fn radiance(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::light::unshadowed;
+    use crate::shade::light::unshadowed;
 
     fn dielectric(base: f32, roughness: f32) -> PbrColor {
         PbrColor {
