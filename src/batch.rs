@@ -15,15 +15,13 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::output::{self, Image8};
-use crate::render::{Frame, FrameSetup, render_into};
-use crate::scene::Scene;
+use crate::render::{Frame, Renderer};
+use crate::scene::{Scene, expand_pattern};
 
 pub struct RenderJob {
     pub scene: Scene,
-    /// Frame numbers, in the order they are rendered.
-    pub frames: Vec<u32>,
-    /// Indices into `scene.cameras`.
-    pub cameras: Vec<usize>,
+    /// Which frames of which cameras, and the files each writes.
+    pub plan: FramePlan,
     /// Frames whose files all exist already are not rendered again.
     pub skip_existing: bool,
 }
@@ -113,6 +111,154 @@ pub fn parse_frames(s: &str, total: u32) -> Result<Vec<u32>, Error> {
     Ok(frames.into_iter().collect())
 }
 
+/// Which frames a run renders, of which cameras, and the files each
+/// frame writes: `--frames` and `--camera` choose, and the writers,
+/// `--skip-existing` and the GIF read their file names from here only.
+#[derive(Debug, Clone)]
+pub struct FramePlan {
+    /// Frame numbers, in the order they are rendered.
+    pub frames: Vec<u32>,
+    /// Indices into `scene.cameras`.
+    pub cameras: Vec<usize>,
+    /// The animation's length: a run that covers it writes the GIF.
+    pub total_frames: u32,
+    naming: Naming,
+}
+
+/// What file names are made of.
+#[derive(Debug, Clone)]
+struct Naming {
+    dir: PathBuf,
+    pattern: String,
+    stem: String,
+    cameras: Vec<String>,
+    color: bool,
+    depth: bool,
+    ao: bool,
+    gif: Option<String>,
+}
+
+/// The files of one frame of one camera (None: the scene does not ask).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameFiles {
+    /// `<name>.png`.
+    pub color: Option<PathBuf>,
+    /// `<name>_depth.exr`, channel `Z`.
+    pub depth: Option<PathBuf>,
+    /// `<name>_ao.exr`, channel `AO`.
+    pub ao: Option<PathBuf>,
+}
+
+impl FrameFiles {
+    /// The files, color first.
+    pub fn all(&self) -> Vec<PathBuf> {
+        [&self.color, &self.depth, &self.ao]
+            .into_iter()
+            .flatten()
+            .cloned()
+            .collect()
+    }
+}
+
+impl FramePlan {
+    /// Every frame of every camera.
+    pub fn all(scene: &Scene) -> FramePlan {
+        FramePlan {
+            frames: (0..scene.animation.frames).collect(),
+            cameras: (0..scene.cameras.len()).collect(),
+            total_frames: scene.animation.frames,
+            naming: Naming {
+                dir: scene.output.dir.clone(),
+                pattern: scene.output.name.clone(),
+                stem: scene.stem.clone(),
+                cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
+                color: scene.output.color,
+                depth: scene.output.depth,
+                ao: scene.output.ao,
+                gif: scene.output.gif.clone(),
+            },
+        }
+    }
+
+    /// `--frames` (see `parse_frames`; None: all) and `--camera` (a name;
+    /// None: all).
+    pub fn select(
+        scene: &Scene,
+        frames: Option<&str>,
+        camera: Option<&str>,
+    ) -> Result<FramePlan, Error> {
+        let mut plan = FramePlan::all(scene);
+        if let Some(f) = frames {
+            plan.frames = parse_frames(f, plan.total_frames)?;
+        }
+        if let Some(name) = camera {
+            let names = &plan.naming.cameras;
+            let i = names.iter().position(|c| c == name).ok_or_else(|| {
+                Error::Argument(format!(
+                    "--camera {name}: the scene has {}",
+                    names.join(", ")
+                ))
+            })?;
+            plan.cameras = vec![i];
+        }
+        Ok(plan)
+    }
+
+    /// Frames times cameras.
+    pub fn total(&self) -> usize {
+        self.frames.len() * self.cameras.len()
+    }
+
+    /// Whether the run renders every frame of the animation.
+    pub fn covers_animation(&self) -> bool {
+        self.frames.len() == self.total_frames as usize
+    }
+
+    pub fn camera_name(&self, cam: usize) -> &str {
+        &self.naming.cameras[cam]
+    }
+
+    /// The files frame `frame` of camera `cam` writes.
+    pub fn files(&self, cam: usize, frame: u32) -> FrameFiles {
+        let n = &self.naming;
+        let stem = expand_pattern(&n.pattern, &n.stem, &n.cameras[cam], frame);
+        let file = |on: bool, suffix: &str| on.then(|| n.dir.join(format!("{stem}{suffix}")));
+        FrameFiles {
+            color: file(n.color, ".png"),
+            depth: file(n.depth, "_depth.exr"),
+            ao: file(n.ao, "_ao.exr"),
+        }
+    }
+
+    /// The GIF of camera `cam`: `output.gif` in the output directory, per
+    /// camera when the scene has several (`{camera}` in the name, or
+    /// `_<camera>` before the extension).
+    pub fn gif_path(&self, cam: usize) -> Option<PathBuf> {
+        let n = &self.naming;
+        let name = n.gif.as_ref()?;
+        let cam_name = &n.cameras[cam];
+        let name = if name.contains("{camera}") {
+            name.replace("{camera}", cam_name)
+        } else if n.cameras.len() > 1 {
+            let p = Path::new(name);
+            let stem = p
+                .file_stem()
+                .map(|s| s.to_string_lossy())
+                .unwrap_or_default();
+            let ext = p
+                .extension()
+                .map(|e| format!(".{}", e.to_string_lossy()))
+                .unwrap_or_default();
+            p.with_file_name(format!("{stem}_{cam_name}{ext}"))
+                .to_string_lossy()
+                .into_owned()
+        } else {
+            name.clone()
+        };
+        Some(n.dir.join(name))
+    }
+}
+
 /// One file of a frame, ready to write.
 enum Output {
     Png(PathBuf, Image8),
@@ -137,64 +283,35 @@ impl Output {
     }
 }
 
+/// A frame's files from its buffers, as the plan names them.
+fn outputs(frame: &Frame, files: FrameFiles, scene: &Scene) -> Vec<Output> {
+    let (width, height) = (frame.width, frame.height);
+    let mut out = Vec::new();
+    if let Some(p) = files.color {
+        out.push(Output::Png(p, output::resolve(frame, &scene.settings)));
+    }
+    if let Some(p) = files.depth {
+        out.push(Output::Exr(p, width, height, "Z", frame.depth.clone()));
+    }
+    if let Some(p) = files.ao {
+        let ao = if frame.ao.is_empty() {
+            vec![1.0; frame.depth.len()]
+        } else {
+            frame.ao.clone()
+        };
+        out.push(Output::Exr(p, width, height, "AO", ao));
+    }
+    out
+}
+
 impl RenderJob {
     /// Every frame of every camera.
     pub fn all(scene: Scene) -> RenderJob {
         RenderJob {
-            frames: (0..scene.animation.frames).collect(),
-            cameras: (0..scene.cameras.len()).collect(),
+            plan: FramePlan::all(&scene),
             scene,
             skip_existing: false,
         }
-    }
-
-    pub fn total(&self) -> usize {
-        self.frames.len() * self.cameras.len()
-    }
-
-    /// The files frame `frame` of camera `cam` writes.
-    pub fn frame_files(&self, cam: usize, frame: u32) -> Vec<PathBuf> {
-        let scene = &self.scene;
-        let stem = scene.file_stem(&scene.cameras[cam].name, frame);
-        let file = |suffix: &str| scene.output.dir.join(format!("{stem}{suffix}"));
-        let mut files = Vec::new();
-        if scene.output.color {
-            files.push(file(".png"));
-        }
-        if scene.output.depth {
-            files.push(file("_depth.exr"));
-        }
-        if scene.output.ao {
-            files.push(file("_ao.exr"));
-        }
-        files
-    }
-
-    /// The GIF of camera `cam`: `output.gif` in the output directory, per
-    /// camera when the scene has several.
-    pub fn gif_path(&self, cam: usize) -> Option<PathBuf> {
-        let scene = &self.scene;
-        let name = scene.output.gif.as_ref()?;
-        let cam_name = &scene.cameras[cam].name;
-        let name = if name.contains("{camera}") {
-            name.replace("{camera}", cam_name)
-        } else if scene.cameras.len() > 1 {
-            let p = Path::new(name);
-            let stem = p
-                .file_stem()
-                .map(|s| s.to_string_lossy())
-                .unwrap_or_default();
-            let ext = p
-                .extension()
-                .map(|e| format!(".{}", e.to_string_lossy()))
-                .unwrap_or_default();
-            p.with_file_name(format!("{stem}_{cam_name}{ext}"))
-                .to_string_lossy()
-                .into_owned()
-        } else {
-            name.clone()
-        };
-        Some(scene.output.dir.join(name))
     }
 
     /// Renders and writes everything; calls `on_done` as frames land. Then
@@ -206,13 +323,13 @@ impl RenderJob {
         if self.scene.output.gif.is_none() {
             return Ok(summary);
         }
-        let total = self.scene.animation.frames;
-        let covered = self.frames.len() == total as usize;
-        if !covered {
+        let plan = &self.plan;
+        let total = plan.total_frames;
+        if !plan.covers_animation() {
             summary.gif_skipped = Some(format!(
                 "output.gif not written: this run has {} of the scene's {total} frames \
                  (run `softraster gif` on the frames, or render again with --skip-existing)",
-                self.frames.len()
+                plan.frames.len()
             ));
             return Ok(summary);
         }
@@ -220,12 +337,12 @@ impl RenderJob {
             delay_ms: self.scene.output.gif_delay_ms,
             dither: self.scene.output.gif_dither,
         };
-        for &cam in &self.cameras {
-            let Some(path) = self.gif_path(cam) else {
+        for &cam in &plan.cameras {
+            let Some(path) = plan.gif_path(cam) else {
                 continue;
             };
             let frames: Vec<PathBuf> = (0..total)
-                .map(|f| self.frame_files(cam, f).swap_remove(0))
+                .filter_map(|f| plan.files(cam, f).color)
                 .collect();
             output::gif::assemble(&frames, &path, opts)?;
             summary.gifs.push(path);
@@ -261,52 +378,31 @@ impl RenderJob {
                 }
             }
         };
+        let plan = &self.plan;
+        let renderer = Renderer::new(scene);
         let mut buffer = Frame::new(0, 0);
-        'frames: for &frame in &self.frames {
-            for &cam in &self.cameras {
-                let name = &scene.cameras[cam].name;
-                if self.skip_existing {
-                    let files = self.frame_files(cam, frame);
-                    if files.iter().all(|f| f.is_file()) {
-                        on_done(&FrameDone {
-                            frame,
-                            camera: name.clone(),
-                            files,
-                            render_seconds: 0.0,
-                            skipped: true,
-                        });
-                        continue;
-                    }
+        'frames: for &frame in &plan.frames {
+            for &cam in &plan.cameras {
+                let camera = plan.camera_name(cam).to_string();
+                let files = plan.files(cam, frame);
+                if self.skip_existing && files.all().iter().all(|f| f.is_file()) {
+                    on_done(&FrameDone {
+                        frame,
+                        camera,
+                        files: files.all(),
+                        render_seconds: 0.0,
+                        skipped: true,
+                    });
+                    continue;
                 }
                 let t0 = Instant::now();
-                render_into(&FrameSetup::new(scene, cam, frame), &mut buffer);
-                // The files in `frame_files` order: PNG, depth, AO.
-                let mut files = self.frame_files(cam, frame).into_iter();
-                let mut file = || files.next().unwrap_or_default();
-                let (width, height) = (buffer.width, buffer.height);
-                let mut outputs = Vec::new();
-                if scene.output.color {
-                    let img = output::resolve(&buffer, &scene.settings);
-                    outputs.push(Output::Png(file(), img));
-                }
-                if scene.output.depth {
-                    let z = buffer.depth.clone();
-                    outputs.push(Output::Exr(file(), width, height, "Z", z));
-                }
-                if scene.output.ao {
-                    let ao = if buffer.ao.is_empty() {
-                        vec![1.0; buffer.depth.len()]
-                    } else {
-                        buffer.ao.clone()
-                    };
-                    outputs.push(Output::Exr(file(), width, height, "AO", ao));
-                }
-                let render_seconds = t0.elapsed().as_secs_f64();
+                renderer.render(scene, cam, frame, &mut buffer);
+                let outputs = outputs(&buffer, files, scene);
                 let done = FrameDone {
                     frame,
-                    camera: name.clone(),
+                    camera,
                     files: outputs.iter().map(|o| o.path().to_path_buf()).collect(),
-                    render_seconds,
+                    render_seconds: t0.elapsed().as_secs_f64(),
                     skipped: false,
                 };
                 if to_writer.send((done, outputs)).is_err() {

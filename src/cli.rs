@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use softraster::batch::{RenderJob, parse_frames, thread_pool};
+use softraster::batch::{FrameDone, FramePlan, JobSummary, RenderJob, thread_pool};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
@@ -350,28 +350,10 @@ fn render(args: RenderArgs) -> Result<(), Error> {
                 eprintln!("warning: {w}");
             }
         }
-        let frames = match &args.frames {
-            Some(f) => parse_frames(f, scene.animation.frames)?,
-            None => (0..scene.animation.frames).collect(),
-        };
-        let cameras = match &args.camera {
-            Some(name) => vec![scene
-                .cameras
-                .iter()
-                .position(|c| &c.name == name)
-                .ok_or_else(|| {
-                    let names: Vec<_> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
-                    Error::Argument(format!(
-                        "--camera {name}: the scene has {}",
-                        names.join(", ")
-                    ))
-                })?],
-            None => (0..scene.cameras.len()).collect(),
-        };
+        let plan = FramePlan::select(&scene, args.frames.as_deref(), args.camera.as_deref())?;
         let job = RenderJob {
             scene,
-            frames,
-            cameras,
+            plan,
             skip_existing: args.skip_existing,
         };
         if !args.quiet {
@@ -379,17 +361,42 @@ fn render(args: RenderArgs) -> Result<(), Error> {
                 "{}: {} triangles, {} frame(s) x {} camera(s) at {}x{}, loaded in {:.2} s, writing to {}",
                 args.scene.display(),
                 job.scene.triangle_count(),
-                job.frames.len(),
-                job.cameras.len(),
+                job.plan.frames.len(),
+                job.plan.cameras.len(),
                 job.scene.settings.width,
                 job.scene.settings.height,
                 load_s,
                 job.scene.output.dir.display()
             );
         }
+        let t0 = std::time::Instant::now();
+        let report = Reporter::new(&args, job.plan.total());
+        let summary = job.run(|d| report.frame(d))?;
+        report.finish(&summary);
+        if !args.quiet {
+            eprintln!(
+                "done: {} frame(s) in {:.2} s",
+                job.plan.total(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        Ok(())
+    })
+}
+
+/// How `render` reports progress: JSON lines on stdout, a bar on a
+/// terminal, a line per frame otherwise, or nothing (`--quiet`).
+struct Reporter {
+    json: bool,
+    quiet: bool,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Reporter {
+    fn new(args: &RenderArgs, total: usize) -> Reporter {
         let json = args.progress == Progress::Json;
         let bar = (!args.quiet && !json && std::io::stderr().is_terminal()).then(|| {
-            let b = indicatif::ProgressBar::new(job.total() as u64);
+            let b = indicatif::ProgressBar::new(total as u64);
             b.set_style(
                 indicatif::ProgressStyle::with_template(
                     "{bar:40} {pos}/{len} frames  {elapsed_precise} (eta {eta})  {msg}",
@@ -398,64 +405,63 @@ fn render(args: RenderArgs) -> Result<(), Error> {
             );
             b
         });
-        let t0 = std::time::Instant::now();
-        let quiet = args.quiet;
-        let summary = job.run(|d| {
-            if json {
-                let line = serde_json::json!({
-                    "event": "frame",
-                    "frame": d.frame,
-                    "camera": d.camera,
-                    "files": d.files,
-                    "seconds": d.render_seconds,
-                    "skipped": d.skipped,
-                });
-                println!("{line}");
-            } else if let Some(b) = &bar {
-                b.set_message(format!("{:.1} ms/frame", d.render_seconds * 1e3));
-                b.inc(1);
-            } else if !quiet {
-                let files: Vec<_> = d.files.iter().map(|f| f.display().to_string()).collect();
-                if d.skipped {
-                    eprintln!(
-                        "frame {} camera {}: exists, skipped ({})",
-                        d.frame,
-                        d.camera,
-                        files.join(", ")
-                    );
-                } else {
-                    eprintln!(
-                        "frame {} camera {}: {:.1} ms -> {}",
-                        d.frame,
-                        d.camera,
-                        d.render_seconds * 1e3,
-                        files.join(", ")
-                    );
-                }
+        Reporter {
+            json,
+            quiet: args.quiet,
+            bar,
+        }
+    }
+
+    fn frame(&self, d: &FrameDone) {
+        if self.json {
+            let line = serde_json::json!({
+                "event": "frame",
+                "frame": d.frame,
+                "camera": d.camera,
+                "files": d.files,
+                "seconds": d.render_seconds,
+                "skipped": d.skipped,
+            });
+            println!("{line}");
+        } else if let Some(b) = &self.bar {
+            b.set_message(format!("{:.1} ms/frame", d.render_seconds * 1e3));
+            b.inc(1);
+        } else if !self.quiet {
+            let files: Vec<_> = d.files.iter().map(|f| f.display().to_string()).collect();
+            if d.skipped {
+                eprintln!(
+                    "frame {} camera {}: exists, skipped ({})",
+                    d.frame,
+                    d.camera,
+                    files.join(", ")
+                );
+            } else {
+                eprintln!(
+                    "frame {} camera {}: {:.1} ms -> {}",
+                    d.frame,
+                    d.camera,
+                    d.render_seconds * 1e3,
+                    files.join(", ")
+                );
             }
-        })?;
-        if let Some(b) = &bar {
+        }
+    }
+
+    fn finish(&self, summary: &JobSummary) {
+        if let Some(b) = &self.bar {
             b.finish();
         }
         for g in &summary.gifs {
-            if json {
+            if self.json {
                 println!("{}", serde_json::json!({ "event": "gif", "file": g }));
-            } else if !quiet {
+            } else if !self.quiet {
                 eprintln!("gif: {}", g.display());
             }
         }
         if let Some(why) = &summary.gif_skipped
-            && !quiet
+            && !self.quiet
         {
             eprintln!("note: {why}");
         }
-        if !quiet {
-            eprintln!(
-                "done: {} frame(s) in {:.2} s",
-                job.total(),
-                t0.elapsed().as_secs_f64()
-            );
-        }
-        Ok(())
-    })
+    }
 }

@@ -8,8 +8,9 @@ mod common;
 
 use std::path::Path;
 
+use common::render_frame;
 use softraster::raster::coverage::sample_pattern;
-use softraster::render::{Frame, render_frame};
+use softraster::render::Frame;
 use softraster::scene::Scene;
 use softraster::tools::accuracy;
 

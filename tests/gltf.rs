@@ -7,10 +7,10 @@
 
 mod common;
 
+use common::render_frame;
 use common::{Prim, cube, gltf_text};
 use glam::{Mat4, Quat, Vec3};
 use softraster::output::resolve;
-use softraster::render::render_frame;
 use softraster::scene::Scene;
 use softraster::scene::camera::Projection;
 use softraster::scene::light::LightKind;

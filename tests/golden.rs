@@ -13,8 +13,8 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
+use common::render_frame;
 use softraster::output::{png, resolve};
-use softraster::render::render_frame;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 use softraster::scene::overrides::SetOverride;

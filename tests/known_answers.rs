@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::render_frame;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use softraster::raster::CullMode;
 use softraster::raster::bin::TileRect;
@@ -10,7 +11,6 @@ use softraster::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use softraster::raster::coverage::raster_triangle;
 use softraster::raster::interp;
 use softraster::raster::setup::{Viewport, setup};
-use softraster::render::render_frame;
 
 /// A whole (unclipped) triangle: each vertex is its own barycentric corner.
 fn corners(c: [Vec4; 3]) -> [ClipVertex; 3] {

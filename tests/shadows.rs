@@ -6,11 +6,12 @@ mod common;
 
 use std::path::Path;
 
+use common::render_frame;
 use glam::Vec3;
 use softraster::batch::RenderJob;
 use softraster::output::exr::read_channel;
 use softraster::procedural::{self, Builder};
-use softraster::render::{Frame, render_frame};
+use softraster::render::Frame;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 
@@ -81,10 +82,10 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
          [[model]]\npath = \"ground.obj\"\n[[model]]\npath = \"sphere.obj\"\ntranslate = [0.3, 1.2, -0.4]\n\
          [[camera]]\neye = [0.5, 2.5, 5.0]\ntarget = [0.0, 0.6, 0.0]\nfov = {fov}\nnear = 0.3\nfar = 40.0\n"
     );
-    let scene = load(&dir, &text);
+    let mut scene = load(&dir, &text);
     let out = dir.join("out");
-    let mut job = RenderJob::all(scene);
-    job.scene.output.dir = out.clone();
+    scene.output.dir = out.clone();
+    let job = RenderJob::all(scene);
     job.run(|_| {}).unwrap();
     let (ew, eh, z) = read_channel(&out.join("f_depth.exr"), "Z").unwrap();
     assert_eq!((ew, eh), (w, h));

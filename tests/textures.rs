@@ -4,10 +4,11 @@
 
 mod common;
 
+use common::render_frame;
 use glam::{Vec3, Vec4};
 use softraster::output::png;
 use softraster::output::{Image8, resolve};
-use softraster::render::render_frame;
+use softraster::render::{Frame, Renderer};
 
 use common::{scene_in, scratch, shared_assets};
 
@@ -293,8 +294,9 @@ fn mip_chains_are_built_only_for_minified_textures() {
                 ("quad.mtl", "newmtl m\nKd 1 1 1\nmap_Kd t.png\n"),
             ],
         );
-        assert!(!s.textures[0].has_mips());
-        render_frame(&s, 0, 0);
-        assert_eq!(s.textures[0].has_mips(), minified, "{size}x{size} on 32x32");
+        let renderer = Renderer::new(&s);
+        assert!(!renderer.has_mips(0));
+        renderer.render(&s, 0, 0, &mut Frame::new(0, 0));
+        assert_eq!(renderer.has_mips(0), minified, "{size}x{size} on 32x32");
     }
 }

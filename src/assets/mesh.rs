@@ -38,8 +38,6 @@ pub struct Mesh {
     /// bitangent sign (w), MikkTSpace; empty unless a normal or bump map
     /// needs them (`compute_tangents`).
     pub tangents: Vec<glam::Vec4>,
-    /// Object-space BVH for ray-traced shadows and AO, built on first use.
-    pub bvh: std::sync::OnceLock<crate::raytrace::bvh::Bvh>,
 }
 
 impl Mesh {

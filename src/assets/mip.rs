@@ -18,9 +18,7 @@ use crate::color::{encode_linear, encode_srgb};
 /// Levels 1.. of `t` (empty for a 1x1 texture).
 pub fn build_chain(t: &Texture) -> Vec<Level> {
     let mut levels = Vec::new();
-    let Some(base) = t.level(0) else {
-        return levels;
-    };
+    let base = t.base();
     // Level 0 decoded on the fly; later levels from the floats kept.
     let (mut w, mut h) = (t.width, t.height);
     let mut prev: Option<Vec<Vec4>> = None;

@@ -268,7 +268,6 @@ fn convert_material(m: &tobj::Material, base: &Path, mtl: &Path) -> Result<MtlMa
         norm: map(unknown("norm"))?,
         disp: map(unknown("disp"))?,
         synthetic: false,
-        ..Default::default()
     })
 }
 

@@ -14,7 +14,6 @@
 //! worth a few shifts per fetch.
 
 use std::path::Path;
-use std::sync::OnceLock;
 
 use glam::{Affine2, Vec2, Vec4};
 
@@ -61,13 +60,14 @@ pub struct Level {
 pub struct Texture {
     pub width: u32,
     pub height: u32,
-    /// Level 0, as decoded.
+    /// Level 0, as decoded. Levels 1.. (`mip::build_chain`) belong to
+    /// the renderer, which builds them when a frame first minifies the
+    /// texture and hands them to the lookups (`Filtering::mips`).
     base: Level,
-    /// Levels 1.. (down to 1x1), built on first need (`ensure_mips`).
-    mips: OnceLock<Vec<Level>>,
     /// Color data stored sRGB-encoded (decoded to linear on fetch).
     pub srgb: bool,
-    /// Index in the scene's texture list (per-frame state is kept by it).
+    /// Index in the scene's texture list (the renderer keeps this
+    /// texture's mip chain under it).
     pub id: usize,
     /// Some texel has alpha below 255.
     pub has_alpha: bool,
@@ -109,12 +109,13 @@ impl From<AddressMode> for Wrap {
 }
 
 /// How to filter a lookup that carries screen-space derivatives.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Filtering {
+#[derive(Debug, Clone, Copy)]
+pub struct Filtering<'a> {
     pub filter: TextureFilter,
     pub max_anisotropy: f32,
-    /// False where this frame never minifies the texture: level 0 only.
-    pub mips: bool,
+    /// The texture's levels 1.. (empty for a 1x1 texture); None where this
+    /// frame never minifies the texture: level 0 only.
+    pub mips: Option<&'a [Level]>,
 }
 
 /// Texture-coordinate derivatives along screen x and y (from a 2x2 quad).
@@ -210,7 +211,6 @@ impl Texture {
             width,
             height,
             base: Level::from_rows(width, height, &texels),
-            mips: OnceLock::new(),
             srgb,
             id: 0,
             has_alpha: partial > 0,
@@ -223,25 +223,9 @@ impl Texture {
         }
     }
 
-    /// Whether the chain below level 0 has been built.
-    pub fn has_mips(&self) -> bool {
-        self.mips.get().is_some()
-    }
-
-    /// Builds levels 1.. once (box filter in linear space, parallel over
-    /// rows). Call outside of parallel shading.
-    pub fn ensure_mips(&self) {
-        self.mips
-            .get_or_init(|| crate::assets::mip::build_chain(self));
-    }
-
-    /// Level `i` (0 = base), if built.
-    pub fn level(&self, i: usize) -> Option<&Level> {
-        if i == 0 {
-            Some(&self.base)
-        } else {
-            self.mips.get().and_then(|m| m.get(i - 1))
-        }
+    /// Level 0.
+    pub fn base(&self) -> &Level {
+        &self.base
     }
 
     #[inline]
@@ -289,11 +273,17 @@ impl Texture {
         self.bilinear_wrapped(l, uv, mode)
     }
 
-    /// Trilinear lookup at level of detail `lod` (clamped to the chain;
-    /// level 0 only while the chain is not built).
-    pub fn sample_lod(&self, uv: Vec2, mode: impl Into<Wrap>, lod: f32) -> Vec4 {
+    /// Trilinear lookup at level of detail `lod` in the chain whose levels
+    /// 1.. are `mips` (clamped to the chain; level 0 only without one).
+    pub fn sample_lod(
+        &self,
+        mips: Option<&[Level]>,
+        uv: Vec2,
+        mode: impl Into<Wrap>,
+        lod: f32,
+    ) -> Vec4 {
         let mode = mode.into();
-        let Some(mips) = self.mips.get().filter(|_| lod > 0.0) else {
+        let Some(mips) = mips.filter(|_| lod > 0.0) else {
             return self.bilinear(&self.base, uv, mode);
         };
         let top = mips.len() as f32;
@@ -318,11 +308,11 @@ impl Texture {
         match f.filter {
             TextureFilter::Nearest => self.sample_nearest(uv, mode),
             TextureFilter::Bilinear => self.sample_bilinear(uv, mode),
-            _ if !f.mips => self.sample_bilinear(uv, mode),
+            _ if f.mips.is_none() => self.sample_bilinear(uv, mode),
             TextureFilter::Trilinear => {
                 let size = Vec2::new(self.width as f32, self.height as f32);
                 let (lx, ly) = ((g.dx * size).length(), (g.dy * size).length());
-                self.sample_lod(uv, mode, lod_of(lx.max(ly)))
+                self.sample_lod(f.mips, uv, mode, lod_of(lx.max(ly)))
             }
             TextureFilter::Anisotropic => {
                 let size = Vec2::new(self.width as f32, self.height as f32);
@@ -340,7 +330,7 @@ impl Texture {
                 };
                 let n = ratio.min(f.max_anisotropy).ceil().max(1.0);
                 if !n.is_finite() || n <= 1.0 {
-                    return self.sample_lod(uv, mode, lod_of(major));
+                    return self.sample_lod(f.mips, uv, mode, lod_of(major));
                 }
                 // n probes cover the major axis; each filters major / n.
                 let lod = lod_of(major / n);
@@ -348,7 +338,7 @@ impl Texture {
                 let mut sum = Vec4::ZERO;
                 for k in 0..count {
                     let t = (k as f32 + 0.5) / n - 0.5;
-                    sum += self.sample_lod(uv + axis * t, mode, lod);
+                    sum += self.sample_lod(f.mips, uv + axis * t, mode, lod);
                 }
                 sum / n
             }

@@ -1,14 +1,23 @@
 //! Ray-traced visibility, the reference the approximate methods are measured
-//! against: one object-space BVH per mesh (built once, on the first frame
-//! that needs it, and shared by every model using the mesh), and per frame
-//! a `Tracer` that carries world-space rays into each model's object space.
+//! against: one object-space BVH per mesh (the renderer builds it once and
+//! keeps it across frames), and per frame a `Tracer` that carries
+//! world-space rays into each placed mesh's object space. Nothing here knows
+//! about scenes: a tracer is made from BVHs and placements.
 
 pub mod bvh;
 
 use glam::{Mat4, Vec3, Vec3A};
 
-use crate::scene::Scene;
 use bvh::Bvh;
+
+/// A mesh as one frame places it.
+#[derive(Debug, Clone, Copy)]
+pub struct Placed<'a> {
+    pub bvh: &'a Bvh,
+    /// The mesh's object-space bounds (lo, hi).
+    pub bounds: (Vec3, Vec3),
+    pub world_from_object: Mat4,
+}
 
 struct Instance<'a> {
     bvh: &'a Bvh,
@@ -27,21 +36,15 @@ pub struct Tracer<'a> {
 }
 
 impl<'a> Tracer<'a> {
-    /// `world_from_object`: per model, this frame's placement.
-    pub fn new(scene: &'a Scene, world_from_object: &[Mat4]) -> Tracer<'a> {
-        let instances = scene
-            .models
-            .iter()
-            .zip(world_from_object)
-            .filter_map(|(m, &w)| {
-                let mesh = &*m.mesh;
-                let bvh = mesh
-                    .bvh
-                    .get_or_init(|| Bvh::build(&mesh.positions, &mesh.triangles));
-                if bvh.is_empty() {
-                    return None;
-                }
-                let (lo, hi) = mesh.bounds();
+    /// `placed`: every mesh of the frame (empty BVHs are skipped);
+    /// `scene_radius`: the scene's bounding radius, which sets `epsilon`.
+    pub fn new(placed: impl IntoIterator<Item = Placed<'a>>, scene_radius: f32) -> Tracer<'a> {
+        let instances = placed
+            .into_iter()
+            .filter(|p| !p.bvh.is_empty())
+            .map(|p| {
+                let (lo, hi) = p.bounds;
+                let w = p.world_from_object;
                 let mut wlo = Vec3A::splat(f32::INFINITY);
                 let mut whi = Vec3A::splat(f32::NEG_INFINITY);
                 for k in 0..8 {
@@ -50,21 +53,21 @@ impl<'a> Tracer<'a> {
                         if k & 2 == 0 { lo.y } else { hi.y },
                         if k & 4 == 0 { lo.z } else { hi.z },
                     );
-                    let p = Vec3A::from(w.transform_point3(c));
-                    wlo = wlo.min(p);
-                    whi = whi.max(p);
+                    let q = Vec3A::from(w.transform_point3(c));
+                    wlo = wlo.min(q);
+                    whi = whi.max(q);
                 }
-                Some(Instance {
-                    bvh,
+                Instance {
+                    bvh: p.bvh,
                     object_from_world: w.inverse(),
                     lo: wlo,
                     hi: whi,
-                })
+                }
             })
             .collect();
         Tracer {
             instances,
-            epsilon: scene.bounds_radius.max(1e-6) * 1e-4,
+            epsilon: scene_radius.max(1e-6) * 1e-4,
         }
     }
 

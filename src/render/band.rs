@@ -16,7 +16,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::{Draw, FrameSetup, ModelVertices};
+use super::FrameSetup;
+use super::geometry::{Draw, Geometry};
+use super::vertex::ModelVertices;
 use crate::assets::texture::Gradients;
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
@@ -25,9 +27,9 @@ use crate::raster::coverage::{
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::material::AlphaMode;
-use crate::scene::settings::ShadingMode;
+use crate::scene::settings::{AoMethod, ShadingMode};
 use crate::shade::ao::GPixel;
-use crate::shade::{ShadeContext, Surface, TexCoords};
+use crate::shade::{ShadeContext, Surface, TexCoords, background};
 
 /// What every band of one frame reads.
 pub(super) struct FrameData<'a> {
@@ -36,7 +38,7 @@ pub(super) struct FrameData<'a> {
     pub verts: &'a [ModelVertices],
     pub draws: &'a [Draw],
     /// Per draw.
-    pub alpha: &'a [AlphaMode],
+    pub alpha: Vec<AlphaMode>,
     pub tris: &'a [Tri],
     /// Sample offsets in 1/16 pixel; one entry without MSAA.
     pub pattern: &'static [(i8, i8)],
@@ -49,7 +51,41 @@ pub(super) struct FrameData<'a> {
     pub geo_normal: bool,
 }
 
-impl FrameData<'_> {
+impl<'a> FrameData<'a> {
+    /// `grads`: the texture filter reads derivatives (trilinear,
+    /// anisotropic).
+    pub fn new(
+        fs: &'a FrameSetup<'a>,
+        ctx: ShadeContext<'a>,
+        verts: &'a [ModelVertices],
+        geo: &'a Geometry,
+        pattern: &'static [(i8, i8)],
+        grads: bool,
+    ) -> FrameData<'a> {
+        let s = &fs.scene.settings;
+        let alpha = geo
+            .draws
+            .iter()
+            .map(|d| fs.scene.models[d.model].materials[d.material].alpha)
+            .collect();
+        let geo_normal = s.shading == ShadingMode::Flat
+            || !ctx.shadows.lights.is_empty()
+            || s.ao.method != AoMethod::Off;
+        FrameData {
+            fs,
+            verts,
+            draws: &geo.draws,
+            alpha,
+            tris: &geo.tris,
+            pattern,
+            reverse: super::reverse_z(fs),
+            bg: background(s.background),
+            grads,
+            geo_normal,
+            ctx,
+        }
+    }
+
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
     /// alpha-tested triangle per pixel, and the blended triangles to
     /// composite over them. `bins`: per setup chunk, its per-band triangle

@@ -13,7 +13,8 @@
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::{FrameSetup, ModelVertices};
+use super::FrameSetup;
+use super::vertex::ModelVertices;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::coverage::raster_triangle;
@@ -31,7 +32,13 @@ struct Geo<'g> {
     triangles: &'g [[u32; 3]],
 }
 
-pub(super) fn shadows<'a>(fs: &FrameSetup<'a>, mv: &[ModelVertices]) -> Shadows<'a> {
+/// The frame's shadows. `tracer`: the frame's ray tracer, which
+/// `render.shadows = "raytraced"` tests against.
+pub(super) fn shadows<'a>(
+    fs: &FrameSetup,
+    mv: &[ModelVertices],
+    tracer: Option<&'a Tracer<'a>>,
+) -> Shadows<'a> {
     let s = &fs.scene.settings;
     if s.shadows == ShadowMethod::Off || !fs.lights.iter().any(|l| l.shadows) {
         return Shadows::none();
@@ -48,7 +55,7 @@ pub(super) fn shadows<'a>(fs: &FrameSetup<'a>, mv: &[ModelVertices]) -> Shadows<
         tracer: None,
     };
     if s.shadows == ShadowMethod::Raytraced {
-        out.tracer = Some(Tracer::new(fs.scene, &fs.world_from_object));
+        out.tracer = tracer;
     }
     let size = s.shadow_map_size;
     let verts: Vec<Geo> = mv

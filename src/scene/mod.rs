@@ -58,11 +58,6 @@ impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.models.iter().map(|m| m.mesh.triangles.len()).sum()
     }
-
-    /// The file stem for a camera and frame, from the output name pattern.
-    pub fn file_stem(&self, camera: &str, frame: u32) -> String {
-        expand_pattern(&self.output.name, &self.stem, camera, frame)
-    }
 }
 
 /// Expands `{scene}`, `{camera}`, `{frame}` and `{frame:0N}`.

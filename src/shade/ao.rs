@@ -185,7 +185,7 @@ pub fn raytraced(
 const BAYER4: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
 
 /// Slices and steps per side for a budget of `samples` depth reads.
-pub fn ssao_layout(samples: u32) -> (u32, u32) {
+pub fn gtao_layout(samples: u32) -> (u32, u32) {
     let slices = (samples / 8).max(1);
     let steps = (samples / (2 * slices)).max(1);
     (slices, steps)
@@ -201,15 +201,15 @@ fn fast_acos(x: f32) -> f32 {
 }
 
 /// Screen-space (GTAO) AO of every pixel of `g`, blurred.
-pub fn ssao(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
-    let raw = ssao_raw(g, view, radius, samples);
+pub fn gtao(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
+    let raw = gtao_raw(g, view, radius, samples);
     blur(g, view, &raw)
 }
 
 /// GTAO before the blur.
-pub fn ssao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
+pub fn gtao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f32> {
     let (w, h) = (view.width as usize, view.height as usize);
-    let (slices, steps) = ssao_layout(samples);
+    let (slices, steps) = gtao_layout(samples);
     let rot = view.view_from_world;
     // Each pixel's tangent plane in view space (n, n.p), NaN where empty:
     // a sample at an exact point of the slice's screen line is the ray
@@ -424,7 +424,7 @@ mod tests {
                 };
             }
         }
-        let ao = ssao(&g, &view, 0.5, 32);
+        let ao = gtao(&g, &view, 0.5, 32);
         for (i, a) in ao.iter().enumerate() {
             assert!((a - 1.0).abs() < 2e-3, "pixel {i}: {a}");
         }

@@ -3,13 +3,14 @@
 
 pub mod ao;
 pub mod blinn_phong;
+pub mod gouraud;
 pub mod light;
 pub mod pbr;
 pub mod shadow;
 
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
-use crate::assets::texture::{Filtering, Gradients, TextureRef};
+use crate::assets::texture::{Filtering, Gradients, Level, TextureRef};
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
@@ -28,9 +29,9 @@ pub struct ShadeContext<'a> {
     pub filter: TextureFilter,
     pub max_anisotropy: f32,
     pub address: AddressMode,
-    /// Per texture id: whether this frame may read its mip chain (it
-    /// minifies the texture somewhere, and the chain is built).
-    pub mips: &'a [bool],
+    /// Per texture id: the mip chain (levels 1..) this frame may read, or
+    /// None where the frame never minifies the texture (level 0 only).
+    pub mips: &'a [Option<&'a [Level]>],
     /// View-depth range mapped to white..black by the `depth` view.
     pub depth_range: (f32, f32),
     /// This frame's shadow maps or ray tracer.
@@ -205,7 +206,7 @@ impl ShadeContext<'_> {
         let f = Filtering {
             filter: self.filter,
             max_anisotropy: self.max_anisotropy,
-            mips: self.mips.get(t.texture.id).copied().unwrap_or(false),
+            mips: self.mips.get(t.texture.id).copied().flatten(),
         };
         Some(t.sample_grad(uv, tc.grads[set], self.address, f))
     }

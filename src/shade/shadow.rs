@@ -119,7 +119,8 @@ pub struct Shadows<'a> {
     pub lights: Vec<LightShadow>,
     pub filter: Filter,
     pub bias: ShadowBias,
-    pub tracer: Option<Tracer<'a>>,
+    /// The frame's ray tracer (ray-traced shadows only).
+    pub tracer: Option<&'a Tracer<'a>>,
 }
 
 const MAX_TAN: f32 = 10.0;

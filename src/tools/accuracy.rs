@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::output;
-use crate::render::{Frame, FrameSetup, render_into};
+use crate::render::{Frame, Renderer};
 use crate::scene::Scene;
 use crate::scene::build::LoadOptions;
 
@@ -36,9 +36,10 @@ fn timed(scene: &Scene, frames: &[u32]) -> (Vec<Frame>, f64) {
     let mut times = Vec::new();
     // One buffer, as a render job reuses it; copies kept for comparison.
     let mut frame = Frame::new(0, 0);
+    let renderer = Renderer::new(scene);
     for &f in frames {
         let t = Instant::now();
-        render_into(&FrameSetup::new(scene, 0, f), &mut frame);
+        renderer.render(scene, 0, f, &mut frame);
         let _ = output::resolve(&frame, &scene.settings);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         out.push(frame.clone());

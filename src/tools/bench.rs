@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::output;
-use crate::render::{Frame, FrameSetup, render_frame, render_into};
+use crate::render::{Frame, Renderer};
 use crate::scene::Scene;
 use crate::scene::build::LoadOptions;
 use crate::scene::light::{Light, LightKind};
@@ -199,13 +199,13 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     )?;
     // Mip chains are built when a frame first minifies a texture; the
     // benchmark builds them up front and counts them as loading.
+    let renderer = Renderer::new(&scene);
     if matches!(
         scene.settings.texture_filter,
         crate::scene::settings::TextureFilter::Trilinear
             | crate::scene::settings::TextureFilter::Anisotropic
     ) {
-        use rayon::prelude::*;
-        scene.textures.par_iter().for_each(|t| t.ensure_mips());
+        renderer.build_all_mips();
     }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     scene.lights = anchor_lights(&scene);
@@ -214,7 +214,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     let mut frame = Frame::new(0, 0);
     for f in 0..args.frames {
         let t = Instant::now();
-        render_into(&FrameSetup::new(&scene, 0, f), &mut frame);
+        renderer.render(&scene, 0, f, &mut frame);
         let img = output::resolve(&frame, &scene.settings);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         let t = Instant::now();
@@ -447,12 +447,17 @@ pub fn filter_accuracy(dir: &Path, width: u32, height: u32) -> Result<Vec<Filter
         Scene::from_text(&dir.join("filters.toml"), &text, &LoadOptions::default())
     };
     const SS: u32 = 16;
-    let reference = render_frame(&scene(width * SS, height * SS, "anisotropic")?, 0, 0);
+    let render = |s: &Scene| {
+        let mut f = Frame::new(0, 0);
+        Renderer::new(s).render(s, 0, 0, &mut f);
+        f
+    };
+    let reference = render(&scene(width * SS, height * SS, "anisotropic")?);
     let mut results = Vec::new();
     for filter in ["nearest", "bilinear", "trilinear", "anisotropic"] {
         let s = scene(width, height, filter)?;
         let t = Instant::now();
-        let f = render_frame(&s, 0, 0);
+        let f = render(&s);
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let mut err = 0.0f64;
         for y in 0..height {

@@ -3,8 +3,16 @@
 
 use std::path::{Path, PathBuf};
 
+use softraster::render::{Frame, Renderer};
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
+
+/// One frame of one camera, through the library's one entry for a frame.
+pub fn render_frame(scene: &Scene, camera: usize, frame: u32) -> Frame {
+    let mut out = Frame::new(0, 0);
+    Renderer::new(scene).render(scene, camera, frame, &mut out);
+    out
+}
 
 /// The softraster binary under test.
 pub const BIN: &str = env!("CARGO_BIN_EXE_softraster");

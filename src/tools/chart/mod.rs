@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::output::{self, Image8};
-use crate::render::{Frame, FrameSetup, render_into};
+use crate::render::{Frame, Renderer};
 use crate::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use crate::scene::{AoSettings, Scene};
 use crate::tools::compare::{Metric, score};
@@ -114,14 +114,14 @@ pub struct ChartOptions {
 /// Renders `frame` of `scene` up to `runs` times (fewer when a render takes
 /// seconds: at most about 4 s per setting after the first), timed; the
 /// last frame and its 8-bit image.
-fn timed(scene: &Scene, frame: u32, runs: usize) -> (Frame, Image8, Timing) {
+fn timed(renderer: &Renderer, scene: &Scene, frame: u32, runs: usize) -> (Frame, Image8, Timing) {
     let mut f = Frame::new(0, 0);
     let mut times = Vec::new();
     let t_all = Instant::now();
     let mut img = None;
     while times.len() < runs.max(1) && (times.is_empty() || t_all.elapsed().as_secs_f64() < 4.0) {
         let t = Instant::now();
-        render_into(&FrameSetup::new(scene, 0, frame), &mut f);
+        renderer.render(scene, 0, frame, &mut f);
         img = Some(output::resolve(&f, &scene.settings));
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
@@ -140,12 +140,13 @@ fn timed(scene: &Scene, frame: u32, runs: usize) -> (Frame, Image8, Timing) {
 /// compared with the first render (deterministic rendering makes this 0),
 /// its time the median of both renders.
 fn reference_row(
+    renderer: &Renderer,
     scene: &Scene,
     opts: &ChartOptions,
     first: Timing,
     error: impl FnOnce(&Frame, &Image8) -> Result<f64, Error>,
 ) -> Result<(Timing, f64), Error> {
-    let (f, img, t) = timed(scene, opts.frame, 1);
+    let (f, img, t) = timed(renderer, scene, opts.frame, 1);
     let (lo, hi) = (first.min_ms.min(t.min_ms), first.max_ms.max(t.max_ms));
     let time = Timing {
         median_ms: (first.median_ms + t.median_ms) * 0.5,
@@ -233,10 +234,8 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
         )));
     }
     // Mip chains up front: building them is loading, not rendering.
-    {
-        use rayon::prelude::*;
-        scene.textures.par_iter().for_each(|t| t.ensure_mips());
-    }
+    let renderer = Renderer::new(scene);
+    renderer.build_all_mips();
     let original = scene.settings.clone();
     let original_lights = scene.lights.clone();
     let mut rows = Vec::new();
@@ -248,10 +247,10 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
                 scene.settings.ao.method = AoMethod::Off;
             }
             match knob {
-                Knob::Aa => sweep_aa(scene, opts, &mut rows)?,
-                Knob::Texture => sweep_texture(scene, opts, &mut rows)?,
-                Knob::Shadows => sweep_shadows(scene, opts, &mut rows)?,
-                Knob::Ao => sweep_ao(scene, opts, &mut rows)?,
+                Knob::Aa => sweep_aa(&renderer, scene, opts, &mut rows)?,
+                Knob::Texture => sweep_texture(&renderer, scene, opts, &mut rows)?,
+                Knob::Shadows => sweep_shadows(&renderer, scene, opts, &mut rows)?,
+                Knob::Ao => sweep_ao(&renderer, scene, opts, &mut rows)?,
                 Knob::Depth => sweep_depth(opts, &mut rows)?,
             }
         }
@@ -286,13 +285,20 @@ fn row(
     }
 }
 
-fn sweep_aa(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
+fn sweep_aa(
+    renderer: &Renderer,
+    scene: &mut Scene,
+    opts: &ChartOptions,
+    rows: &mut Vec<Row>,
+) -> Result<(), Error> {
     let k = reference_ssaa(scene, opts.quick);
     scene.settings.msaa = 1;
     scene.settings.ssaa = k;
-    let (_, reference, t) = timed(scene, opts.frame, 1);
+    let (_, reference, t) = timed(renderer, scene, opts.frame, 1);
     let against = format!("ssaa {k}x{k}");
-    let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference, img, None))?;
+    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
+        flip(&reference, img, None)
+    })?;
     rows.push(row(Knob::Aa, &against, false, true, t, e, &against));
     let settings: &[(u32, u32)] = if opts.quick {
         &[(1, 1), (4, 1), (1, 2)]
@@ -302,7 +308,7 @@ fn sweep_aa(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
     for &(msaa, ssaa) in settings {
         scene.settings.msaa = msaa;
         scene.settings.ssaa = ssaa;
-        let (_, img, t) = timed(scene, opts.frame, opts.runs);
+        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
         let name = if ssaa > 1 {
             format!("ssaa {ssaa}x{ssaa}")
         } else {
@@ -322,7 +328,12 @@ fn sweep_aa(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
     Ok(())
 }
 
-fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
+fn sweep_texture(
+    renderer: &Renderer,
+    scene: &mut Scene,
+    opts: &ChartOptions,
+    rows: &mut Vec<Row>,
+) -> Result<(), Error> {
     if scene.textures.is_empty() {
         return Ok(());
     }
@@ -332,9 +343,9 @@ fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     scene.settings.msaa = 1;
     scene.settings.texture_filter = TextureFilter::Anisotropic;
     scene.settings.max_anisotropy = 16.0;
-    let (reference_frame, reference, t) = timed(scene, opts.frame, 1);
+    let (reference_frame, reference, t) = timed(renderer, scene, opts.frame, 1);
     let against = format!("ssaa {k}x{k}, anisotropic 16");
-    let (t, e) = reference_row(scene, opts, t, |_, img| {
+    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
         flip(&reference, img, Some(&interior_mask(&reference_frame)))
     })?;
     rows.push(row(Knob::Texture, &against, false, true, t, e, &against));
@@ -359,7 +370,7 @@ fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     for &(filter, aniso, name) in settings {
         scene.settings.texture_filter = filter;
         scene.settings.max_anisotropy = aniso;
-        let (f, img, t) = timed(scene, opts.frame, opts.runs);
+        let (f, img, t) = timed(renderer, scene, opts.frame, opts.runs);
         let m = mask.get_or_insert_with(|| interior_mask(&f));
         let e = flip(&reference, &img, Some(m))?;
         let default = filter == TextureFilter::Anisotropic && aniso == 16.0;
@@ -368,7 +379,12 @@ fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     Ok(())
 }
 
-fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
+fn sweep_shadows(
+    renderer: &Renderer,
+    scene: &mut Scene,
+    opts: &ChartOptions,
+    rows: &mut Vec<Row>,
+) -> Result<(), Error> {
     if scene.lights.is_empty() {
         return Ok(());
     }
@@ -383,9 +399,11 @@ fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
         " (all lights made to cast)"
     };
     scene.settings.shadows = ShadowMethod::Raytraced;
-    let (_, reference, t) = timed(scene, opts.frame, opts.runs);
+    let (_, reference, t) = timed(renderer, scene, opts.frame, opts.runs);
     let against = format!("raytraced{note}");
-    let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference, img, None))?;
+    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
+        flip(&reference, img, None)
+    })?;
     rows.push(row(Knob::Shadows, "raytraced", true, true, t, e, &against));
     let sizes: &[u32] = if opts.quick {
         &[512, 2048]
@@ -396,7 +414,7 @@ fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
         for &size in sizes {
             scene.settings.shadows = method;
             scene.settings.shadow_map_size = size;
-            let (_, img, t) = timed(scene, opts.frame, opts.runs);
+            let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
             let e = flip(&reference, &img, None)?;
             rows.push(row(
                 Knob::Shadows,
@@ -412,7 +430,12 @@ fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) ->
     Ok(())
 }
 
-fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
+fn sweep_ao(
+    renderer: &Renderer,
+    scene: &mut Scene,
+    opts: &ChartOptions,
+    rows: &mut Vec<Row>,
+) -> Result<(), Error> {
     let r = scene
         .settings
         .ao
@@ -433,11 +456,11 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
             radius: Some(radius),
             samples: rays,
         };
-        let (reference, _, t) = timed(scene, opts.frame, 1);
+        let (reference, _, t) = timed(renderer, scene, opts.frame, 1);
         let noise = crate::tools::accuracy::ao_noise_bound(&reference, rays);
         let against =
             format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE below {noise:.4})");
-        let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;
+        let (t, e) = reference_row(renderer, scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;
         rows.push(row(
             Knob::Ao,
             format!("raytraced {rays} r{scale}"),
@@ -460,7 +483,7 @@ fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Resu
                 radius: Some(radius),
                 samples: n,
             };
-            let (f, _, t) = timed(scene, opts.frame, opts.runs);
+            let (f, _, t) = timed(renderer, scene, opts.frame, opts.runs);
             let e = ao_rmse(&f, &reference);
             let ssao = method == AoMethod::Gtao;
             let default =
@@ -535,7 +558,7 @@ fn sweep_depth(opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
         ] {
             let scene = depth_scene(&dir, name)?;
             debug_assert_eq!(scene.settings.depth, mode);
-            let (f, _, t) = timed(&scene, 0, opts.runs);
+            let (f, _, t) = timed(&Renderer::new(&scene), &scene, 0, opts.runs);
             let (mut red, mut green) = (0usize, 0usize);
             for c in &f.color {
                 if c.x > 0.5 && c.y < 0.5 {

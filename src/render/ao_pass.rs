@@ -1,0 +1,31 @@
+//! The AO pass: ambient occlusion of the whole frame from its geometry
+//! buffer, by GTAO over the depth buffer or by rays through the scene's
+//! BVHs. It runs between visibility and shading, which multiplies the
+//! ambient term by it.
+
+use super::FrameSetup;
+use crate::raytrace::Tracer;
+use crate::scene::settings::AoMethod;
+use crate::shade::ao::{self, AoView, GPixel};
+
+/// Per pixel, 1 = unoccluded. `tracer`: the frame's ray tracer (needed
+/// for `AoMethod::Raytraced`, unused otherwise).
+pub(super) fn occlusion(
+    fs: &FrameSetup,
+    gbuf: &[GPixel],
+    width: u32,
+    height: u32,
+    tracer: Option<&Tracer>,
+) -> Vec<f32> {
+    let s = &fs.scene.settings;
+    match (s.ao.method, tracer) {
+        (AoMethod::Raytraced, Some(tracer)) => {
+            ao::raytraced(tracer, gbuf, width, s.ao.samples, s.ao.radius)
+        }
+        _ => {
+            let view = AoView::new(&fs.camera, width, height);
+            let radius = s.ao.radius.unwrap_or(fs.scene.bounds_radius * 0.2);
+            ao::gtao(gbuf, &view, radius, s.ao.samples)
+        }
+    }
+}

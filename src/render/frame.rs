@@ -1,0 +1,113 @@
+//! The frame buffers a render fills, and the supersampling resolve that
+//! turns a frame rendered `k` times larger per axis into the output size.
+
+use glam::Vec4;
+use rayon::prelude::*;
+
+/// A rendered frame in linear space, before tone mapping.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB and coverage alpha per pixel, row-major from the top.
+    /// For the data views (normals, depth, wireframe) RGB is already the
+    /// display value.
+    pub color: Vec<Vec4>,
+    /// Distance along the view axis at the pixel center; +inf where nothing
+    /// was drawn.
+    pub depth: Vec<f32>,
+    /// Ambient occlusion at the pixel center (1: unoccluded, and where
+    /// nothing was drawn); empty unless the scene selects an AO method.
+    pub ao: Vec<f32>,
+}
+
+impl Frame {
+    pub fn new(width: u32, height: u32) -> Frame {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            color: vec![Vec4::ZERO; n],
+            depth: vec![f32::INFINITY; n],
+            ao: Vec::new(),
+        }
+    }
+
+    pub(super) fn resize(&mut self, width: u32, height: u32) {
+        let n = width as usize * height as usize;
+        self.width = width;
+        self.height = height;
+        self.color.resize(n, Vec4::ZERO);
+        self.depth.resize(n, f32::INFINITY);
+    }
+}
+
+/// Box filter of `k` x `k` blocks: the mean color (linear, before tone
+/// mapping) and AO, the nearest depth.
+pub(super) fn downsample(big: &Frame, k: u32, out: &mut Frame) {
+    let (w, h) = (big.width / k, big.height / k);
+    out.resize(w, h);
+    let k = k as usize;
+    let bw = big.width as usize;
+    let inv = 1.0 / (k * k) as f32;
+    let has_ao = !big.ao.is_empty();
+    if has_ao {
+        out.ao.resize(w as usize * h as usize, 1.0);
+    } else {
+        out.ao.clear();
+    }
+    let w = w as usize;
+    out.color
+        .par_chunks_mut(w)
+        .zip(out.depth.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (color, depth))| {
+            for x in 0..w {
+                let mut c = Vec4::ZERO;
+                let mut d = f32::INFINITY;
+                for sy in 0..k {
+                    let row = (y * k + sy) * bw + x * k;
+                    for sx in 0..k {
+                        c += big.color[row + sx];
+                        d = d.min(big.depth[row + sx]);
+                    }
+                }
+                color[x] = c * inv;
+                depth[x] = d;
+            }
+        });
+    if has_ao {
+        out.ao.par_chunks_mut(w).enumerate().for_each(|(y, ao)| {
+            for (x, a) in ao.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for sy in 0..k {
+                    let row = (y * k + sy) * bw + x * k;
+                    sum += big.ao[row..row + k].iter().sum::<f32>();
+                }
+                *a = sum * inv;
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn downsample_averages_color_and_ao_and_keeps_the_nearest_depth() {
+        let mut big = Frame::new(4, 2);
+        for (i, c) in big.color.iter_mut().enumerate() {
+            *c = Vec4::splat(i as f32);
+        }
+        big.depth = vec![5.0, 4.0, f32::INFINITY, 9.0, 3.0, 6.0, 8.0, 7.0];
+        big.ao = vec![1.0, 0.0, 0.5, 0.5, 1.0, 1.0, 0.0, 0.0];
+        let mut out = Frame::new(0, 0);
+        downsample(&big, 2, &mut out);
+        assert_eq!((out.width, out.height), (2, 1));
+        // Block 0 holds pixels 0, 1, 4, 5; block 1 holds 2, 3, 6, 7.
+        assert_eq!(out.color, vec![Vec4::splat(2.5), Vec4::splat(4.5)]);
+        assert_eq!(out.depth, vec![3.0, 7.0]);
+        assert_eq!(out.ao, vec![0.75, 0.25]);
+    }
+}

@@ -1,0 +1,192 @@
+//! The geometry pass: one draw per model and material group in file
+//! order, its triangles clipped (homogeneous, with a guard band), set up
+//! (fixed-point edges, culling) and binned into bands of rows, in parallel
+//! chunks of triangles merged back in submission order. Each chunk also
+//! measures the largest texel density of each texture-coordinate set, from
+//! which the frame decides which textures it minifies.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::FrameSetup;
+use super::vertex::ModelVertices;
+use crate::raster::CullMode;
+use crate::raster::bin::{TileGrid, bin};
+use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
+use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
+
+/// One model's triangles that share a material.
+#[derive(Clone, Copy)]
+pub(super) struct Draw {
+    pub model: usize,
+    pub material: usize,
+    pub first: u32,
+    pub end: u32,
+}
+
+/// Triangles a chunk of a draw sets up at most.
+const CHUNK: u32 = 2048;
+
+/// One chunk's output.
+pub(super) struct Chunk {
+    /// The draw the chunk belongs to.
+    pub draw: usize,
+    /// Index of its first triangle in `Geometry::tris`.
+    pub first: u32,
+    /// Per band: indices (from `first`) of the triangles touching it.
+    pub bins: Vec<Vec<u32>>,
+    /// Largest UV area per pixel area, per texture-coordinate set (0 when
+    /// the frame filters without mip maps).
+    pub density: [f32; 2],
+}
+
+/// The frame's set-up triangles, binned.
+pub(super) struct Geometry {
+    pub draws: Vec<Draw>,
+    pub tris: Vec<Tri>,
+    pub chunks: Vec<Chunk>,
+    pub grid: TileGrid,
+}
+
+impl Geometry {
+    /// Per chunk: its per-band triangle lists and the index of its first
+    /// triangle (what visibility walks, band by band).
+    pub fn bins(&self) -> Vec<(&[Vec<u32>], u32)> {
+        self.chunks
+            .iter()
+            .map(|c| (c.bins.as_slice(), c.first))
+            .collect()
+    }
+}
+
+/// `densities`: whether to measure texel densities (filters with mip maps).
+pub(super) fn setup_and_bin(
+    fs: &FrameSetup,
+    verts: &[ModelVertices],
+    vp: Viewport,
+    densities: bool,
+) -> Geometry {
+    let scene = fs.scene;
+    let mut draws = Vec::new();
+    for (mi, m) in scene.models.iter().enumerate() {
+        for g in &m.mesh.groups {
+            draws.push(Draw {
+                model: mi,
+                material: g.material,
+                first: g.triangles.start,
+                end: g.triangles.end,
+            });
+        }
+    }
+    let mut ranges = Vec::new();
+    for (di, d) in draws.iter().enumerate() {
+        let mut start = d.first;
+        while start < d.end {
+            let end = (start + CHUNK).min(d.end);
+            ranges.push((di, start, end));
+            start = end;
+        }
+    }
+    let grid = TileGrid::bands(vp.width, vp.height);
+    let per_chunk: Vec<(Vec<Tri>, Chunk)> = ranges
+        .par_iter()
+        .map(|&(di, start, end)| {
+            let d = draws[di];
+            let material = &scene.models[d.model].materials[d.material];
+            // glTF doubleSided materials are never culled.
+            let cull = if material.double_sided {
+                CullMode::None
+            } else {
+                scene.settings.cull
+            };
+            let measure = densities && material.maps().next().is_some();
+            let (tris, density) =
+                setup_range(fs, &verts[d.model], d, di, start..end, vp, cull, measure);
+            let bins = bin(&tris, &grid, vp.msaa);
+            let chunk = Chunk {
+                draw: di,
+                first: 0,
+                bins,
+                density,
+            };
+            (tris, chunk)
+        })
+        .collect();
+    let mut tris = Vec::new();
+    let mut chunks = Vec::with_capacity(per_chunk.len());
+    for (t, mut c) in per_chunk {
+        c.first = tris.len() as u32;
+        tris.extend(t);
+        chunks.push(c);
+    }
+    Geometry {
+        draws,
+        tris,
+        chunks,
+        grid,
+    }
+}
+
+/// Clips and sets up triangles `prims` of draw `d` (index `di`); with
+/// `measure`, also their largest texel density per coordinate set.
+#[allow(clippy::too_many_arguments)]
+fn setup_range(
+    fs: &FrameSetup,
+    mv: &ModelVertices,
+    d: Draw,
+    di: usize,
+    prims: std::ops::Range<u32>,
+    vp: Viewport,
+    cull: CullMode,
+    measure: bool,
+) -> (Vec<Tri>, [f32; 2]) {
+    let mesh = &fs.scene.models[d.model].mesh;
+    let (gx, gy) = vp.guard_band();
+    let mut tris = Vec::with_capacity(prims.len());
+    let mut max_density = [0.0f32; 2];
+    for prim in prims {
+        let before = tris.len();
+        let idx = mesh.triangles[prim as usize];
+        let v = idx.map(|i| mv.clip[i as usize]);
+        let base = |k: usize, b: Vec3| ClipVertex { pos: v[k], bary: b };
+        match clip_triangle(v, gx, gy) {
+            Clipped::Rejected => {}
+            Clipped::Inside => {
+                let tri = [base(0, Vec3::X), base(1, Vec3::Y), base(2, Vec3::Z)];
+                tris.extend(setup(tri, vp, cull, di as u32, prim));
+            }
+            Clipped::Polygon(p) => {
+                let p = p.as_slice();
+                for k in 1..p.len() - 1 {
+                    tris.extend(setup([p[0], p[k], p[k + 1]], vp, cull, di as u32, prim));
+                }
+            }
+        }
+        if measure {
+            for t in &tris[before..] {
+                for (set, uvs) in [&mesh.uvs, &mesh.uvs1].into_iter().enumerate() {
+                    if !uvs.is_empty() {
+                        max_density[set] = max_density[set].max(uv_density(t, uvs, idx));
+                    }
+                }
+            }
+        }
+    }
+    (tris, max_density)
+}
+
+/// UV area per pixel area of a set-up triangle (texture units squared per
+/// pixel squared), from its barycentrics in the original triangle.
+fn uv_density(t: &Tri, uvs: &[glam::Vec2], idx: [u32; 3]) -> f32 {
+    let uv = idx.map(|i| uvs[i as usize]);
+    let at = |b: Vec3| uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    let [a, b, c] = t.bary.map(at);
+    let uv_area = (b - a).perp_dot(c - a).abs();
+    let px = SUBPIXEL as f64;
+    let px_area = t.area2 as f64 / (px * px);
+    if px_area <= 0.0 {
+        return 0.0;
+    }
+    let d = (uv_area as f64 / px_area) as f32;
+    if d.is_finite() { d } else { 0.0 }
+}
