@@ -208,23 +208,7 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| err(format!("malformed glTF: {e}")))?;
     let doc = &gltf.document;
-    let mut warnings = Vec::new();
-    for ext in doc.extensions_required() {
-        if !SUPPORTED_EXTENSIONS.contains(&ext) {
-            return Err(err(format!(
-                "the file requires the glTF extension `{ext}`, which softraster does not support (it supports {})",
-                SUPPORTED_EXTENSIONS.join(", ")
-            )));
-        }
-    }
-    for ext in doc.extensions_used() {
-        if !SUPPORTED_EXTENSIONS.contains(&ext) && !doc.extensions_required().any(|r| r == ext) {
-            warnings.push(format!(
-                "{}: uses the optional glTF extension `{ext}`, which softraster ignores",
-                path.display()
-            ));
-        }
-    }
+    let mut warnings = extensions(doc, path).map_err(err)?;
     validate(doc).map_err(err)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(doc, gltf.blob.as_deref(), dir, path)?;
@@ -243,10 +227,69 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
         default_material: None,
         skipped_modes: BTreeSet::new(),
     };
-    let mut lights = Vec::new();
-    let mut cameras = Vec::new();
+    let mut placed = Placed::default();
+    walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
+    for mode in &b.skipped_modes {
+        warnings.push(format!(
+            "{}: primitives of mode {mode} are not drawn (softraster draws triangles, strips and fans)",
+            path.display()
+        ));
+    }
+    let mut mesh = b.finish();
+    mesh.groups.retain(|g| !g.triangles.is_empty());
+    Ok(GltfModel {
+        mesh,
+        materials,
+        lights: placed.lights,
+        cameras: placed.cameras,
+        warnings,
+    })
+}
 
-    // Nodes of the default scene (or the first; without scenes, every root).
+/// An error for a required extension softraster lacks; warnings for the
+/// optional ones it ignores.
+fn extensions(doc: &gltf::Document, path: &Path) -> Result<Vec<String>, String> {
+    for ext in doc.extensions_required() {
+        if !SUPPORTED_EXTENSIONS.contains(&ext) {
+            return Err(format!(
+                "the file requires the glTF extension `{ext}`, which softraster does not support (it supports {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ));
+        }
+    }
+    Ok(doc
+        .extensions_used()
+        .filter(|ext| {
+            !SUPPORTED_EXTENSIONS.contains(ext) && !doc.extensions_required().any(|r| r == *ext)
+        })
+        .map(|ext| {
+            format!(
+                "{}: uses the optional glTF extension `{ext}`, which softraster ignores",
+                path.display()
+            )
+        })
+        .collect())
+}
+
+/// The lights and cameras the node hierarchy places.
+#[derive(Default)]
+struct Placed {
+    lights: Vec<GltfLight>,
+    cameras: Vec<GltfCamera>,
+}
+
+/// Walks the default scene's nodes (or the first scene's; without scenes,
+/// every root), depth first in document order, adding each mesh's
+/// primitives to `b` with the node's world transform; a node reached twice
+/// or with a non-finite transform is an error.
+fn walk_nodes(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    materials: &mut Vec<GltfMaterial>,
+    b: &mut Builder,
+    placed: &mut Placed,
+) -> Result<(), String> {
+    let (lights, cameras) = (&mut placed.lights, &mut placed.cameras);
     let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(s) => s.nodes().collect(),
         None => {
@@ -267,17 +310,17 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
         .collect();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut seen[node.index()], true) {
-            return Err(err(format!(
+            return Err(format!(
                 "node {} is reached twice in the scene's hierarchy (a cycle, or a node with two parents)",
                 node.index()
-            )));
+            ));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {
-            return Err(err(format!(
+            return Err(format!(
                 "node {}: its transform is not finite",
                 node.index()
-            )));
+            ));
         }
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
@@ -288,12 +331,8 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
                         materials.len() - 1
                     }),
                 };
-                b.add_primitive(&prim, &buffers, world, mat).map_err(|m| {
-                    err(format!(
-                        "mesh {} primitive {}: {m}",
-                        mesh.index(),
-                        prim.index()
-                    ))
+                b.add_primitive(&prim, buffers, world, mat).map_err(|m| {
+                    format!("mesh {} primitive {}: {m}", mesh.index(), prim.index())
                 })?;
             }
         }
@@ -307,21 +346,7 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
             stack.push((child, world));
         }
     }
-    for mode in &b.skipped_modes {
-        warnings.push(format!(
-            "{}: primitives of mode {mode} are not drawn (softraster draws triangles, strips and fans)",
-            path.display()
-        ));
-    }
-    let mut mesh = b.finish();
-    mesh.groups.retain(|g| !g.triangles.is_empty());
-    Ok(GltfModel {
-        mesh,
-        materials,
-        lights,
-        cameras,
-        warnings,
-    })
+    Ok(())
 }
 
 fn validate(doc: &gltf::Document) -> Result<(), String> {
@@ -602,6 +627,90 @@ fn tex_info(
     })
 }
 
+/// A primitive's vertex attributes and indices, read and checked: every
+/// attribute as long as POSITION, every index in range.
+struct Attributes {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    tangents: Option<Vec<Vec4>>,
+    uv: [Option<Vec<Vec2>>; 2],
+    colors: Option<Vec<Vec4>>,
+    /// Without an index accessor: 0..n.
+    indices: Vec<u32>,
+}
+
+fn read_attributes(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Attributes, String> {
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or_else(|| {
+            if prim.get(&gltf::Semantic::Positions).is_none() {
+                "it has no POSITION attribute".to_string()
+            } else {
+                unreadable("POSITION")
+            }
+        })?
+        .map(Vec3::from)
+        .collect();
+    let n = positions.len();
+    let same_len = |what: &str, len: usize| {
+        if len == n {
+            Ok(())
+        } else {
+            Err(format!("{what} has {len} elements but POSITION has {n}"))
+        }
+    };
+    let normals: Option<Vec<Vec3>> = match reader.read_normals() {
+        Some(r) => Some(r.map(Vec3::from).collect()),
+        None if prim.get(&gltf::Semantic::Normals).is_some() => {
+            return Err(unreadable("NORMAL"));
+        }
+        None => None,
+    };
+    let tangents: Option<Vec<Vec4>> = reader.read_tangents().map(|r| r.map(Vec4::from).collect());
+    let uv: [Option<Vec<Vec2>>; 2] = [0, 1].map(|s| {
+        reader
+            .read_tex_coords(s)
+            .map(|r| r.into_f32().map(Vec2::from).collect())
+    });
+    let colors: Option<Vec<Vec4>> = reader
+        .read_colors(0)
+        .map(|r| r.into_rgba_f32().map(Vec4::from).collect());
+    if let Some(v) = &normals {
+        same_len("NORMAL", v.len())?;
+    }
+    if let Some(v) = &tangents {
+        same_len("TANGENT", v.len())?;
+    }
+    for (s, v) in uv.iter().enumerate() {
+        if let Some(v) = v {
+            same_len(&format!("TEXCOORD_{s}"), v.len())?;
+        }
+    }
+    if let Some(v) = &colors {
+        same_len("COLOR_0", v.len())?;
+    }
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(r) => r.into_u32().collect(),
+        None if prim.indices().is_some() => return Err(unreadable("indices")),
+        None => (0..n as u32).collect(),
+    };
+    if let Some((k, &bad)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= n) {
+        return Err(format!(
+            "index {k} is {bad}, out of range: the primitive has {n} vertices"
+        ));
+    }
+    Ok(Attributes {
+        positions,
+        normals,
+        tangents,
+        uv,
+        colors,
+        indices,
+    })
+}
+
 fn material(
     m: &gltf::Material,
     images: &[ImageSource],
@@ -793,68 +902,15 @@ impl Builder {
             self.skipped_modes.insert(format!("{mode:?}"));
             return Ok(());
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-        let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| {
-                if prim.get(&gltf::Semantic::Positions).is_none() {
-                    "it has no POSITION attribute".to_string()
-                } else {
-                    unreadable("POSITION")
-                }
-            })?
-            .map(Vec3::from)
-            .collect();
+        let Attributes {
+            positions,
+            normals,
+            tangents,
+            uv,
+            colors,
+            indices,
+        } = read_attributes(prim, buffers)?;
         let n = positions.len();
-        let same_len = |what: &str, len: usize| {
-            if len == n {
-                Ok(())
-            } else {
-                Err(format!("{what} has {len} elements but POSITION has {n}"))
-            }
-        };
-        let normals: Option<Vec<Vec3>> = match reader.read_normals() {
-            Some(r) => Some(r.map(Vec3::from).collect()),
-            None if prim.get(&gltf::Semantic::Normals).is_some() => {
-                return Err(unreadable("NORMAL"));
-            }
-            None => None,
-        };
-        let tangents: Option<Vec<Vec4>> =
-            reader.read_tangents().map(|r| r.map(Vec4::from).collect());
-        let uv: [Option<Vec<Vec2>>; 2] = [0, 1].map(|s| {
-            reader
-                .read_tex_coords(s)
-                .map(|r| r.into_f32().map(Vec2::from).collect())
-        });
-        let colors: Option<Vec<Vec4>> = reader
-            .read_colors(0)
-            .map(|r| r.into_rgba_f32().map(Vec4::from).collect());
-        if let Some(v) = &normals {
-            same_len("NORMAL", v.len())?;
-        }
-        if let Some(v) = &tangents {
-            same_len("TANGENT", v.len())?;
-        }
-        for (s, v) in uv.iter().enumerate() {
-            if let Some(v) = v {
-                same_len(&format!("TEXCOORD_{s}"), v.len())?;
-            }
-        }
-        if let Some(v) = &colors {
-            same_len("COLOR_0", v.len())?;
-        }
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(r) => r.into_u32().collect(),
-            None if prim.indices().is_some() => return Err(unreadable("indices")),
-            None => (0..n as u32).collect(),
-        };
-        if let Some((k, &bad)) = indices.iter().enumerate().find(|(_, i)| **i as usize >= n) {
-            return Err(format!(
-                "index {k} is {bad}, out of range: the primitive has {n} vertices"
-            ));
-        }
         let Some(mut tris) = triangulate(mode, &indices) else {
             return Ok(());
         };

@@ -74,8 +74,41 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
         .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
     let text = String::from_utf8_lossy(&text);
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let (models, tobj_mats, libs) = parse(path, &text, &dir)?;
+    let mut mats = materials(&tobj_mats, libs, &dir)?;
+    let (mut mesh, missing_normal) = mesh(&models, &mut mats);
+    if mesh.triangles.is_empty() {
+        return Err(Error::asset(path, None, "the model has no faces"));
+    }
+    if missing_normal.iter().any(|m| *m) {
+        smooth_normals(
+            &mesh.positions,
+            &mesh.triangles,
+            &mut mesh.normals,
+            &missing_normal,
+        );
+    }
+    if mesh.positions.iter().any(|p| !p.is_finite()) {
+        return Err(Error::asset(path, None, "a vertex position is not finite"));
+    }
+    Ok(ObjModel {
+        mesh,
+        materials: mats,
+    })
+}
+
+/// Each material library read, with how many materials it gave.
+type Libraries = Vec<(PathBuf, usize)>;
+
+/// tobj's models and materials of the OBJ text, and the libraries the
+/// materials came from; an unreadable library is an error naming it.
+fn parse(
+    path: &Path,
+    text: &str,
+    dir: &Path,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Libraries), Error> {
     // Which MTL file each material came from (for relative texture paths).
-    let libs: RefCell<Vec<(PathBuf, usize)>> = RefCell::new(Vec::new());
+    let libs: RefCell<Libraries> = RefCell::new(Vec::new());
     let lib_error: RefCell<Option<Error>> = RefCell::new(None);
     let opts = tobj::LoadOptions {
         single_index: false,
@@ -111,16 +144,23 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
     if let Some(e) = lib_error.into_inner() {
         return Err(e);
     }
-    let (models, materials) = result.map_err(|e| match locate_error(&text) {
+    let (models, materials) = result.map_err(|e| match locate_error(text) {
         Some((line, msg)) => Error::asset(path, Some(line), msg),
         None => Error::asset(path, None, format!("malformed OBJ: {e}")),
     })?;
-    let tobj_mats = materials.unwrap_or_default();
+    Ok((models, materials.unwrap_or_default(), libs.into_inner()))
+}
 
+/// The materials, each with texture paths relative to its own library.
+fn materials(
+    tobj_mats: &[tobj::Material],
+    libs: Libraries,
+    dir: &Path,
+) -> Result<Vec<MtlMaterial>, Error> {
     let mut mats = Vec::with_capacity(tobj_mats.len() + 1);
-    let mut lib_iter = libs.into_inner().into_iter();
+    let mut lib_iter = libs.into_iter();
     let mut current: Option<(PathBuf, usize)> = None;
-    for m in &tobj_mats {
+    for m in tobj_mats {
         while current.as_ref().is_none_or(|c| c.1 == 0) {
             current = lib_iter.next();
             if current.is_none() {
@@ -130,21 +170,28 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
         let base = current
             .as_ref()
             .and_then(|c| c.0.parent().map(Path::to_path_buf))
-            .unwrap_or_else(|| dir.clone());
+            .unwrap_or_else(|| dir.to_path_buf());
         if let Some(c) = current.as_mut() {
             c.1 -= 1;
         }
         let mtl_file = current.as_ref().map(|c| c.0.clone()).unwrap_or_default();
         mats.push(convert_material(m, &base, &mtl_file)?);
     }
+    Ok(mats)
+}
 
+/// One mesh from tobj's models: a vertex per distinct (position, uv,
+/// normal) corner, a group per run of one material (faces without one get
+/// a `default` material appended to `mats`), and per vertex whether the
+/// file gave it no usable normal.
+fn mesh(models: &[tobj::Model], mats: &mut Vec<MtlMaterial>) -> (Mesh, Vec<bool>) {
     let mut mesh = Mesh::default();
     let mut missing_normal = Vec::new();
     let any_uv = models.iter().any(|m| {
         !m.mesh.texcoord_indices.is_empty() && m.mesh.texcoord_indices.len() == m.mesh.indices.len()
     });
     let mut default_material = None;
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         let has_uv = !m.texcoord_indices.is_empty() && m.texcoord_indices.len() == m.indices.len();
         let has_n = !m.normal_indices.is_empty() && m.normal_indices.len() == m.indices.len();
@@ -213,24 +260,7 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
             }),
         }
     }
-    if mesh.triangles.is_empty() {
-        return Err(Error::asset(path, None, "the model has no faces"));
-    }
-    if missing_normal.iter().any(|m| *m) {
-        smooth_normals(
-            &mesh.positions,
-            &mesh.triangles,
-            &mut mesh.normals,
-            &missing_normal,
-        );
-    }
-    if mesh.positions.iter().any(|p| !p.is_finite()) {
-        return Err(Error::asset(path, None, "a vertex position is not finite"));
-    }
-    Ok(ObjModel {
-        mesh,
-        materials: mats,
-    })
+    (mesh, missing_normal)
 }
 
 fn fix_separators(s: &str) -> String {

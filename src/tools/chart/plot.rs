@@ -49,16 +49,9 @@ fn register_font() {
     });
 }
 
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    rows: &[Row],
-    title: &str,
-) -> Result<(), String>
-where
-    DB::ErrorType: 'static,
-{
-    let err = |e: &dyn std::fmt::Display| e.to_string();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
+/// The log axes' ranges (time, error) and the floor where zero errors
+/// are drawn, a factor below the smallest error.
+fn axes(rows: &[Row]) -> (std::ops::Range<f64>, std::ops::Range<f64>, f64) {
     let times: Vec<f64> = rows.iter().map(|r| r.time.median_ms.max(1e-3)).collect();
     let positive: Vec<f64> = rows.iter().map(|r| r.error).filter(|e| *e > 0.0).collect();
     let (tmin, tmax) = times
@@ -72,10 +65,47 @@ where
     } else {
         (emin, emax)
     };
-    let x = (tmin / 1.6)..(tmax * 1.6);
-    // Zero errors are drawn on the floor, a factor below the smallest.
     let floor = emin / 4.0;
-    let y = (floor / 1.5)..(emax * 2.0);
+    (
+        (tmin / 1.6)..(tmax * 1.6),
+        (floor / 1.5)..(emax * 2.0),
+        floor,
+    )
+}
+
+/// A setting's name on the chart.
+fn setting_label(r: &Row) -> String {
+    if r.default {
+        format!("{} (default)", r.setting)
+    } else {
+        r.setting.clone()
+    }
+}
+
+/// A Pareto front's points as a staircase, by increasing time.
+fn staircase(mut front: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut stairs = Vec::new();
+    for (i, p) in front.iter().enumerate() {
+        if i > 0 {
+            stairs.push((p.0, front[i - 1].1));
+        }
+        stairs.push(*p);
+    }
+    stairs
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    title: &str,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (x, y, floor) = axes(rows);
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 22))
         .margin(16)
@@ -116,19 +146,11 @@ where
         let mut groups: Vec<&str> = ks.iter().map(|r| r.against.as_str()).collect();
         groups.dedup();
         for g in groups {
-            let mut front: Vec<(f64, f64)> = ks
+            let front = ks
                 .iter()
                 .filter(|r| r.pareto && r.against == g)
-                .map(|r| at(r))
-                .collect();
-            front.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut stairs = Vec::new();
-            for (i, p) in front.iter().enumerate() {
-                if i > 0 {
-                    stairs.push((p.0, front[i - 1].1));
-                }
-                stairs.push(*p);
-            }
+                .map(|r| at(r));
+            let stairs = staircase(front.collect());
             chart
                 .draw_series(DashedLineSeries::new(stairs, 6, 4, c.stroke_width(2)))
                 .map_err(|e| err(&e))?;
@@ -151,11 +173,9 @@ where
                 } else {
                     c.stroke_width(2)
                 };
-                if r.error > 0.0 {
-                    EmptyElement::at(p) + Circle::new((0, 0), 5, style)
-                } else {
-                    EmptyElement::at(p) + Circle::new((0, 0), 0, style)
-                }
+                // Zero errors get a triangle on the floor instead.
+                let radius = if r.error > 0.0 { 5 } else { 0 };
+                EmptyElement::at(p) + Circle::new((0, 0), radius, style)
             }))
             .map_err(|e| err(&e))?;
         chart
@@ -169,13 +189,8 @@ where
         // dominated ones are in the CSV), and the default ringed.
         chart
             .draw_series(ks.iter().filter(|r| r.pareto || r.default).map(|r| {
-                let name = if r.default {
-                    format!("{} (default)", r.setting)
-                } else {
-                    r.setting.clone()
-                };
-                EmptyElement::at(at(r))
-                    + Text::new(name, (7, -14), ("sans-serif", 11).into_font().color(&c))
+                let style = ("sans-serif", 11).into_font().color(&c);
+                EmptyElement::at(at(r)) + Text::new(setting_label(r), (7, -14), style)
             }))
             .map_err(|e| err(&e))?;
         chart
