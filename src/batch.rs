@@ -58,7 +58,7 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
     }
     builder
         .build()
-        .map_err(|e| Error::Argument(format!("cannot start {threads:?} threads: {e}")))
+        .map_err(|e| Error::Render(format!("cannot start {threads:?} threads: {e}")))
 }
 
 /// Frame selection for `--frames`: `a..b` (half-open), `a..` (to the end),
@@ -420,5 +420,77 @@ impl RenderJob {
         }
         let _ = writer.join();
         result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(extra: &str) -> Scene {
+        let dir = std::env::temp_dir().join(format!("softraster-plan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let text = format!("[[model]]\npath = \"t.obj\"\n[animation]\nframes = 12\n{extra}");
+        let opts = crate::scene::build::LoadOptions::default();
+        Scene::from_text(&dir.join("shot.toml"), &text, &opts).unwrap()
+    }
+
+    #[test]
+    fn frames_and_cameras_are_chosen_by_the_flags() {
+        let two =
+            "[[camera]]\nname = \"front\"\n[[camera]]\nname = \"side\"\neye = [5.0, 0.0, 0.0]\n";
+        let s = scene(two);
+        let all = FramePlan::all(&s);
+        assert_eq!(
+            (all.frames.len(), all.cameras.clone(), all.total()),
+            (12, vec![0, 1], 24)
+        );
+        assert!(all.covers_animation());
+        let p = FramePlan::select(&s, Some("1-3,10.."), Some("side")).unwrap();
+        assert_eq!(p.frames, vec![1, 2, 3, 10, 11]);
+        assert_eq!((p.cameras.clone(), p.camera_name(1)), (vec![1], "side"));
+        assert!(!p.covers_animation());
+        let e = FramePlan::select(&s, None, Some("top")).unwrap_err();
+        assert_eq!(e.to_string(), "--camera top: the scene has front, side");
+        assert!(FramePlan::select(&s, Some("11..13"), None).is_err());
+    }
+
+    #[test]
+    fn files_follow_the_output_settings() {
+        let s = scene(
+            "[output]\nname = \"{scene}-{camera}-{frame:03}\"\ndepth = true\ngif = \"t.gif\"\n",
+        );
+        let p = FramePlan::all(&s);
+        let f = p.files(0, 7);
+        let dir = &s.output.dir;
+        assert_eq!(f.color, Some(dir.join("shot-camera-007.png")));
+        assert_eq!(f.depth, Some(dir.join("shot-camera-007_depth.exr")));
+        assert_eq!(f.ao, None);
+        assert_eq!(
+            f.all(),
+            vec![
+                dir.join("shot-camera-007.png"),
+                dir.join("shot-camera-007_depth.exr")
+            ]
+        );
+        assert_eq!(p.gif_path(0), Some(dir.join("t.gif")));
+        // Several cameras: one GIF each.
+        let s = scene(
+            "[output]\ngif = \"t.gif\"\n[[camera]]\nname = \"a\"\n[[camera]]\nname = \"b\"\neye = [5.0, 0.0, 0.0]\n",
+        );
+        let p = FramePlan::all(&s);
+        assert_eq!(p.gif_path(1), Some(s.output.dir.join("t_b.gif")));
+        assert_eq!(p.files(1, 0).color, Some(s.output.dir.join("b_0000.png")));
+    }
+
+    #[test]
+    fn frame_lists_parse_and_refuse() {
+        assert_eq!(parse_frames("0..3", 5).unwrap(), vec![0, 1, 2]);
+        assert_eq!(parse_frames("4,1-2,2", 5).unwrap(), vec![1, 2, 4]);
+        assert_eq!(parse_frames("3..", 5).unwrap(), vec![3, 4]);
+        assert!(parse_frames("3..3", 5).is_err());
+        assert!(parse_frames("2-9", 5).is_err());
+        assert!(parse_frames("x", 5).is_err());
     }
 }

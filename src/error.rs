@@ -58,9 +58,16 @@ pub enum Error {
         message: String,
     },
 
-    /// A command-line argument is invalid.
+    /// A command-line argument (or its library counterpart: a frame
+    /// list, a `--set`, a camera name) is invalid.
     #[error("{0}")]
     Argument(String),
+
+    /// The render, or a tool measuring it, failed for a reason that is not
+    /// the input's (the thread pool could not start, two frames that must
+    /// match in size do not).
+    #[error("{0}")]
+    Render(String),
 
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]
@@ -84,7 +91,7 @@ impl Error {
             | Error::SceneGlobal { .. }
             | Error::Asset { .. }
             | Error::Argument(_) => 2,
-            Error::Io { .. } | Error::Encode { .. } => 1,
+            Error::Io { .. } | Error::Encode { .. } | Error::Render(_) => 1,
         }
     }
 

@@ -203,18 +203,47 @@ fn set_overrides_and_bad_arguments() {
     assert_eq!(code, 0, "{err}");
     let img = image::open(out.join("x00.png")).unwrap();
     assert_eq!((img.width(), img.height()), (32, 16));
-    let (code, err) = run(&["render", s.to_str().unwrap(), "--set", "render.msaa=3"]);
+    let fresh = dir.join("fresh");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            s.to_str().unwrap(),
+            "--out",
+            fresh.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        run(&args)
+    };
+    // Each refusal says what was wrong, and writes nothing.
+    let (code, err) = render(&["--set", "render.msaa=3"]);
     assert_eq!(code, 2);
-    assert!(err.contains("render.msaa"), "{err}");
-    assert_eq!(
-        run(&["render", s.to_str().unwrap(), "--frames", "3..9"]).0,
-        2
+    assert!(
+        err.contains("--set render.msaa=3: render.msaa = 3: expected one of 1, 2, 4, 8, 16"),
+        "{err}"
     );
-    assert_eq!(
-        run(&["render", s.to_str().unwrap(), "--camera", "nope"]).0,
-        2
+    let (code, err) = render(&["--frames", "3..9"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("--frames 3..9") && err.contains("the scene has frames 0..1"),
+        "{err}"
     );
-    assert_eq!(run(&["render"]).0, 2);
+    let (code, err) = render(&["--camera", "nope"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--camera nope: the scene has camera"), "{err}");
+    let (code, err) = render(&["--threads", "0"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--threads must be at least 1"), "{err}");
+    let (code, err) = render(&["--set", "render"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--set render: expected key=value"), "{err}");
+    assert!(
+        !fresh.exists(),
+        "a refused render wrote {}",
+        fresh.display()
+    );
+    let (code, err) = run(&["render"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("<SCENE>"), "{err}");
 }
 
 #[test]
@@ -252,6 +281,13 @@ fn unwritable_output_exits_1() {
         blocker.join("sub").to_str().unwrap(),
     ]);
     assert_eq!(code, 1, "{err}");
+    // The message names the path that could not be made.
+    assert!(err.contains(&blocker.display().to_string()), "{err}");
+    assert_eq!(
+        std::fs::read(&blocker).unwrap(),
+        b"",
+        "the blocking file is untouched"
+    );
 }
 
 #[test]

@@ -7,14 +7,16 @@
 //!
 //! On a mismatch the new image and the FLIP error map are written to
 //! `tests/failures/`. To accept new output as the golden:
-//! `UPDATE_GOLDENS=1 cargo test --test golden`, then look at the images.
+//! `UPDATE_GOLDENS=1 cargo test --test golden` rewrites the images and fails
+//! (so an update never passes as a green run); look at the images, then run
+//! the tests again without it.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
 use common::render_frame;
-use softraster::output::{png, resolve};
+use softraster::output::{Image8, png, resolve};
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 use softraster::scene::overrides::SetOverride;
@@ -28,47 +30,82 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn check(name: &str, scene: &Path, frame: u32, sets: &[&str]) {
-    let opts = LoadOptions {
-        sets: sets
-            .iter()
-            .map(|s| s.parse::<SetOverride>().unwrap())
-            .collect(),
-        out_dir: None,
-    };
-    let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
-    let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);
-    let golden = root().join("tests/golden").join(format!("{name}.png"));
-    if std::env::var_os("UPDATE_GOLDENS").is_some() {
-        png::write(&golden, &img).unwrap();
-        eprintln!("updated {}", golden.display());
-        return;
+/// Golden checks of one test: every image is checked (or, with
+/// `UPDATE_GOLDENS`, rewritten) before the test reports, so one mismatch
+/// does not hide the next.
+#[derive(Default)]
+struct Goldens {
+    failed: Vec<String>,
+    updated: Vec<String>,
+}
+
+impl Goldens {
+    fn check(&mut self, name: &str, scene: &Path, frame: u32, sets: &[&str]) {
+        let opts = LoadOptions {
+            sets: sets
+                .iter()
+                .map(|s| s.parse::<SetOverride>().unwrap())
+                .collect(),
+            out_dir: None,
+        };
+        let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
+        let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);
+        let golden = root().join("tests/golden").join(format!("{name}.png"));
+        if std::env::var_os("UPDATE_GOLDENS").is_some() {
+            png::write(&golden, &img).unwrap();
+            self.updated.push(golden.display().to_string());
+            return;
+        }
+        if let Err(why) = compare(name, &golden, &img) {
+            self.failed.push(why);
+        }
     }
-    let reference = png::read(&golden).unwrap_or_else(|e| {
-        panic!("{e}: no golden yet? run UPDATE_GOLDENS=1 cargo test --test golden")
-    });
+
+    /// Fails the test on any mismatch, and after an update: rewritten
+    /// goldens are to be looked at before they are trusted.
+    fn finish(self) {
+        assert!(
+            self.updated.is_empty(),
+            "UPDATE_GOLDENS rewrote {} golden image(s): look at them, then run the tests again without UPDATE_GOLDENS:\n{}",
+            self.updated.len(),
+            self.updated.join("\n")
+        );
+        assert!(self.failed.is_empty(), "{}", self.failed.join("\n"));
+    }
+}
+
+fn check(name: &str, scene: &Path, frame: u32, sets: &[&str]) {
+    let mut g = Goldens::default();
+    g.check(name, scene, frame, sets);
+    g.finish();
+}
+
+/// `img` against the golden at `golden`, under the module's tolerance; on
+/// a mismatch the new image and the FLIP error map go to tests/failures.
+fn compare(name: &str, golden: &Path, img: &Image8) -> Result<(), String> {
+    let reference = png::read(golden).map_err(|e| {
+        format!("{e}: no golden yet? run UPDATE_GOLDENS=1 cargo test --test golden")
+    })?;
     let fail_dir = root().join("tests/failures");
     let save = || {
-        png::write(&fail_dir.join(format!("{name}.new.png")), &img).unwrap();
+        png::write(&fail_dir.join(format!("{name}.new.png")), img).unwrap();
     };
-    let s = match score(&reference, &img, Metric::Flip) {
-        Ok(s) => s,
-        Err(e) => {
-            save();
-            panic!("{name}: {e} ({})", golden.display());
-        }
-    };
+    let s = score(&reference, img, Metric::Flip).map_err(|e| {
+        save();
+        format!("{name}: {e} ({})", golden.display())
+    })?;
     let local = s.error_map.iter().filter(|&&e| e > LOCAL_FLIP).count();
     let pixels = s.error_map.len();
     if s.value > MEAN_FLIP || local as f64 > LOCAL_FRACTION * pixels as f64 {
         save();
         png::write(&fail_dir.join(format!("{name}.flip.png")), &s.diff_image()).unwrap();
-        panic!(
+        return Err(format!(
             "{name}: mean FLIP {:.5} (max {MEAN_FLIP}), {local} of {pixels} pixels above {LOCAL_FLIP}; new image and error map in {}",
             s.value,
             fail_dir.display()
-        );
+        ));
     }
+    Ok(())
 }
 
 #[test]
@@ -83,8 +120,9 @@ fn showcase() {
 
 #[test]
 fn showcase_shading_modes() {
+    let mut g = Goldens::default();
     for mode in ["flat", "gouraud", "unlit", "normals", "depth", "wireframe"] {
-        check(
+        g.check(
             &format!("showcase_{mode}"),
             &root().join("scenes/showcase.toml"),
             0,
@@ -95,64 +133,65 @@ fn showcase_shading_modes() {
             ],
         );
     }
+    g.finish();
 }
 
-fn real(name: &str) {
+/// Scenes on the shared models, checked together: SKIPPED without the
+/// models, a failure naming their path under CI.
+fn real(names: &[&str]) {
     if common::shared_assets().is_none() {
         return;
     }
-    check(
-        name,
-        &root().join(format!("tests/scenes/{name}.toml")),
-        0,
-        &[],
-    );
+    let mut g = Goldens::default();
+    for name in names {
+        let scene = root().join(format!("tests/scenes/{name}.toml"));
+        g.check(name, &scene, 0, &[]);
+    }
+    g.finish();
 }
 
 #[test]
 fn diablo3_pose_textures_by_override() {
-    real("diablo3_pose");
+    real(&["diablo3_pose"]);
 }
 
 #[test]
 fn diablo3_pose_mtl() {
-    real("diablo3_pose_mtl");
+    real(&["diablo3_pose_mtl"]);
 }
 
 #[test]
 fn african_head_full_three_objects() {
-    real("african_head_full");
+    real(&["african_head_full"]);
 }
 
 #[test]
 fn spot_triangulated_and_quads() {
-    real("spot_triangulated");
-    real("spot_quads");
+    real(&["spot_triangulated", "spot_quads"]);
 }
 
 #[test]
 fn gltf_flight_helmet_and_cornell_box() {
-    real("flight_helmet");
-    real("cornell_box");
+    real(&["flight_helmet", "cornell_box"]);
 }
 
 #[test]
 fn bunny_nefertiti_teapot() {
-    real("bunny");
-    real("nefertiti");
-    real("teapot");
+    real(&["bunny", "nefertiti", "teapot"]);
 }
 
 #[test]
 fn address_modes() {
+    let mut g = Goldens::default();
     for mode in ["repeat", "mirror", "clamp", "border"] {
-        check(
+        g.check(
             &format!("address_{mode}"),
             &root().join("tests/scenes/address.toml"),
             0,
             &[&format!("render.address={mode}")],
         );
     }
+    g.finish();
 }
 
 #[test]
@@ -167,5 +206,5 @@ fn displacement_map() {
 
 #[test]
 fn african_head_blended_eye_shell_over_the_iris() {
-    real("african_head_eye");
+    real(&["african_head_eye"]);
 }

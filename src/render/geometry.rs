@@ -190,3 +190,45 @@ fn uv_density(t: &Tri, uvs: &[glam::Vec2], idx: [u32; 3]) -> f32 {
     let d = (uv_area as f64 / px_area) as f32;
     if d.is_finite() { d } else { 0.0 }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    #[test]
+    fn a_quad_sets_up_two_triangles_binned_in_the_bands_it_covers() {
+        let dir = std::env::temp_dir().join(format!("softraster-geometry-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Rows 1.6..9.6 of a 32x32 frame (band 0 of 2), and a second quad
+        // behind the camera.
+        let quad = "v -0.5 0.4 0\nv 0.5 0.4 0\nv 0.5 0.9 0\nv -0.5 0.9 0\nf 1 2 3 4\n\
+                    v -0.5 0.4 9\nv 0.5 0.4 9\nv 0.5 0.9 9\nv -0.5 0.9 9\nf 5 6 7 8\n";
+        std::fs::write(dir.join("quad.obj"), quad).unwrap();
+        let text = "[output]\nwidth = 32\nheight = 32\n[[model]]\npath = \"quad.obj\"\n\
+                    [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                    projection = \"orthographic\"\nheight = 2.0\nnear = 0.1\nfar = 10.0\n";
+        let opts = crate::scene::build::LoadOptions::default();
+        let scene = Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap();
+        let fs = FrameSetup::new(&scene, 0, 0);
+        let verts = super::super::vertex::transform_all(&fs);
+        let vp = Viewport {
+            width: 32,
+            height: 32,
+            msaa: false,
+        };
+        let geo = setup_and_bin(&fs, &verts, vp, false);
+        assert_eq!(geo.draws.len(), 1);
+        // The quad behind the camera is clipped away.
+        assert_eq!(geo.tris.len(), 2);
+        assert!(geo.tris.iter().all(|t| t.prim < 2 && t.front));
+        let bins = geo.bins();
+        assert_eq!(bins.len(), 1);
+        assert_eq!(bins[0].0[0], vec![0, 1]);
+        assert!(bins[0].0[1].is_empty());
+        // Two triangles of half the quad's area: 16 x 8 pixels in all.
+        let px = (SUBPIXEL * SUBPIXEL) as f64;
+        let area: f64 = geo.tris.iter().map(|t| t.area2 as f64 / px / 2.0).sum();
+        assert!((area - 128.0).abs() < 1e-6, "{area}");
+    }
+}

@@ -5,9 +5,12 @@
 //! `ambient.color=[0.1,0.1,0.1]`); a value that is not valid TOML is taken as a
 //! string (`render.shading=flat`).
 
+use std::path::Path;
+
 use toml_edit::{DocumentMut, Item, Table, Value};
 
-use crate::error::Error;
+use super::desc::SceneDesc;
+use crate::error::{Error, Location};
 
 /// One parsed `--set`.
 #[derive(Debug, Clone)]
@@ -68,19 +71,42 @@ impl std::str::FromStr for SetOverride {
     }
 }
 
-/// Returns the scene text with every override applied, in order.
-pub fn apply(text: &str, sets: &[SetOverride]) -> Result<String, Error> {
+/// Returns the scene text of `file` with every override applied, in
+/// order. A scene that is not valid TOML is an error at its location.
+pub fn apply(file: &Path, text: &str, sets: &[SetOverride]) -> Result<String, Error> {
     if sets.is_empty() {
         return Ok(text.to_string());
     }
-    let mut doc: DocumentMut = text
-        .parse()
-        // A syntax error is reported by the real parser with its location.
-        .map_err(|_| Error::Argument("--set: the scene file is not valid TOML".into()))?;
+    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
+        let offset = e.span().map(|s| s.start).unwrap_or(0);
+        Error::Scene {
+            location: Location::from_offset(file, text, offset),
+            message: e.message().trim_end().to_string(),
+        }
+    })?;
     for s in sets {
         set_one(doc.as_table_mut(), s)?;
     }
     Ok(doc.to_string())
+}
+
+/// For an error in the scene as edited by `sets`: when an override made
+/// it (the file alone parses, and applying the overrides one by one, one
+/// of them breaks it), the error names that `--set`; otherwise `error` as
+/// it is.
+pub fn blame(file: &Path, text: &str, sets: &[SetOverride], error: Error) -> Error {
+    if sets.is_empty() || SceneDesc::parse(file, text).is_err() {
+        return error;
+    }
+    for k in 1..=sets.len() {
+        let Ok(edited) = apply(file, text, &sets[..k]) else {
+            return error;
+        };
+        if let Err(Error::Scene { message, .. }) = SceneDesc::parse(file, &edited) {
+            return Error::Argument(format!("--set {}: {message}", sets[k - 1].raw));
+        }
+    }
+    error
 }
 
 fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
@@ -130,7 +156,7 @@ mod tests {
     use super::*;
 
     fn set(text: &str, s: &str) -> Result<String, Error> {
-        apply(text, &[s.parse()?])
+        apply(Path::new("s.toml"), text, &[s.parse()?])
     }
 
     #[test]
@@ -156,5 +182,36 @@ mod tests {
         let v: toml::Table = toml::from_str(&out).unwrap();
         assert_eq!(v["render"]["ao"]["samples"].as_integer(), Some(8));
         assert_eq!(v["render"]["ao"]["method"].as_str(), Some("ssao"));
+    }
+
+    #[test]
+    fn a_scene_that_is_not_toml_keeps_its_location() {
+        let t = "[[model]]\npath = \"a.obj\"\n[render\nmsaa = 4\n";
+        let e = set(t, "render.msaa=4").unwrap_err();
+        assert!(matches!(e, Error::Scene { .. }), "{e:?}");
+        assert!(e.to_string().starts_with("s.toml:3:"), "{e}");
+    }
+
+    #[test]
+    fn an_error_made_by_an_override_names_it() {
+        let file = Path::new("s.toml");
+        let t = "[[model]]\npath = \"a.obj\"\n";
+        let sets: Vec<SetOverride> = ["output.width=64", "render.msaa=3", "render.ssaa=2"]
+            .iter()
+            .map(|s| s.parse().unwrap())
+            .collect();
+        let edited = apply(file, t, &sets).unwrap();
+        let e = SceneDesc::parse(file, &edited).unwrap_err();
+        let e = blame(file, t, &sets, e);
+        assert!(e.to_string().starts_with("--set render.msaa=3: "), "{e}");
+        assert!(
+            e.to_string().contains("expected one of 1, 2, 4, 8, 16"),
+            "{e}"
+        );
+        // An error of the file itself stays the file's.
+        let bad = "[[model]]\npath = \"\"\n";
+        let e = SceneDesc::parse(file, bad).unwrap_err();
+        let e = blame(file, bad, &sets, e);
+        assert!(e.to_string().starts_with("s.toml:2:"), "{e}");
     }
 }

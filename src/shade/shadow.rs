@@ -292,3 +292,80 @@ pub fn cube_face(d: Vec3) -> usize {
         5
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An 8x8 orthographic map of a light 5 units up, looking down -Y over
+    /// [-1, 1] x [-1, 1], distances 0..10, with an occluder at height 1
+    /// over x < 0 (texel columns 0..4).
+    fn map() -> ShadowMap {
+        let view_from_world = Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)
+            * Mat4::from_translation(Vec3::new(0.0, -5.0, 0.0));
+        let (near, far) = (0.0, 10.0);
+        let stored = (far - 4.0) / (far - near);
+        let depth = (0..64)
+            .map(|i| if i % 8 < 4 { stored } else { 0.0 })
+            .collect();
+        ShadowMap {
+            size: 8,
+            view_from_world,
+            projection: MapProjection::Ortho {
+                x0: -1.0,
+                x1: 1.0,
+                y0: -1.0,
+                y1: 1.0,
+                near,
+                far,
+            },
+            depth,
+        }
+    }
+
+    fn shadows(filter: Filter) -> Shadows<'static> {
+        Shadows {
+            lights: vec![LightShadow::Map(map())],
+            filter,
+            bias: ShadowBias::default(),
+            tracer: None,
+        }
+    }
+
+    #[test]
+    fn a_map_shadows_what_lies_below_its_occluder() {
+        let up = Vec3::Y;
+        let s = shadows(Filter::Hard);
+        // On the ground under the occluder, and beside it.
+        assert_eq!(s.visibility(0, Vec3::new(-0.5, 0.0, 0.1), up, up), 0.0);
+        assert_eq!(s.visibility(0, Vec3::new(0.5, 0.0, 0.1), up, up), 1.0);
+        // Above the occluder's height: lit.
+        assert_eq!(s.visibility(0, Vec3::new(-0.5, 2.0, 0.1), up, up), 1.0);
+        // Facing away from the light: its own shadow.
+        assert_eq!(s.visibility(0, Vec3::new(0.5, 0.0, 0.1), -up, up), 0.0);
+        // Outside the map, and a light without shadows: lit.
+        assert_eq!(s.visibility(0, Vec3::new(3.0, 0.0, 0.0), up, up), 1.0);
+        assert_eq!(Shadows::none().visibility(0, Vec3::ZERO, up, up), 1.0);
+    }
+
+    #[test]
+    fn pcf_is_the_covered_fraction_of_a_three_texel_box() {
+        let (up, s) = (Vec3::Y, shadows(Filter::Pcf));
+        // Centered on the occluder's edge: half of the box is shadowed.
+        let v = s.visibility(0, Vec3::new(0.0, 0.0, 0.1), up, up);
+        assert!((v - 0.5).abs() < 1e-5, "{v}");
+        // A quarter texel (1/16 unit) into the lit side: 1/2 + 1/12 lit.
+        let v = s.visibility(0, Vec3::new(1.0 / 16.0, 0.0, 0.1), up, up);
+        assert!((v - (0.5 + 1.0 / 12.0)).abs() < 1e-5, "{v}");
+        // Two texels away the box sees one side only.
+        assert_eq!(s.visibility(0, Vec3::new(-0.6, 0.0, 0.1), up, up), 0.0);
+        assert_eq!(s.visibility(0, Vec3::new(0.6, 0.0, 0.1), up, up), 1.0);
+    }
+
+    #[test]
+    fn cube_faces_follow_the_largest_axis() {
+        let faces = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z]
+            .map(|d| cube_face(d * 2.0 + Vec3::splat(0.1)));
+        assert_eq!(faces, [0, 1, 2, 3, 4, 5]);
+    }
+}

@@ -391,7 +391,7 @@ pub fn edges(
         save(name, &img)?;
         let flip =
             crate::tools::compare::score(&reference_img, &img, crate::tools::compare::Metric::Flip)
-                .map_err(|e| Error::Argument(format!("edge accuracy: {e}")))?
+                .map_err(|e| Error::Render(format!("edge accuracy: {e}")))?
                 .value;
         rows.push(EdgeRow {
             method: name.to_string(),

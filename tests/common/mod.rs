@@ -45,15 +45,26 @@ pub fn scene_in(dir: &Path, scene: &str, files: &[(&str, &str)]) -> Scene {
     Scene::load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The shared model directory, or None (tests that need it say they skip).
+/// The shared model directory. When it is missing: under CI (`CI=true`)
+/// the calling test fails with a message naming the path, so tests on real
+/// models cannot pass by not running; elsewhere the test prints SKIPPED and
+/// gets None.
 pub fn shared_assets() -> Option<PathBuf> {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
     if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!("SKIPPED: ../shared/assets not found; tests on real models did not run");
-        None
+        return Some(p);
     }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!(
+            "CI=true and the shared assets are missing: {} (tests on real models must run in CI)",
+            p.display()
+        );
+    }
+    eprintln!(
+        "SKIPPED: {} not found; tests on real models did not run",
+        p.display()
+    );
+    None
 }
 
 /// Direction through the center of pixel (px, py) in view space (z = -1)

@@ -41,8 +41,9 @@ impl Scene {
             },
             message: format!("cannot read the scene file: {e}"),
         })?;
-        let text = overrides::apply(&text, &opts.sets)?;
-        Scene::from_text(path, &text, opts)
+        let edited = overrides::apply(path, &text, &opts.sets)?;
+        Scene::from_text(path, &edited, opts)
+            .map_err(|e| overrides::blame(path, &text, &opts.sets, e))
     }
 
     /// Loads a scene from text; `path` names the file in errors and is the

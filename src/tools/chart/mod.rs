@@ -159,7 +159,7 @@ fn reference_row(
 
 fn flip(reference: &Image8, img: &Image8, mask: Option<&[bool]>) -> Result<f64, Error> {
     let s =
-        score(reference, img, Metric::Flip).map_err(|e| Error::Argument(format!("chart: {e}")))?;
+        score(reference, img, Metric::Flip).map_err(|e| Error::Render(format!("chart: {e}")))?;
     Ok(match mask {
         None => s.value,
         Some(m) => {
