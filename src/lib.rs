@@ -1,9 +1,43 @@
 //! softraster: a data-driven CPU batch renderer.
 //!
-//! Data flows one way: scene file ([`scene::desc`]) -> loaded [`scene::Scene`]
-//! -> per-frame draw list ([`render::FrameSetup`]) -> raster pipeline
-//! ([`raster`]) and shading ([`shade`]) -> [`render::Frame`] -> writers
-//! ([`output`]).
+//! Data flows one way: scene file ([`scene::desc`]) -> loaded
+//! [`scene::Scene`] ([`scene::build`]) -> per-frame draw list
+//! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
+//! shadows, geometry through [`raster`], visibility, AO and shading through
+//! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
+//! frame by [`batch`]. [`color`], [`error`], [`raster`] and [`raytrace`]
+//! are the ground floor: they import nothing of the layers above.
+//!
+//! The library is the renderer alone with `--no-default-features`; the
+//! default feature `tools` adds [`tools`] (bench, chart, accuracy tables,
+//! image comparison) and the `softraster` binary.
+//!
+//! Rendering a frame from Rust:
+//!
+//! ```
+//! use softraster::output::{png, resolve};
+//! use softraster::render::{Frame, Renderer};
+//! use softraster::scene::{LoadOptions, Scene};
+//!
+//! # fn main() -> Result<(), softraster::Error> {
+//! let dir = std::env::temp_dir().join(format!("softraster-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! std::fs::write(dir.join("tri.obj"), "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+//! let text = "[output]\nwidth = 64\nheight = 64\n[[model]]\npath = \"tri.obj\"\n";
+//! let scene = Scene::from_text(&dir.join("tri.toml"), text, &LoadOptions::default())?;
+//!
+//! // The renderer keeps BVHs and mip chains across frames: make it once.
+//! let renderer = Renderer::new(&scene);
+//! let mut frame = Frame::new(0, 0);
+//! renderer.render(&scene, 0, 0, &mut frame); // camera 0, frame 0
+//! assert!(frame.depth.iter().any(|d| d.is_finite()));
+//!
+//! // Tone map and encode as the scene says, and write it.
+//! let image = resolve(&frame, &scene.settings);
+//! png::write(&dir.join("tri.png"), &image)?;
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod assets;
 pub mod batch;

@@ -10,6 +10,12 @@ use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use toml::Spanned;
 
+use super::animation::TurntableTarget;
+use super::material::NormalSpace;
+use super::settings::{
+    AddressMode, AoMethod, Background, CullMode, DepthMode, GifDither, ShadingMode, ShadowMethod,
+    TextureFilter, Tonemap,
+};
 use crate::error::{Error, Location};
 
 pub type S<T> = Spanned<T>;
@@ -50,101 +56,6 @@ pub struct OutputDesc {
     /// Extension: "none" (default), "ordered" or "floyd-steinberg".
     pub gif_dither: Option<S<GifDither>>,
     pub background: Option<S<Background>>,
-}
-
-/// The file's spelling of [`super::settings::GifDither`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum GifDither {
-    None,
-    Ordered,
-    FloydSteinberg,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Background {
-    Color([f32; 3]),
-    Transparent,
-}
-
-/// The file's spelling of [`super::settings::ShadingMode`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum ShadingMode {
-    Auto,
-    BlinnPhong,
-    Pbr,
-    Flat,
-    Gouraud,
-    Unlit,
-    Normals,
-    Depth,
-    Wireframe,
-}
-
-/// The file's spelling of [`super::settings::TextureFilter`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum TextureFilter {
-    Nearest,
-    Bilinear,
-    Trilinear,
-    Anisotropic,
-}
-
-/// The file's spelling of [`super::settings::AddressMode`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum AddressMode {
-    Repeat,
-    Mirror,
-    Clamp,
-    Border,
-}
-
-/// The file's spelling of [`super::settings::CullMode`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum CullMode {
-    Back,
-    Front,
-    None,
-}
-
-/// The file's spelling of [`super::settings::DepthMode`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum DepthMode {
-    ReverseZ,
-    Standard,
-}
-
-/// The file's spelling of [`super::settings::ShadowMethod`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum ShadowMethod {
-    Off,
-    Hard,
-    Pcf,
-    Raytraced,
-}
-
-/// The file's spelling of [`super::settings::AoMethod`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum AoMethod {
-    Off,
-    Ssao,
-    Raytraced,
-}
-
-/// The file's spelling of [`super::settings::Tonemap`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum Tonemap {
-    Clamp,
-    Reinhard,
-    Aces,
 }
 
 /// `[render]`. The defaults are `scene::build::settings`'s (and the
@@ -214,14 +125,6 @@ pub struct ModelDesc {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scale(pub [f32; 3]);
 
-/// The file's spelling of [`super::material::NormalSpace`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum NormalSpaceDesc {
-    Tangent,
-    Object,
-}
-
 /// Overrides of MTL values; keys are the MTL keys in lower case.
 #[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
@@ -244,7 +147,7 @@ pub struct MaterialOverride {
     pub norm: Option<S<String>>,
     pub disp: Option<S<String>>,
     pub bump_scale: Option<S<f32>>,
-    pub normal_space: Option<S<NormalSpaceDesc>>,
+    pub normal_space: Option<S<NormalSpace>>,
     /// Extension: "opaque" | "mask" | "blend" (default: from d, map_d and
     /// the alpha of map_Kd).
     pub alpha_mode: Option<S<AlphaModeDesc>>,
@@ -326,14 +229,6 @@ pub struct AnimationDesc {
     pub turntable: Option<S<TurntableDesc>>,
 }
 
-/// The file's spelling of [`super::animation::TurntableTarget`].
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum TurntableTarget {
-    Models,
-    Camera,
-}
-
 /// Defaults: axis +Y, 360 degrees, rotate the models.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -342,6 +237,53 @@ pub struct TurntableDesc {
     pub degrees: Option<S<f32>>,
     pub rotate: Option<S<TurntableTarget>>,
 }
+
+// ---------------------------------------------------------------------------
+// The file's names of the renderer's values: the spelling lives here, the
+// types with their stages (`scene::settings` and what it re-exports).
+
+/// `Deserialize` for a renderer type from the names the file uses for its
+/// values; anything else is "unknown variant `x`, expected one of ...".
+macro_rules! file_names {
+    ($t:ident { $($name:literal => $v:ident),+ $(,)? }) => {
+        impl<'de> Deserialize<'de> for $t {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
+                const NAMES: &[&str] = &[$($name),+];
+                let s = String::deserialize(d)?;
+                match s.as_str() {
+                    $($name => Ok($t::$v),)+
+                    other => Err(de::Error::unknown_variant(other, NAMES)),
+                }
+            }
+        }
+    };
+}
+
+file_names!(ShadingMode {
+    "auto" => Auto, "blinn-phong" => BlinnPhong, "pbr" => Pbr, "flat" => Flat,
+    "gouraud" => Gouraud, "unlit" => Unlit, "normals" => Normals, "depth" => Depth,
+    "wireframe" => Wireframe,
+});
+file_names!(TextureFilter {
+    "nearest" => Nearest, "bilinear" => Bilinear, "trilinear" => Trilinear,
+    "anisotropic" => Anisotropic,
+});
+file_names!(AddressMode {
+    "repeat" => Repeat, "mirror" => Mirror, "clamp" => Clamp, "border" => Border,
+});
+file_names!(CullMode { "back" => Back, "front" => Front, "none" => None });
+file_names!(DepthMode { "reverse-z" => ReverseZ, "standard" => Standard });
+file_names!(ShadowMethod {
+    "off" => Off, "hard" => Hard, "pcf" => Pcf, "raytraced" => Raytraced,
+});
+// The screen-space method is GTAO; the file calls it `ssao`.
+file_names!(AoMethod { "off" => Off, "ssao" => Gtao, "raytraced" => Raytraced });
+file_names!(Tonemap { "clamp" => Clamp, "reinhard" => Reinhard, "aces" => Aces });
+file_names!(GifDither {
+    "none" => None, "ordered" => Ordered, "floyd-steinberg" => FloydSteinberg,
+});
+file_names!(NormalSpace { "tangent" => Tangent, "object" => Object });
+file_names!(TurntableTarget { "models" => Models, "camera" => Camera });
 
 // ---------------------------------------------------------------------------
 // Values with two spellings.
@@ -362,7 +304,7 @@ impl<'de> Deserialize<'de> for Background {
                 }
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Background, A::Error> {
-                Ok(Background::Color(read_vec3(seq, &self)?))
+                Ok(Background::Color(read_vec3(seq, &self)?.into()))
             }
         }
         d.deserialize_any(V)
@@ -442,7 +384,7 @@ impl SceneDesc {
         if let Some(bg) = &o.background
             && let Background::Color(col) = bg.get_ref()
         {
-            c.color(bg.span(), col, "output.background")?;
+            c.color(bg.span(), &col.to_array(), "output.background")?;
         }
         if let Some(n) = &o.name
             && n.get_ref().trim().is_empty()

@@ -1,6 +1,10 @@
-//! From a scene file to a loaded `Scene`: `desc` (the TOML as data),
-//! `overrides` (`--set`), `build` (resolve paths, load assets, defaults),
-//! `materials` (file materials to renderer materials).
+//! The loaded scene: what a scene file describes, with its assets loaded
+//! and every default filled in. `desc` is the file's shape (serde structs
+//! with spans, for errors), `overrides` edits the text for `--set`, `build`
+//! turns a `desc` into a `Scene` (the defaults live there), and the rest
+//! are the runtime types the renderer reads: `settings`, `camera`,
+//! `light`, `material`, `animation`. Nothing here knows how a frame is
+//! rendered, and the renderer never writes into a `Scene`.
 
 pub mod animation;
 pub mod build;
@@ -18,6 +22,7 @@ use glam::{Mat4, Vec3};
 
 use crate::assets::mesh::Mesh;
 pub use animation::Animation;
+pub use build::LoadOptions;
 pub use camera::Camera;
 pub use light::Light;
 pub use material::Material;

@@ -31,12 +31,7 @@ pub fn incidence(light: &Light, p: Vec3) -> Option<Incidence> {
             position,
             intensity,
         } => {
-            let d = position - p;
-            let r2 = d.length_squared();
-            if r2 <= 0.0 {
-                return None;
-            }
-            let l = d / r2.sqrt();
+            let (l, r2) = towards(position, p)?;
             Some(Incidence {
                 l,
                 e: light.color * (intensity * window(light, r2) / r2),
@@ -49,12 +44,7 @@ pub fn incidence(light: &Light, p: Vec3) -> Option<Incidence> {
             cos_inner,
             cos_outer,
         } => {
-            let d = position - p;
-            let r2 = d.length_squared();
-            if r2 <= 0.0 {
-                return None;
-            }
-            let l = d / r2.sqrt();
+            let (l, r2) = towards(position, p)?;
             let f = spot_falloff(-l.dot(direction), cos_inner, cos_outer);
             if f <= 0.0 {
                 return None;
@@ -65,6 +55,18 @@ pub fn incidence(light: &Light, p: Vec3) -> Option<Incidence> {
             })
         }
     }
+}
+
+/// The unit direction from `p` to a light at `position`, and the squared
+/// distance; None at the light itself.
+#[inline]
+fn towards(position: Vec3, p: Vec3) -> Option<(Vec3, f32)> {
+    let d = position - p;
+    let r2 = d.length_squared();
+    if r2 <= 0.0 {
+        return None;
+    }
+    Some((d / r2.sqrt(), r2))
 }
 
 #[inline]

@@ -12,7 +12,7 @@ use crate::assets::gltf::{GltfAlphaMode, GltfMaterial, ImageSource, TexInfo};
 use crate::assets::obj::{self, MapSpec, MtlMaterial};
 use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
-use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, NormalSpaceDesc, S};
+use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
 use crate::scene::material::{
     AlphaMode, Material, Native, NormalMap, NormalSpace, Pbr, ns_from_roughness, roughness_from_ns,
 };
@@ -30,7 +30,7 @@ pub enum SourceMaterial {
 pub struct MtlSource {
     pub mtl: MtlMaterial,
     pub bump_scale: Option<f32>,
-    pub normal_space: Option<NormalSpaceDesc>,
+    pub normal_space: Option<NormalSpace>,
     pub alpha_mode: Option<AlphaModeDesc>,
     pub alpha_cutoff: Option<f32>,
     /// World units per unit of `disp` height.
@@ -316,10 +316,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
             .or(spec.as_ref().and_then(|s| s.bump_scale))
             .unwrap_or(1.0)
     };
-    let space = match x.normal_space {
-        Some(NormalSpaceDesc::Object) => NormalSpace::Object,
-        Some(NormalSpaceDesc::Tangent) | None => NormalSpace::Tangent,
-    };
+    let space = x.normal_space.unwrap_or(NormalSpace::Tangent);
     let normal_map = if let Some(map) = tex(&m.norm, false) {
         Some(NormalMap::Normals {
             map,

@@ -111,10 +111,7 @@ fn animation(a: &desc::AnimationDesc, pivot: Vec3) -> Animation {
         Turntable {
             axis: Vec3::from(get(&t.axis, [0.0, 1.0, 0.0])).normalize(),
             degrees: get(&t.degrees, 360.0),
-            rotate: match t.rotate.as_ref().map(|r| *r.get_ref()) {
-                None | Some(desc::TurntableTarget::Models) => TurntableTarget::Models,
-                Some(desc::TurntableTarget::Camera) => TurntableTarget::Camera,
-            },
+            rotate: get(&t.rotate, TurntableTarget::Models),
         }
     });
     Animation {

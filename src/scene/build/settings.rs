@@ -9,60 +9,16 @@ use glam::Vec3;
 
 use super::get;
 use crate::error::Error;
+use crate::scene::check_pattern;
 use crate::scene::desc::{self, Ctx, SceneDesc};
 use crate::scene::settings::{
     AoMethod, AoSettings, Background, OutputSettings, RenderSettings, ShadowBias, ShadowMethod,
     TextureFilter,
 };
-use crate::scene::{check_pattern, settings};
 
-/// `From<desc::X> for X` where the file's enum and the renderer's have the
-/// same variants.
-macro_rules! same_variants {
-    ($name:ident: $($v:ident),+) => {
-        impl From<desc::$name> for settings::$name {
-            fn from(v: desc::$name) -> settings::$name {
-                match v {
-                    $(desc::$name::$v => settings::$name::$v,)+
-                }
-            }
-        }
-    };
-}
-
-same_variants!(ShadingMode: Auto, BlinnPhong, Pbr, Flat, Gouraud, Unlit, Normals, Depth, Wireframe);
-same_variants!(TextureFilter: Nearest, Bilinear, Trilinear, Anisotropic);
-same_variants!(AddressMode: Repeat, Mirror, Clamp, Border);
-same_variants!(CullMode: Back, Front, None);
-same_variants!(DepthMode: ReverseZ, Standard);
-same_variants!(ShadowMethod: Off, Hard, Pcf, Raytraced);
-same_variants!(Tonemap: Clamp, Reinhard, Aces);
-same_variants!(GifDither: None, Ordered, FloydSteinberg);
-
-impl From<desc::AoMethod> for AoMethod {
-    fn from(v: desc::AoMethod) -> AoMethod {
-        match v {
-            desc::AoMethod::Off => AoMethod::Off,
-            desc::AoMethod::Ssao => AoMethod::Gtao,
-            desc::AoMethod::Raytraced => AoMethod::Raytraced,
-        }
-    }
-}
-
-impl From<desc::Background> for Background {
-    fn from(v: desc::Background) -> Background {
-        match v {
-            desc::Background::Color(c) => Background::Color(Vec3::from(c)),
-            desc::Background::Transparent => Background::Transparent,
-        }
-    }
-}
-
-/// A file enum mapped to the renderer's, or the renderer's default.
-fn pick<D: Copy + Into<R>, R: Default>(v: &Option<desc::S<D>>) -> R {
-    v.as_ref()
-        .map(|v| (*v.get_ref()).into())
-        .unwrap_or_default()
+/// An optional key's value, or the renderer's default for it.
+fn pick<T: Copy + Default>(v: &Option<desc::S<T>>) -> T {
+    v.as_ref().map(|v| *v.get_ref()).unwrap_or_default()
 }
 
 /// `[render]`, `output.width/height/background` and `[ambient]`.
@@ -79,11 +35,7 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
         depth: pick(&r.depth),
         tonemap: pick(&r.tonemap),
         exposure: get(&r.exposure, 0.0),
-        background: o
-            .background
-            .as_ref()
-            .map(|b| (*b.get_ref()).into())
-            .unwrap_or(Background::Color(Vec3::ZERO)),
+        background: get(&o.background, Background::Color(Vec3::ZERO)),
         ambient: Vec3::from(get(&d.ambient.color, [0.03; 3])),
         shadows: shadow_method(r),
         shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
@@ -163,7 +115,7 @@ fn shadow_bias(r: &desc::RenderDesc) -> ShadowBias {
 /// key (it asked for maps), otherwise the default (raytraced).
 fn shadow_method(r: &desc::RenderDesc) -> ShadowMethod {
     match &r.shadows {
-        Some(m) => (*m.get_ref()).into(),
+        Some(m) => *m.get_ref(),
         None if r.shadow_map_size.is_some() || r.shadow_bias.is_some() => ShadowMethod::Pcf,
         None => ShadowMethod::default(),
     }
