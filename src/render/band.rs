@@ -16,7 +16,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::FrameSetup;
+use super::setup::FrameSetup;
 use super::geometry::{Draw, Geometry};
 use super::vertex::ModelVertices;
 use crate::assets::texture::Gradients;
@@ -27,7 +27,7 @@ use crate::raster::coverage::{
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::material::AlphaMode;
-use crate::scene::settings::{AoMethod, ShadingMode};
+use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
 use crate::shade::ao::GPixel;
 use crate::shade::{ShadeContext, Surface, TexCoords, background};
 
@@ -78,7 +78,7 @@ impl<'a> FrameData<'a> {
             alpha,
             tris: &geo.tris,
             pattern,
-            reverse: super::reverse_z(fs),
+            reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),
             grads,
             geo_normal,

@@ -8,7 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::FrameSetup;
+use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::CullMode;
 use crate::raster::bin::{TileGrid, bin};

@@ -39,7 +39,6 @@ pub use setup::FrameSetup;
 use crate::assets::mesh::Mesh;
 use crate::assets::mip;
 use crate::assets::texture::{Level, Texture};
-use crate::raster::DepthMode;
 use crate::raster::coverage::sample_pattern;
 use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
@@ -304,9 +303,4 @@ fn shade_context<'a>(
         shadows,
         pixel_scale: 1.0,
     }
-}
-
-/// Whether the frame's depth test keeps the larger value.
-fn reverse_z(fs: &FrameSetup) -> bool {
-    fs.scene.settings.depth == DepthMode::ReverseZ
 }

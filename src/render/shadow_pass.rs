@@ -13,7 +13,7 @@
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::FrameSetup;
+use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};

@@ -5,7 +5,7 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::FrameSetup;
+use super::setup::FrameSetup;
 use crate::scene::Model;
 
 /// Vertices of one model after the vertex pass.
