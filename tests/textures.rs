@@ -300,3 +300,45 @@ fn mip_chains_are_built_only_for_minified_textures() {
         assert_eq!(renderer.has_mips(0), minified, "{size}x{size} on 32x32");
     }
 }
+
+/// The renderer keeps BVHs and mip chains across frames; a frame must not
+/// depend on which frames it rendered before, nor on whether the renderer
+/// was made for this scene's assets.
+#[test]
+fn render_state_carried_across_frames_changes_no_pixel() {
+    use softraster::scene::{LoadOptions, Scene};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sets = [
+        "output.width=96",
+        "output.height=72",
+        "render.msaa=1",
+        "light.0.shadows=true",
+        "render.ao={method=\"raytraced\",samples=4}",
+        "render.texture_filter=\"anisotropic\"",
+    ];
+    let opts = LoadOptions {
+        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
+        out_dir: None,
+    };
+    let scene = Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
+    let frame = |r: &Renderer, s: &Scene, f: u32| {
+        let mut out = Frame::new(0, 0);
+        r.render(s, 0, f, &mut out);
+        out
+    };
+    let warm = Renderer::new(&scene);
+    for f in 0..3 {
+        frame(&warm, &scene, f);
+    }
+    // The frames minified some texture: a chain is carried over.
+    assert!((0..scene.textures.len()).any(|t| warm.has_mips(t)));
+    let after = frame(&warm, &scene, 5);
+    let fresh = frame(&Renderer::new(&scene), &scene, 5);
+    assert_eq!(after.color, fresh.color);
+    assert_eq!(after.ao, fresh.ao);
+    // A renderer made for other assets renders this scene all the same.
+    let other = Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
+    let foreign = frame(&Renderer::new(&other), &scene, 5);
+    assert_eq!(foreign.color, fresh.color);
+    assert_eq!(foreign.depth, fresh.depth);
+}

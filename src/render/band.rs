@@ -16,8 +16,8 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::setup::FrameSetup;
 use super::geometry::{Draw, Geometry};
+use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::assets::texture::Gradients;
 use crate::raster::bin::TileRect;
