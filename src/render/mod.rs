@@ -36,6 +36,7 @@ use rayon::prelude::*;
 pub use frame::Frame;
 pub use setup::FrameSetup;
 
+use crate::assets::environment::EnvImage;
 use crate::assets::mesh::Mesh;
 use crate::assets::mip;
 use crate::assets::texture::{Level, Texture};
@@ -47,6 +48,7 @@ use crate::scene::Scene;
 use crate::scene::camera::Projection;
 use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter};
 use crate::shade::ao::GPixel;
+use crate::shade::env::EnvLight;
 use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
 use geometry::Geometry;
@@ -64,6 +66,10 @@ pub struct Renderer {
     /// Per texture: levels 1.. of its mip chain, built on the first frame
     /// that minifies it.
     mips: Vec<OnceLock<Vec<Level>>>,
+    /// The scene's environment image, and its prefiltered lighting (built
+    /// on the first frame).
+    env_image: Option<Arc<EnvImage>>,
+    env: OnceLock<Option<EnvLight>>,
 }
 
 impl Renderer {
@@ -88,6 +94,8 @@ impl Renderer {
             model_mesh,
             mips: scene.textures.iter().map(|_| OnceLock::new()).collect(),
             textures: scene.textures.clone(),
+            env_image: scene.environment.as_ref().map(|e| e.image.clone()),
+            env: OnceLock::new(),
         }
     }
 
@@ -137,12 +145,28 @@ impl Renderer {
                 .iter()
                 .zip(&self.model_mesh)
                 .all(|(m, &k)| Arc::ptr_eq(&m.mesh, &self.meshes[k]))
+            && match (&scene.environment, &self.env_image) {
+                (Some(e), Some(i)) => Arc::ptr_eq(&e.image, i),
+                (None, None) => true,
+                _ => false,
+            }
             && scene.textures.len() == self.textures.len()
             && scene
                 .textures
                 .iter()
                 .zip(&self.textures)
                 .all(|(a, b)| Arc::ptr_eq(a, b))
+    }
+
+    /// The environment's lighting, prefiltered once per scene (its
+    /// intensity and rotation are taken from the first frame's scene).
+    fn env_light(&self, scene: &Scene) -> Option<&EnvLight> {
+        self.env
+            .get_or_init(|| {
+                let e = scene.environment.as_ref()?;
+                Some(EnvLight::new(&e.image, e.intensity, e.rotation))
+            })
+            .as_ref()
     }
 
     /// The frame's meshes as placed, for rays.
@@ -181,8 +205,9 @@ impl Renderer {
 
         let mut verts = vertex::transform_all(fs);
         let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref());
+        let env = self.env_light(fs.scene);
         if s.shading == ShadingMode::Gouraud {
-            let ctx = shade_context(fs, &[], &shadows);
+            let ctx = shade_context(fs, &[], &shadows, env);
             for (m, mv) in fs.scene.models.iter().zip(&mut verts) {
                 mv.light = gouraud::vertex_light(&ctx, m, &mv.world, &mv.normal);
             }
@@ -194,7 +219,7 @@ impl Renderer {
         let geo = geometry::setup_and_bin(fs, &verts, vp, filtered);
         let mips = self.frame_mips(fs, &geo);
 
-        let mut ctx = shade_context(fs, &mips, &shadows);
+        let mut ctx = shade_context(fs, &mips, &shadows, env);
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered);
@@ -280,6 +305,7 @@ fn shade_context<'a>(
     fs: &'a FrameSetup,
     mips: &'a [Option<&'a [Level]>],
     shadows: &'a Shadows<'a>,
+    env: Option<&'a EnvLight>,
 ) -> ShadeContext<'a> {
     let s = &fs.scene.settings;
     let cam = &fs.camera;
@@ -301,6 +327,7 @@ fn shade_context<'a>(
         mips,
         depth_range: (lo, hi),
         shadows,
+        env,
         pixel_scale: 1.0,
     }
 }

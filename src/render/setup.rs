@@ -38,7 +38,7 @@ impl<'a> FrameSetup<'a> {
                 }
             })
             .collect();
-        let lights = if scene.lights.is_empty() {
+        let lights = if scene.lights.is_empty() && scene.environment.is_none() {
             // Headlight: a directional light travelling along the view.
             vec![Light {
                 kind: LightKind::Directional {

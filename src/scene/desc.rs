@@ -37,6 +37,20 @@ pub struct SceneDesc {
     pub cameras: Vec<S<CameraDesc>>,
     #[serde(default)]
     pub animation: AnimationDesc,
+    /// Version 2: image-based lighting.
+    pub environment: Option<S<EnvironmentDesc>>,
+}
+
+/// `[environment]`: an equirectangular HDR image lighting the scene.
+/// Defaults: intensity 1, rotation 0.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// `.hdr` or `.exr`, relative to the scene file.
+    pub path: S<String>,
+    pub intensity: Option<S<f32>>,
+    /// Degrees about +Y, counter-clockwise seen from above.
+    pub rotation: Option<S<f32>>,
 }
 
 /// `[output]`. Defaults: 800x800, `out/<scene stem>`, `{camera}_{frame:04}`,
@@ -446,6 +460,14 @@ impl SceneDesc {
         }
         for cam in &self.cameras {
             validate_camera(c, cam.get_ref())?;
+        }
+        if let Some(e) = &self.environment {
+            let e = e.get_ref();
+            if e.path.get_ref().trim().is_empty() {
+                return Err(c.err(e.path.span(), "environment.path must not be empty"));
+            }
+            c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
+            c.finite(&e.rotation, "environment.rotation")?;
         }
         let a = &self.animation;
         c.int_range(&a.frames, "animation.frames", 1, 1_000_000)?;

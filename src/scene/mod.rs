@@ -10,6 +10,7 @@ pub mod animation;
 pub mod build;
 pub mod camera;
 pub mod desc;
+pub mod environment;
 pub mod light;
 pub mod material;
 pub mod overrides;
@@ -45,8 +46,11 @@ pub struct Scene {
     pub settings: RenderSettings,
     pub output: OutputSettings,
     pub models: Vec<Model>,
-    /// Empty: every camera gets a headlight (a directional light along its view).
+    /// Empty, and no environment: every camera gets a headlight (a
+    /// directional light along its view).
     pub lights: Vec<Light>,
+    /// Image-based lighting (`[environment]`).
+    pub environment: Option<environment::Environment>,
     pub cameras: Vec<Camera>,
     pub animation: Animation,
     /// World-space bounding sphere of all models at rest.

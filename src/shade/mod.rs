@@ -3,6 +3,7 @@
 
 pub mod ao;
 pub mod blinn_phong;
+pub mod env;
 pub mod gouraud;
 pub mod light;
 pub mod pbr;
@@ -36,6 +37,8 @@ pub struct ShadeContext<'a> {
     pub depth_range: (f32, f32),
     /// This frame's shadow maps or ray tracer.
     pub shadows: &'a shadow::Shadows<'a>,
+    /// Image-based lighting, when the scene has an environment.
+    pub env: Option<&'a env::EnvLight>,
     /// Rendered pixels per output pixel along an axis (the supersampling
     /// factor): wireframe lines keep their width in output pixels.
     pub pixel_scale: f32,
@@ -132,7 +135,8 @@ impl ShadeContext<'_> {
             ShadingMode::Gouraud => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let (d, sp) = s.vertex_light.unwrap_or((Vec3::ZERO, Vec3::ZERO));
-                blinn_phong::combine(&c, self.ambient * s.ao, d, sp)
+                let env = self.env_blinn_phong(s, s.normal, &c);
+                blinn_phong::combine(&c, self.ambient * s.ao, d, sp) + env
             }
             ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
             ShadingMode::Pbr => self.shade_pbr(s),
@@ -141,13 +145,17 @@ impl ShadeContext<'_> {
                 let v = self.view_vector(s.position);
                 let n = self.mapped_normal(s);
                 let ambient = self.ambient * s.ao;
+                let env = self.env_blinn_phong(s, n, &c);
                 blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
+                    + env
             }
             ShadingMode::Flat => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 let (n, ambient) = (s.normal, self.ambient * s.ao);
+                let env = self.env_blinn_phong(s, n, &c);
                 blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
+                    + env
             }
         }
     }
@@ -158,7 +166,29 @@ impl ShadeContext<'_> {
         let v = self.view_vector(s.position);
         let n = self.mapped_normal(s);
         let ambient = self.ambient * s.ao;
-        pbr::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
+        let direct = pbr::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s));
+        match self.env {
+            Some(env) => direct + pbr::environment(env, n, v, &c, s.ao),
+            None => direct,
+        }
+    }
+
+    /// The environment's light on a Blinn-Phong surface with unit normal
+    /// `n`: Kd E(n) / pi (times AO) plus Ks times the radiance prefiltered
+    /// along the reflection with the GGX lobe that matches Ns (zero
+    /// without an environment).
+    fn env_blinn_phong(&self, s: &Surface, n: Vec3, c: &SurfaceColor) -> Vec3 {
+        let Some(env) = self.env else {
+            return Vec3::ZERO;
+        };
+        let v = self.view_vector(s.position);
+        let diffuse = c.kd * env.irradiance(n) * (s.ao / std::f32::consts::PI);
+        if c.ks == Vec3::ZERO {
+            return diffuse;
+        }
+        let r = n * (2.0 * n.dot(v)) - v;
+        let roughness = crate::scene::material::roughness_from_ns(c.ns);
+        diffuse + c.ks * env.prefiltered(r, roughness)
     }
 
     /// Light `i`'s shadow at the surface point, towards unit `l`.

@@ -24,6 +24,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use super::env::EnvLight;
 use super::light::for_each_lit;
 use crate::scene::Light;
 
@@ -109,6 +110,21 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
     );
     let a004 = (x * x).min((-9.28 * ndv.max(0.0)).exp2()) * x + y;
     (-1.04 * a004 + z, 1.04 * a004 + w)
+}
+
+/// The environment's light reflected towards `v` (the split sum): the
+/// specular lobe's prefiltered radiance times f0 A + B, the diffuse part
+/// c_diff (1 - (f0 A + B)) E(n) / pi, so that a white furnace never gains
+/// energy. `ao` multiplies the diffuse part, and the specular part through
+/// Lagarde's specular occlusion; the occlusion map multiplies both.
+pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> Vec3 {
+    let ndv = n.dot(v).abs().max(1e-4);
+    let ab = env.brdf(ndv, c.roughness);
+    let spec = c.f0() * ab.x + Vec3::splat(ab.y);
+    let diffuse = c.c_diff() * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
+    let r = n * (2.0 * n.dot(v)) - v;
+    let so = ((ndv + ao).powf((-16.0 * c.roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0);
+    (diffuse + env.prefiltered(r, c.roughness) * spec * so) * c.occlusion
 }
 
 /// Outgoing radiance at `p` towards `v`.

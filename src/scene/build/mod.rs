@@ -18,8 +18,11 @@ use glam::Vec3;
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, S, SceneDesc};
+use super::environment::Environment;
 use super::overrides::{self, SetOverride};
+use crate::assets::environment::EnvImage;
 use crate::error::Error;
+use std::sync::Arc;
 
 /// Options that come from outside the scene file.
 #[derive(Debug, Clone, Default)]
@@ -86,6 +89,11 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         .collect();
     lights.extend(models.lights);
     let cameras = cameras::build(d, ctx, bounds, &models.cameras)?;
+    let environment = d
+        .environment
+        .as_ref()
+        .map(|e| environment(e.get_ref(), ctx, &scene_dir))
+        .transpose()?;
     Ok(Scene {
         file: ctx.file.to_path_buf(),
         stem,
@@ -93,12 +101,38 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         output,
         models: models.models,
         lights,
+        environment,
         cameras,
         animation: animation(&d.animation, bounds.center),
         bounds_center: bounds.center,
         bounds_radius: bounds.radius,
         textures: models.textures,
         warnings,
+    })
+}
+
+/// `[environment]`: the image read (relative to the scene file); a
+/// missing file names the `path` key.
+fn environment(
+    e: &desc::EnvironmentDesc,
+    ctx: &Ctx,
+    scene_dir: &Path,
+) -> Result<Environment, Error> {
+    let path = scene_dir.join(e.path.get_ref().replace('\\', "/"));
+    if !path.is_file() {
+        return Err(Error::asset(
+            &path,
+            None,
+            format!(
+                "environment file not found (from {})",
+                ctx.location(e.path.span())
+            ),
+        ));
+    }
+    Ok(Environment {
+        image: Arc::new(EnvImage::load(&path)?),
+        intensity: get(&e.intensity, 1.0),
+        rotation: get(&e.rotation, 0.0),
     })
 }
 

@@ -36,7 +36,15 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
         tonemap: pick(&r.tonemap),
         exposure: get(&r.exposure, 0.0),
         background: get(&o.background, Background::Color(Vec3::ZERO)),
-        ambient: Vec3::from(get(&d.ambient.color, [0.03; 3])),
+        // With an environment lighting the scene, no ambient by default.
+        ambient: Vec3::from(get(
+            &d.ambient.color,
+            if d.environment.is_some() {
+                [0.0; 3]
+            } else {
+                [0.03; 3]
+            },
+        )),
         shadows: shadow_method(r),
         shadow_map_size: get(&r.shadow_map_size, 2048) as u32,
         shadow_bias: shadow_bias(r),
