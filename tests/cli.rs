@@ -451,3 +451,30 @@ fn keys_without_effect_warn_and_map_keys_mean_shadow_maps() {
         );
     }
 }
+
+#[test]
+fn a_model_file_renders_as_its_one_line_scene() {
+    let dir = common::scratch("model_as_scene");
+    write(&dir, "tri.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    let out = dir.join("out");
+    let (code, err) = run(&[
+        "render",
+        dir.join("tri.obj").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "output.width=40",
+        "--set",
+        "output.height=30",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let img = image::open(out.join("camera_0000.png")).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (40, 30));
+    // The default camera frames the triangle: its middle is lit.
+    assert!(img.get_pixel(20, 15).0.iter().any(|&c| c > 30), "{:?}", img.get_pixel(20, 15));
+    // --set errors name the override.
+    let (code, err) = run(&["render", dir.join("tri.obj").to_str().unwrap(), "--set", "render.ssaa=0"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--set render.ssaa=0"), "{err}");
+}

@@ -34,8 +34,15 @@ pub struct LoadOptions {
 }
 
 impl Scene {
-    /// Reads, parses, validates and loads a scene file.
+    /// Reads, parses, validates and loads a scene file. A model file
+    /// (`.gltf`, `.glb`, `.obj`) is a scene too: the one-line scene that
+    /// names it, read from its directory (output in `out/<model stem>/`).
     pub fn load(path: &Path, opts: &LoadOptions) -> Result<Scene, Error> {
+        if let Some(text) = model_as_scene(path) {
+            let edited = overrides::apply(path, &text, &opts.sets)?;
+            return Scene::from_text(path, &edited, opts)
+                .map_err(|e| overrides::blame(path, &text, &opts.sets, e));
+        }
         let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
             location: crate::error::Location {
                 file: path.to_path_buf(),
@@ -56,6 +63,18 @@ impl Scene {
         let ctx = Ctx { file: path, text };
         build(&desc, &ctx, opts)
     }
+}
+
+/// The one-line scene of a model file, or None for other files.
+fn model_as_scene(path: &Path) -> Option<String> {
+    let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+    if !matches!(ext.as_str(), "gltf" | "glb" | "obj") {
+        return None;
+    }
+    let name = path.file_name()?.to_string_lossy().into_owned();
+    let mut value = toml_edit::Value::from(name);
+    value.decor_mut().clear();
+    Some(format!("[[model]]\npath = {value}\n"))
 }
 
 /// The value of an optional key, or its default.
