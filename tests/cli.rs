@@ -472,9 +472,18 @@ fn a_model_file_renders_as_its_one_line_scene() {
     let img = image::open(out.join("camera_0000.png")).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (40, 30));
     // The default camera frames the triangle: its middle is lit.
-    assert!(img.get_pixel(20, 15).0.iter().any(|&c| c > 30), "{:?}", img.get_pixel(20, 15));
+    assert!(
+        img.get_pixel(20, 15).0.iter().any(|&c| c > 30),
+        "{:?}",
+        img.get_pixel(20, 15)
+    );
     // --set errors name the override.
-    let (code, err) = run(&["render", dir.join("tri.obj").to_str().unwrap(), "--set", "render.ssaa=0"]);
+    let (code, err) = run(&[
+        "render",
+        dir.join("tri.obj").to_str().unwrap(),
+        "--set",
+        "render.ssaa=0",
+    ]);
     assert_eq!(code, 2);
     assert!(err.contains("--set render.ssaa=0"), "{err}");
 }

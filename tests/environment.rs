@@ -251,3 +251,39 @@ fn bad_environments_are_refused_by_name() {
     let (code, _, err) = run("intensity = 2.0");
     assert_eq!(code, 0, "{err}");
 }
+
+#[test]
+fn the_background_shows_the_environment_sharp_or_blurred() {
+    let dir = scratch("env_background");
+    // The image's left half (u < 0.5: directions toward -X) 1, the right
+    // half 0. Seen from +Z looking at -Z, screen left is toward -X.
+    write_env(&dir.join("env.exr"), 128, |x, _| {
+        if x < 64 { [1.0; 3] } else { [0.0; 3] }
+    });
+    let scene = |bg: &str| {
+        // A perspective camera: each pixel looks its own way.
+        let t = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+            .replace(
+                "height = 64\n",
+                &format!("height = 64\nbackground = {bg}\n"),
+            )
+            .replace("projection = \"orthographic\"\nheight = 2.4", "fov = 60.0");
+        load(&dir, &t)
+    };
+    let f = render_frame(&scene("\"environment\""), 0, 0);
+    // Corners: top-left sees -X (lit half), top-right sees +X.
+    let (tl, tr) = (f.color[0], f.color[63]);
+    assert!((tl.x - 1.0).abs() < 1e-3 && tl.w == 1.0, "{tl}");
+    assert!(tr.x.abs() < 1e-3 && tr.w == 1.0, "{tr}");
+    // Blurred: the same sides, softened toward each other.
+    let f = render_frame(&scene("\"blurred\"\nbackground_blur = 1.0"), 0, 0);
+    let (tl, tr) = (f.color[0].x, f.color[63].x);
+    assert!(tl > tr && tl < 0.95 && tr > 0.05, "{tl} {tr}");
+    // Without an [environment], refused at the key.
+    let t = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+        .replace("height = 64\n", "height = 64\nbackground = \"blurred\"\n")
+        .replace("[environment]\npath = \"env.exr\"\n", "");
+    std::fs::write(dir.join("s.toml"), t).unwrap();
+    let e = softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_err();
+    assert!(e.to_string().contains("needs an [environment]"), "{e}");
+}

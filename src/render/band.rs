@@ -26,9 +26,12 @@ use crate::raster::coverage::{
 };
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
+use crate::scene::camera::Projection;
 use crate::scene::material::AlphaMode;
+use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
 use crate::shade::ao::GPixel;
+use crate::shade::env::EnvLight;
 use crate::shade::{ShadeContext, Surface, TexCoords, background};
 
 /// What every band of one frame reads.
@@ -44,6 +47,9 @@ pub(super) struct FrameData<'a> {
     pub pattern: &'static [(i8, i8)],
     pub reverse: bool,
     pub bg: Vec4,
+    /// The environment seen through the camera, where the background
+    /// shows it.
+    pub env_bg: Option<EnvBackground<'a>>,
     /// Texture filtering needs derivatives (trilinear, anisotropic).
     pub grads: bool,
     /// Shading reads the triangle's plane normal (flat shading, shadows,
@@ -80,6 +86,7 @@ impl<'a> FrameData<'a> {
             pattern,
             reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),
+            env_bg: EnvBackground::new(fs, &ctx, geo.grid.width, geo.grid.height),
             grads,
             geo_normal,
             ctx,
@@ -318,19 +325,23 @@ impl<'a> FrameData<'a> {
                     }
                     let i = y * tw + x;
                     let ids = &vis.id[i * n..(i + 1) * n];
+                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
+                    let bg = match &self.env_bg {
+                        Some(e) => e.at(px, py),
+                        None => self.bg,
+                    };
                     if ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE) {
-                        color[i] = self.bg;
+                        color[i] = bg;
                         depth[i] = f32::INFINITY;
                         continue;
                     }
-                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
                     let occlusion = ao.map_or(1.0, |a| a[i]);
                     let mut acc = Vec4::ZERO;
                     let mut nearest = f32::INFINITY;
                     for (id, mask) in fragments(ids) {
                         let count = mask.count_ones() as f32;
                         if id == NO_TRIANGLE {
-                            acc += self.bg * count;
+                            acc += bg * count;
                             continue;
                         }
                         let t = &self.tris[id as usize];
@@ -530,6 +541,71 @@ impl<'a> FrameData<'a> {
             geo_normal,
             view_depth,
         }
+    }
+}
+
+/// The environment behind the models: the radiance along each pixel's
+/// view ray (the pixel center's), sharp or prefiltered.
+pub(super) struct EnvBackground<'a> {
+    env: &'a EnvLight,
+    /// Prefiltering roughness; 0: the image itself.
+    blur: f32,
+    forward: Vec3,
+    /// View-space extent of a pixel step along x and y (0: orthographic).
+    right: Vec3,
+    up: Vec3,
+    size: (f32, f32),
+}
+
+impl<'a> EnvBackground<'a> {
+    fn new(
+        fs: &FrameSetup,
+        ctx: &ShadeContext<'a>,
+        width: u32,
+        height: u32,
+    ) -> Option<EnvBackground<'a>> {
+        let blur = match fs.scene.settings.background {
+            Background::Environment => 0.0,
+            Background::Blurred(b) => b,
+            _ => return None,
+        };
+        // The data views show values, not radiance: no environment there.
+        if fs.scene.settings.shading.is_data_view() {
+            return None;
+        }
+        let env = ctx.env?;
+        let cam = &fs.camera;
+        let forward = cam.forward();
+        let side = forward.cross(cam.up).normalize_or(Vec3::X);
+        let up = side.cross(forward);
+        let (right, up) = match cam.projection {
+            Projection::Perspective { fov_y } => {
+                let t = (fov_y.to_radians() * 0.5).tan();
+                let aspect = width as f32 / height as f32;
+                (side * (t * aspect), up * t)
+            }
+            Projection::Orthographic { .. } => (Vec3::ZERO, Vec3::ZERO),
+        };
+        Some(EnvBackground {
+            env,
+            blur,
+            forward,
+            right,
+            up,
+            size: (width as f32, height as f32),
+        })
+    }
+
+    fn at(&self, px: i32, py: i32) -> Vec4 {
+        let x = (px as f32 + 0.5) / self.size.0 * 2.0 - 1.0;
+        let y = 1.0 - (py as f32 + 0.5) / self.size.1 * 2.0;
+        let d = self.forward + self.right * x + self.up * y;
+        let c = if self.blur > 0.0 {
+            self.env.prefiltered(d, self.blur)
+        } else {
+            self.env.radiance(d)
+        };
+        c.extend(1.0)
     }
 }
 

@@ -70,6 +70,8 @@ pub struct OutputDesc {
     /// Extension: "none" (default), "ordered" or "floyd-steinberg".
     pub gif_dither: Option<S<GifDither>>,
     pub background: Option<S<Background>>,
+    /// Version 2: how blurred `background = "blurred"` is, 0..1 (0.5).
+    pub background_blur: Option<S<f32>>,
 }
 
 /// `[render]`. The defaults are `scene::build::settings`'s (and the
@@ -308,13 +310,17 @@ impl<'de> Deserialize<'de> for Background {
         impl<'de> Visitor<'de> for V {
             type Value = Background;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("an RGB array like [0.0, 0.0, 0.0] or the string \"transparent\"")
+                f.write_str(
+                    "an RGB array like [0.0, 0.0, 0.0], or \"transparent\", \"environment\" or \"blurred\"",
+                )
             }
             fn visit_str<E: de::Error>(self, s: &str) -> Result<Background, E> {
-                if s == "transparent" {
-                    Ok(Background::Transparent)
-                } else {
-                    Err(E::invalid_value(de::Unexpected::Str(s), &self))
+                match s {
+                    "transparent" => Ok(Background::Transparent),
+                    "environment" => Ok(Background::Environment),
+                    // The blur comes from `output.background_blur`.
+                    "blurred" => Ok(Background::Blurred(0.5)),
+                    _ => Err(E::invalid_value(de::Unexpected::Str(s), &self)),
                 }
             }
             fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Background, A::Error> {
@@ -399,6 +405,19 @@ impl SceneDesc {
             && let Background::Color(col) = bg.get_ref()
         {
             c.color(bg.span(), &col.to_array(), "output.background")?;
+        }
+        c.float_range(&o.background_blur, "output.background_blur", 0.0, 1.0)?;
+        if let Some(bg) = &o.background
+            && matches!(
+                bg.get_ref(),
+                Background::Environment | Background::Blurred(_)
+            )
+            && self.environment.is_none()
+        {
+            return Err(c.err(
+                bg.span(),
+                "output.background shows the environment: the scene needs an [environment]",
+            ));
         }
         if let Some(n) = &o.name
             && n.get_ref().trim().is_empty()

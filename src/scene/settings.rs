@@ -83,11 +83,15 @@ pub enum Tonemap {
     Aces,
 }
 
-/// `output.background`: linear RGB, or transparent (RGBA output).
+/// `output.background`: linear RGB, transparent (RGBA output), or the
+/// scene's environment seen through the camera, sharp or blurred.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Background {
     Color(Vec3),
     Transparent,
+    Environment,
+    /// The environment prefiltered at roughness `output.background_blur`.
+    Blurred(f32),
 }
 
 /// `output.gif_dither`: how GIF frames are mapped to the shared palette.

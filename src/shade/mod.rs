@@ -370,10 +370,13 @@ impl ShadeContext<'_> {
     }
 }
 
-/// Background pixel: linear color with alpha (0 for transparent).
+/// Background pixel: linear color with alpha (0 for transparent); the
+/// environment backgrounds vary per pixel (`ShadeContext::env_background`)
+/// and are black here.
 pub fn background(bg: Background) -> Vec4 {
     match bg {
         Background::Color(c) => c.extend(1.0),
         Background::Transparent => Vec4::ZERO,
+        Background::Environment | Background::Blurred(_) => Vec4::W,
     }
 }

@@ -35,7 +35,10 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
         depth: pick(&r.depth),
         tonemap: pick(&r.tonemap),
         exposure: get(&r.exposure, 0.0),
-        background: get(&o.background, Background::Color(Vec3::ZERO)),
+        background: match get(&o.background, Background::Color(Vec3::ZERO)) {
+            Background::Blurred(_) => Background::Blurred(get(&o.background_blur, 0.5)),
+            b => b,
+        },
         // With an environment lighting the scene, no ambient by default.
         ambient: Vec3::from(get(
             &d.ambient.color,
@@ -188,6 +191,12 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
         warn(
             Some(ao.span()),
             "render.ao radius/samples have no effect without a method (ssao or raytraced)",
+        );
+    }
+    if !matches!(s.background, Background::Blurred(_)) {
+        warn(
+            o.background_blur.as_ref().map(|v| v.span()),
+            "output.background_blur has no effect: output.background is not \"blurred\"",
         );
     }
     if o.gif.is_none() {
