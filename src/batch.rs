@@ -304,6 +304,15 @@ fn outputs(frame: &Frame, files: FrameFiles, scene: &Scene) -> Vec<Output> {
     out
 }
 
+/// `scene` with `render.exposure = "auto"` resolved to stops.
+pub fn with_auto_exposure(mut scene: Scene) -> Scene {
+    if scene.settings.auto_exposure {
+        scene.settings.exposure = crate::render::auto_exposure(&scene);
+        scene.settings.auto_exposure = false;
+    }
+    scene
+}
+
 impl RenderJob {
     /// Every frame of every camera.
     pub fn all(scene: Scene) -> RenderJob {
@@ -351,7 +360,13 @@ impl RenderJob {
     }
 
     fn render_frames(&self, mut on_done: impl FnMut(&FrameDone)) -> Result<(), Error> {
-        let scene = &self.scene;
+        let auto;
+        let scene = if self.scene.settings.auto_exposure {
+            auto = with_auto_exposure(self.scene.clone());
+            &auto
+        } else {
+            &self.scene
+        };
         let (to_writer, writer_rx) = mpsc::sync_channel::<(FrameDone, Vec<Output>)>(2);
         let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
         let writer = std::thread::spawn(move || {

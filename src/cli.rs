@@ -9,7 +9,9 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use softraster::batch::{FrameDone, FramePlan, JobSummary, RenderJob, thread_pool};
+use softraster::batch::{
+    FrameDone, FramePlan, JobSummary, RenderJob, thread_pool, with_auto_exposure,
+};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
@@ -346,7 +348,15 @@ fn render(args: RenderArgs) -> Result<(), Error> {
     pool.install(|| {
         let t0 = std::time::Instant::now();
         let scene = Scene::load(&args.scene, &opts)?;
+        let auto = scene.settings.auto_exposure;
+        let scene = with_auto_exposure(scene);
         let load_s = t0.elapsed().as_secs_f64();
+        if auto && args.progress == Progress::Json {
+            let stops = scene.settings.exposure;
+            println!("{}", serde_json::json!({ "event": "exposure", "stops": stops }));
+        } else if auto && !args.quiet {
+            eprintln!("exposure: auto, {:+.2} stops", scene.settings.exposure);
+        }
         if !args.quiet {
             for w in &scene.warnings {
                 eprintln!("warning: {w}");

@@ -287,3 +287,36 @@ fn the_background_shows_the_environment_sharp_or_blurred() {
     let e = softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_err();
     assert!(e.to_string().contains("needs an [environment]"), "{e}");
 }
+
+#[test]
+fn auto_exposure_maps_the_models_log_average_to_middle_grey() {
+    let dir = scratch("env_exposure");
+    // kd 0.6 under a uniform radiance of 1/0.6: the sphere's radiance is 1.
+    write_env(&dir.join("env.exr"), 64, |_, _| [1.0 / 0.6; 3]);
+    let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "exposure = \"auto\"\n")
+        .replace("[[model]]", "[animation]\nframes = 12\n[[model]]");
+    let s = load(&dir, &text);
+    assert!(s.settings.auto_exposure);
+    let stops = softraster::render::auto_exposure(&s);
+    assert!((stops - 0.18f32.log2()).abs() < 0.01, "{stops}");
+    // Every shard of a farm run gets the same value.
+    std::fs::write(dir.join("s.toml"), &text).unwrap();
+    let line = |frames: &str| {
+        let (code, _, err) = common::run(&[
+            "render",
+            dir.join("s.toml").to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+            "--frames",
+            frames,
+        ]);
+        assert_eq!(code, 0, "{err}");
+        err.lines()
+            .find(|l| l.starts_with("exposure: auto"))
+            .unwrap_or_default()
+            .to_string()
+    };
+    let a = line("0..3");
+    assert!(a.contains("-2.47 stops"), "{a}");
+    assert_eq!(a, line("9"));
+}

@@ -1,7 +1,8 @@
 //! From linear radiance to display values: exposure and a tone map (clamp,
-//! Reinhard, ACES); the sRGB encoding that follows is `color::encode_srgb`.
+//! Reinhard, ACES, Khronos PBR Neutral, AgX); the sRGB encoding that
+//! follows is `color::encode_srgb`.
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use crate::scene::settings::Tonemap;
 
@@ -16,8 +17,65 @@ pub fn tonemap(c: Vec3, op: Tonemap, exposure_scale: f32) -> Vec3 {
             let (a, b, cc, d, e) = (2.51, 0.03, 2.43, 0.59, 0.14);
             (c * (c * a + b)) / (c * (c * cc + d) + e)
         }
+        Tonemap::PbrNeutral => pbr_neutral(c),
+        Tonemap::Agx => agx(c),
     }
     .clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// Khronos PBR Neutral (2024): identity below 0.76, then a soft compression
+/// of the peak toward 1 that keeps hue, desaturating only what it
+/// compresses; a base colour under white light of 1 shows as itself.
+fn pbr_neutral(c: Vec3) -> Vec3 {
+    const START: f32 = 0.8 - 0.04;
+    const DESATURATION: f32 = 0.15;
+    let x = c.min_element();
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    let c = c - Vec3::splat(offset);
+    let peak = c.max_element();
+    if peak < START {
+        return c;
+    }
+    let d = 1.0 - START;
+    let new_peak = 1.0 - d * d / (peak + d - START);
+    let c = c * (new_peak / peak);
+    let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+    c.lerp(Vec3::splat(new_peak), g)
+}
+
+/// AgX (Troy Sobotka's, in the common minimal form): an inset into a
+/// wider primaries space, a log2 encoding over [-12.47, 4.03] stops, the
+/// default contrast curve (a polynomial fit of its sigmoid), the outset,
+/// and back to linear for the sRGB encoding.
+fn agx(c: Vec3) -> Vec3 {
+    const MIN_EV: f32 = -12.473_931;
+    const MAX_EV: f32 = 4.026_069;
+    let inset = Mat3::from_cols(
+        Vec3::new(0.842_479_06, 0.042_328_24, 0.042_375_65),
+        Vec3::new(0.078_433_6, 0.878_468_6, 0.078_433_6),
+        Vec3::new(0.079_223_75, 0.079_166_13, 0.879_142_97),
+    );
+    let outset = Mat3::from_cols(
+        Vec3::new(1.196_879, -0.052_896_85, -0.052_971_635),
+        Vec3::new(-0.098_020_88, 1.151_903_1, -0.098_043_45),
+        Vec3::new(-0.099_029_74, -0.098_961_18, 1.151_073_7),
+    );
+    let v = inset * c.max(Vec3::splat(1e-10));
+    let v = Vec3::new(v.x.log2(), v.y.log2(), v.z.log2())
+        .clamp(Vec3::splat(MIN_EV), Vec3::splat(MAX_EV));
+    let x = (v - Vec3::splat(MIN_EV)) / (MAX_EV - MIN_EV);
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let curve =
+        x4 * x2 * 15.5 - x4 * x * 40.14 + x4 * 31.96 - x2 * x * 6.868 + x2 * 0.4298 + x * 0.1191
+            - Vec3::splat(0.00232);
+    let display = (outset * curve).max(Vec3::ZERO);
+    // The curve's output is display-encoded (gamma 2.2): back to linear.
+    Vec3::new(
+        display.x.powf(2.2),
+        display.y.powf(2.2),
+        display.z.powf(2.2),
+    )
 }
 
 #[cfg(test)]
@@ -26,7 +84,13 @@ mod tests {
 
     #[test]
     fn tone_maps_are_monotonic_and_bounded() {
-        for op in [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces] {
+        for op in [
+            Tonemap::Clamp,
+            Tonemap::Reinhard,
+            Tonemap::Aces,
+            Tonemap::PbrNeutral,
+            Tonemap::Agx,
+        ] {
             let mut last = -1.0;
             for i in 0..100 {
                 let v = tonemap(Vec3::splat(i as f32 * 0.1), op, 1.0).x;
@@ -35,5 +99,29 @@ mod tests {
             }
         }
         assert!((tonemap(Vec3::ONE, Tonemap::Reinhard, 1.0).x - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn pbr_neutral_keeps_colours_below_its_knee_and_agx_is_neutral_on_grey() {
+        // Between 0.08 and 0.76 PBR Neutral only subtracts its 0.04 offset.
+        let c = Vec3::new(0.5, 0.3, 0.2);
+        let t = tonemap(c, Tonemap::PbrNeutral, 1.0);
+        assert!(
+            (t - (c - Vec3::splat(0.04))).abs().max_element() < 1e-6,
+            "{t}"
+        );
+        // Bright colours approach but never pass 1.
+        let t = tonemap(Vec3::new(50.0, 10.0, 1.0), Tonemap::PbrNeutral, 1.0);
+        assert!(t.max_element() <= 1.0 && t.x > t.y && t.y > t.z, "{t}");
+        // AgX maps greys to greys, middle grey near the middle.
+        for v in [0.01f32, 0.18, 1.0, 10.0] {
+            let t = tonemap(Vec3::splat(v), Tonemap::Agx, 1.0);
+            assert!(
+                (t.x - t.y).abs() < 2e-3 && (t.y - t.z).abs() < 2e-3,
+                "{v}: {t}"
+            );
+        }
+        let mid = tonemap(Vec3::splat(0.18), Tonemap::Agx, 1.0).x;
+        assert!(mid > 0.1 && mid < 0.35, "{mid}");
     }
 }

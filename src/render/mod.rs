@@ -22,6 +22,7 @@
 
 mod ao_pass;
 mod band;
+mod exposure;
 mod frame;
 mod geometry;
 mod setup;
@@ -33,6 +34,7 @@ use std::sync::{Arc, OnceLock};
 use glam::Vec3;
 use rayon::prelude::*;
 
+pub use exposure::auto_exposure;
 pub use frame::Frame;
 pub use setup::FrameSetup;
 

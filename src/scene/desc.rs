@@ -95,7 +95,8 @@ pub struct RenderDesc {
     pub shadow_bias: Option<S<ShadowBiasDesc>>,
     pub ao: Option<S<AoDesc>>,
     pub tonemap: Option<S<Tonemap>>,
-    pub exposure: Option<S<f32>>,
+    /// Stops, or "auto" (version 2).
+    pub exposure: Option<S<Exposure>>,
 }
 
 /// `render.shadow_bias` (extension), in shadow-map texels at the receiver.
@@ -294,7 +295,10 @@ file_names!(ShadowMethod {
 });
 // The screen-space method is GTAO; the file calls it `ssao`.
 file_names!(AoMethod { "off" => Off, "ssao" => Gtao, "raytraced" => Raytraced });
-file_names!(Tonemap { "clamp" => Clamp, "reinhard" => Reinhard, "aces" => Aces });
+file_names!(Tonemap {
+    "clamp" => Clamp, "reinhard" => Reinhard, "aces" => Aces, "pbr-neutral" => PbrNeutral,
+    "agx" => Agx,
+});
 file_names!(GifDither {
     "none" => None, "ordered" => Ordered, "floyd-steinberg" => FloydSteinberg,
 });
@@ -303,6 +307,41 @@ file_names!(TurntableTarget { "models" => Models, "camera" => Camera });
 
 // ---------------------------------------------------------------------------
 // Values with two spellings.
+
+/// `render.exposure`: stops, or "auto".
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    Stops(f32),
+    Auto,
+}
+
+impl<'de> Deserialize<'de> for Exposure {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Exposure;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number of stops or the string \"auto\"")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<Exposure, E> {
+                match s {
+                    "auto" => Ok(Exposure::Auto),
+                    _ => Err(E::invalid_value(de::Unexpected::Str(s), &self)),
+                }
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Exposure, E> {
+                Ok(Exposure::Stops(v as f32))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Exposure, E> {
+                Ok(Exposure::Stops(v as f32))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Exposure, E> {
+                Ok(Exposure::Stops(v as f32))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
 
 impl<'de> Deserialize<'de> for Background {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -452,7 +491,15 @@ impl SceneDesc {
         }
         c.int_range(&r.max_anisotropy, "render.max_anisotropy", 1, 16)?;
         c.int_range(&r.shadow_map_size, "render.shadow_map_size", 16, 16384)?;
-        c.float_range(&r.exposure, "render.exposure", -64.0, 64.0)?;
+        if let Some(e) = &r.exposure
+            && let Exposure::Stops(x) = e.get_ref()
+            && !(x.is_finite() && (-64.0..=64.0).contains(x))
+        {
+            return Err(c.err(
+                e.span(),
+                format!("render.exposure = {x}: expected a number from -64 to 64, or \"auto\""),
+            ));
+        }
         if let Some(ao) = &r.ao {
             let ao = ao.get_ref();
             c.float_range(&ao.radius, "render.ao.radius", f32::MIN_POSITIVE, 1e9)?;

@@ -81,6 +81,10 @@ pub enum Tonemap {
     Reinhard,
     /// Narkowicz's fit of the ACES filmic curve.
     Aces,
+    /// Khronos PBR Neutral: colours under 0.76 unchanged.
+    PbrNeutral,
+    /// AgX: a filmic curve that desaturates highlights toward white.
+    Agx,
 }
 
 /// `output.background`: linear RGB, transparent (RGBA output), or the
@@ -119,7 +123,11 @@ pub struct RenderSettings {
     pub cull: CullMode,
     pub depth: DepthMode,
     pub tonemap: Tonemap,
+    /// Stops (`2^exposure` scales the radiance before the tone map).
     pub exposure: f32,
+    /// `render.exposure = "auto"`: the batch sets `exposure` once for the
+    /// whole sequence (`render::auto_exposure`) before the first frame.
+    pub auto_exposure: bool,
     pub background: Background,
     pub ambient: Vec3,
     /// How lights with `shadows = true` cast them (default raytraced; pcf

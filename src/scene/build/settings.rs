@@ -34,7 +34,14 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
         cull: pick(&r.cull),
         depth: pick(&r.depth),
         tonemap: pick(&r.tonemap),
-        exposure: get(&r.exposure, 0.0),
+        exposure: match r.exposure.as_ref().map(|e| *e.get_ref()) {
+            Some(desc::Exposure::Stops(x)) => x,
+            _ => 0.0,
+        },
+        auto_exposure: matches!(
+            r.exposure.as_ref().map(|e| *e.get_ref()),
+            Some(desc::Exposure::Auto)
+        ),
         background: match get(&o.background, Background::Color(Vec3::ZERO)) {
             Background::Blurred(_) => Background::Blurred(get(&o.background_blur, 0.5)),
             b => b,
