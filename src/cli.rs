@@ -100,7 +100,7 @@ struct ChartArgs {
     /// Timed renders per setting (fewer for settings that take seconds).
     #[arg(long, default_value_t = 5)]
     runs: usize,
-    /// Comma-separated knobs: aa, texture, shadows, ao, depth (default all).
+    /// Comma-separated knobs: aa, texture, shadows, ao, depth, env (default all).
     #[arg(long)]
     knobs: Option<String>,
     /// Fewer settings and smaller references (a quick look, and the tests).
@@ -226,7 +226,7 @@ fn chart(args: ChartArgs) -> Result<(), Error> {
             .map(|k| {
                 Knob::parse(k.trim()).ok_or_else(|| {
                     Error::Argument(format!(
-                        "--knobs {list}: `{k}` is not one of aa, texture, shadows, ao, depth"
+                        "--knobs {list}: `{k}` is not one of aa, texture, shadows, ao, depth, env"
                     ))
                 })
             })

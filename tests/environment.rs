@@ -320,3 +320,54 @@ fn auto_exposure_maps_the_models_log_average_to_middle_grey() {
     assert!(a.contains("-2.47 stops"), "{a}");
     assert_eq!(a, line("9"));
 }
+
+#[test]
+fn the_sampled_reference_agrees_with_the_known_answers() {
+    let dir = scratch("env_sampled");
+    write_env(&dir.join("env.exr"), 64, |_, _| [0.5, 0.5, 0.5]);
+    let text = sphere_scene(
+        &dir,
+        [0.0, 0.0, 5.0],
+        "method = \"sampled\"\nsamples = 64",
+        "",
+    );
+    let s = load(&dir, &text);
+    let f = render_frame(&s, 0, 0);
+    let (mut sum, mut n, mut worst) = (0.0f32, 0, 0.0f32);
+    for py in 0..64 {
+        for px in 0..64 {
+            if normal_from_front(px, py).is_some() {
+                let c = f.color[(py * 64 + px) as usize].x;
+                sum += c;
+                n += 1;
+                worst = worst.max((c - 0.3).abs());
+            }
+        }
+    }
+    // Unbiased: the mean is kd L; each pixel within the noise of 64 pairs.
+    let mean = sum / n as f32;
+    assert!((mean - 0.3).abs() < 0.003, "mean {mean}");
+    assert!(worst < 0.03, "worst {worst}");
+    // Deterministic.
+    assert_eq!(render_frame(&s, 0, 0).color, f.color);
+    // A white furnace, sampled, against the split sum: rough metal loses
+    // the same single-scattering energy.
+    write_env(&dir.join("env.exr"), 64, |_, _| [1.0; 3]);
+    let pbr = |method: &str| {
+        let t = sphere_scene(&dir, [0.0, 0.0, 5.0], method, "")
+            .replace("shading = \"blinn-phong\"", "shading = \"pbr\"")
+            + "[model.material]\nkd = [1.0, 1.0, 1.0]\nmetallic = 1.0\nroughness = 0.6\n";
+        let f = render_frame(&load(&dir, &t), 0, 0);
+        let v: Vec<f32> = (0..64 * 64)
+            .filter(|&i| normal_from_front(i % 64, i / 64).is_some())
+            .map(|i| f.color[i as usize].x)
+            .collect();
+        v.iter().sum::<f32>() / v.len() as f32
+    };
+    let (sampled, prefiltered) = (pbr("method = \"sampled\"\nsamples = 128"), pbr(""));
+    println!("furnace, metal roughness 0.6: sampled {sampled:.4}, prefiltered {prefiltered:.4}");
+    assert!(
+        sampled <= 1.0 && (sampled - prefiltered).abs() < 0.02,
+        "{sampled} {prefiltered}"
+    );
+}

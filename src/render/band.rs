@@ -76,7 +76,8 @@ impl<'a> FrameData<'a> {
             .collect();
         let geo_normal = s.shading == ShadingMode::Flat
             || !ctx.shadows.lights.is_empty()
-            || s.ao.method != AoMethod::Off;
+            || s.ao.method != AoMethod::Off
+            || ctx.env_sampled.is_some();
         FrameData {
             fs,
             verts,

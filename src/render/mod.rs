@@ -48,9 +48,11 @@ use crate::raytrace::bvh::Bvh;
 use crate::raytrace::{Placed, Tracer};
 use crate::scene::Scene;
 use crate::scene::camera::Projection;
+use crate::scene::environment::EnvMethod;
 use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
+use crate::shade::env_sampled::EnvSampler;
 use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
 use geometry::Geometry;
@@ -72,6 +74,8 @@ pub struct Renderer {
     /// on the first frame).
     env_image: Option<Arc<EnvImage>>,
     env: OnceLock<Option<EnvLight>>,
+    /// `method = "sampled"`: the environment's sampling tables.
+    env_sampler: OnceLock<Option<EnvSampler>>,
 }
 
 impl Renderer {
@@ -98,6 +102,7 @@ impl Renderer {
             textures: scene.textures.clone(),
             env_image: scene.environment.as_ref().map(|e| e.image.clone()),
             env: OnceLock::new(),
+            env_sampler: OnceLock::new(),
         }
     }
 
@@ -171,6 +176,20 @@ impl Renderer {
             .as_ref()
     }
 
+    /// `method = "sampled"`: the sampling tables (built once) and the
+    /// sample count.
+    fn env_sampler(&self, scene: &Scene) -> Option<(&EnvSampler, u32)> {
+        let e = scene.environment.as_ref()?;
+        let EnvMethod::Sampled { samples } = e.method else {
+            return None;
+        };
+        let sampler = self
+            .env_sampler
+            .get_or_init(|| Some(EnvSampler::new(&e.image, e.intensity, e.rotation)))
+            .as_ref()?;
+        Some((sampler, samples))
+    }
+
     /// The frame's meshes as placed, for rays.
     fn tracer(&self, fs: &FrameSetup) -> Tracer<'_> {
         let placed =
@@ -203,7 +222,9 @@ impl Renderer {
         };
         let shadow_rays =
             s.shadows == ShadowMethod::Raytraced && fs.lights.iter().any(|l| l.shadows);
-        let tracer = (shadow_rays || s.ao.method == AoMethod::Raytraced).then(|| self.tracer(fs));
+        let sampled = self.env_sampler(fs.scene);
+        let tracer = (shadow_rays || s.ao.method == AoMethod::Raytraced || sampled.is_some())
+            .then(|| self.tracer(fs));
 
         let mut verts = vertex::transform_all(fs);
         let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref());
@@ -222,6 +243,7 @@ impl Renderer {
         let mips = self.frame_mips(fs, &geo);
 
         let mut ctx = shade_context(fs, &mips, &shadows, env);
+        ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered);
@@ -330,6 +352,7 @@ fn shade_context<'a>(
         depth_range: (lo, hi),
         shadows,
         env,
+        env_sampled: None,
         pixel_scale: 1.0,
     }
 }

@@ -51,6 +51,18 @@ pub struct EnvironmentDesc {
     pub intensity: Option<S<f32>>,
     /// Degrees about +Y, counter-clockwise seen from above.
     pub rotation: Option<S<f32>>,
+    /// "prefiltered" (default) or "sampled" (the Monte Carlo reference).
+    pub method: Option<S<EnvMethodName>>,
+    /// Sampled: direction pairs a point (default 64).
+    pub samples: Option<S<i64>>,
+}
+
+/// The file's names of `[environment] method`.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvMethodName {
+    Prefiltered,
+    Sampled,
 }
 
 /// `[output]`. Defaults: 800x800, `out/<scene stem>`, `{camera}_{frame:04}`,
@@ -534,6 +546,7 @@ impl SceneDesc {
             }
             c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
             c.finite(&e.rotation, "environment.rotation")?;
+            c.int_range(&e.samples, "environment.samples", 1, 65536)?;
         }
         let a = &self.animation;
         c.int_range(&a.frames, "animation.frames", 1, 1_000_000)?;

@@ -5,8 +5,20 @@ use std::sync::Arc;
 
 use crate::assets::environment::EnvImage;
 
+/// How the environment's light is integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EnvMethod {
+    /// Irradiance harmonics and the split sum, prefiltered once per run.
+    #[default]
+    Prefiltered,
+    /// Monte Carlo with visibility: `samples` environment and `samples`
+    /// BRDF directions a point, combined by MIS (the reference).
+    Sampled { samples: u32 },
+}
+
 #[derive(Debug, Clone)]
 pub struct Environment {
+    pub method: EnvMethod,
     pub image: Arc<EnvImage>,
     /// Multiplies the radiance (default 1).
     pub intensity: f32,

@@ -4,6 +4,7 @@
 pub mod ao;
 pub mod blinn_phong;
 pub mod env;
+pub mod env_sampled;
 pub mod gouraud;
 pub mod light;
 pub mod pbr;
@@ -39,6 +40,13 @@ pub struct ShadeContext<'a> {
     pub shadows: &'a shadow::Shadows<'a>,
     /// Image-based lighting, when the scene has an environment.
     pub env: Option<&'a env::EnvLight>,
+    /// `method = "sampled"`: the environment's sampler, the frame's rays and
+    /// the sample count; replaces the prefiltered light of `env`.
+    pub env_sampled: Option<(
+        &'a env_sampled::EnvSampler,
+        &'a crate::raytrace::Tracer<'a>,
+        u32,
+    )>,
     /// Rendered pixels per output pixel along an axis (the supersampling
     /// factor): wireframe lines keep their width in output pixels.
     pub pixel_scale: f32,
@@ -167,6 +175,12 @@ impl ShadeContext<'_> {
         let n = self.mapped_normal(s);
         let ambient = self.ambient * s.ao;
         let direct = pbr::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s));
+        if let Some((e, tracer, samples)) = self.env_sampled {
+            let lobes = env_sampled::Lobes::Pbr(&c);
+            let l =
+                env_sampled::radiance(e, tracer, s.position, n, s.geo_normal, v, &lobes, samples);
+            return direct + l * c.occlusion;
+        }
         match self.env {
             Some(env) => direct + pbr::environment(env, n, v, &c, s.ao),
             None => direct,
@@ -182,6 +196,23 @@ impl ShadeContext<'_> {
             return Vec3::ZERO;
         };
         let v = self.view_vector(s.position);
+        if let Some((e, tracer, samples)) = self.env_sampled {
+            let lobes = env_sampled::Lobes::BlinnPhong {
+                kd: c.kd,
+                ks: c.ks,
+                roughness: crate::scene::material::roughness_from_ns(c.ns),
+            };
+            return env_sampled::radiance(
+                e,
+                tracer,
+                s.position,
+                n,
+                s.geo_normal,
+                v,
+                &lobes,
+                samples,
+            );
+        }
         let diffuse = c.kd * env.irradiance(n) * (s.ao / std::f32::consts::PI);
         if c.ks == Vec3::ZERO {
             return diffuse;

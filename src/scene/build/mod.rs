@@ -18,7 +18,7 @@ use glam::Vec3;
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, S, SceneDesc};
-use super::environment::Environment;
+use super::environment::{EnvMethod, Environment};
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::EnvImage;
 use crate::error::Error;
@@ -148,7 +148,14 @@ fn environment(
             ),
         ));
     }
+    let method = match e.method.as_ref().map(|m| *m.get_ref()) {
+        Some(desc::EnvMethodName::Sampled) => EnvMethod::Sampled {
+            samples: get(&e.samples, 64) as u32,
+        },
+        _ => EnvMethod::Prefiltered,
+    };
     Ok(Environment {
+        method,
         image: Arc::new(EnvImage::load(&path)?),
         intensity: get(&e.intensity, 1.0),
         rotation: get(&e.rotation, 0.0),

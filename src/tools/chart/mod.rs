@@ -26,6 +26,7 @@ use std::time::Instant;
 use crate::error::Error;
 use crate::output::{self, Image8};
 use crate::render::{Frame, Renderer};
+use crate::scene::environment::EnvMethod;
 use crate::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use crate::scene::{AoSettings, Scene};
 use crate::tools::compare::{Metric, score};
@@ -38,15 +39,18 @@ pub enum Knob {
     Shadows,
     Ao,
     Depth,
+    /// Environment lighting: prefiltered against sampled.
+    Env,
 }
 
 impl Knob {
-    pub const ALL: [Knob; 5] = [
+    pub const ALL: [Knob; 6] = [
         Knob::Aa,
         Knob::Texture,
         Knob::Shadows,
         Knob::Ao,
         Knob::Depth,
+        Knob::Env,
     ];
 
     pub fn name(self) -> &'static str {
@@ -56,6 +60,7 @@ impl Knob {
             Knob::Shadows => "shadows",
             Knob::Ao => "ao",
             Knob::Depth => "depth",
+            Knob::Env => "env",
         }
     }
 
@@ -65,7 +70,7 @@ impl Knob {
 
     pub fn metric(self) -> &'static str {
         match self {
-            Knob::Aa | Knob::Shadows => "flip",
+            Knob::Aa | Knob::Shadows | Knob::Env => "flip",
             Knob::Texture => "flip-interior",
             Knob::Ao => "rmse",
             Knob::Depth => "failure-fraction",
@@ -252,6 +257,7 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
                 Knob::Shadows => sweep_shadows(&renderer, scene, opts, &mut rows)?,
                 Knob::Ao => sweep_ao(&renderer, scene, opts, &mut rows)?,
                 Knob::Depth => sweep_depth(opts, &mut rows)?,
+                Knob::Env => sweep_env(&renderer, scene, opts, &mut rows)?,
             }
         }
         Ok(())
@@ -376,6 +382,56 @@ fn sweep_texture(
         let default = filter == TextureFilter::Anisotropic && aniso == 16.0;
         rows.push(row(Knob::Texture, name, default, false, t, e, &against));
     }
+    Ok(())
+}
+
+/// Environment lighting, for scenes with an `[environment]`: the
+/// prefiltered split sum and sampled estimates of 4 to 64 direction pairs,
+/// against the sampled reference (256 pairs; 64 with `quick`).
+fn sweep_env(
+    renderer: &Renderer,
+    scene: &mut Scene,
+    opts: &ChartOptions,
+    rows: &mut Vec<Row>,
+) -> Result<(), Error> {
+    let Some(original) = scene.environment.as_ref().map(|e| e.method) else {
+        return Ok(());
+    };
+    let set = |scene: &mut Scene, m: EnvMethod| {
+        if let Some(e) = scene.environment.as_mut() {
+            e.method = m;
+        }
+    };
+    let reference = if opts.quick { 64 } else { 256 };
+    set(scene, EnvMethod::Sampled { samples: reference });
+    let (_, reference_img, t) = timed(renderer, scene, opts.frame, 1);
+    let against = format!("sampled {reference}");
+    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
+        flip(&reference_img, img, None)
+    })?;
+    rows.push(row(Knob::Env, &against, false, true, t, e, &against));
+    let counts: &[u32] = if opts.quick { &[4, 16] } else { &[4, 16, 64] };
+    let methods = std::iter::once(EnvMethod::Prefiltered)
+        .chain(counts.iter().map(|&samples| EnvMethod::Sampled { samples }));
+    for m in methods {
+        set(scene, m);
+        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+        let e = flip(&reference_img, &img, None)?;
+        let name = match m {
+            EnvMethod::Prefiltered => "prefiltered".to_string(),
+            EnvMethod::Sampled { samples } => format!("sampled {samples}"),
+        };
+        rows.push(row(
+            Knob::Env,
+            name,
+            m == EnvMethod::Prefiltered,
+            false,
+            t,
+            e,
+            &against,
+        ));
+    }
+    set(scene, original);
     Ok(())
 }
 

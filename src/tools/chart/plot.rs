@@ -24,6 +24,7 @@ fn color(k: Knob) -> RGBColor {
         Knob::Shadows => RGBColor(44, 160, 44),
         Knob::Ao => RGBColor(214, 39, 40),
         Knob::Depth => RGBColor(148, 103, 189),
+        Knob::Env => RGBColor(140, 86, 75),
     }
 }
 
@@ -34,6 +35,7 @@ fn label(k: Knob) -> &'static str {
         Knob::Shadows => "shadows (FLIP)",
         Knob::Ao => "ambient occlusion (RMSE)",
         Knob::Depth => "depth mode (failure fraction)",
+        Knob::Env => "environment lighting (FLIP)",
     }
 }
 

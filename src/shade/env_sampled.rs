@@ -1,0 +1,273 @@
+//! `[environment] method = "sampled"`: the reference the prefiltered
+//! lighting is measured against. Per shaded point, `samples` pairs of
+//! directions, one drawn from the environment (by luminance, in solid
+//! angle) and one from the BRDF, combined by multiple importance sampling
+//! (the balance heuristic), each ray tested for visibility through the
+//! scene's BVHs. Deterministic: the sample pattern is a Hammersley set
+//! rotated by a hash of the point's position.
+//!
+//! pbr materials integrate `pbr::brdf`. Blinn-Phong materials integrate
+//! what the prefiltered path approximates: Kd / pi (diffuse), and Ks times
+//! the average radiance over the GGX lobe whose roughness matches Ns
+//! (specular, a normalized lobe).
+
+use std::f32::consts::PI;
+
+use glam::{Mat3, Vec2, Vec3};
+
+use super::env::{direction_to_uv, uv_to_direction};
+use super::pbr::{self, PbrColor};
+use crate::assets::environment::EnvImage;
+use crate::raytrace::Tracer;
+
+/// Luminance-proportional sampling of an environment image.
+#[derive(Debug, Clone)]
+pub struct EnvSampler {
+    width: usize,
+    height: usize,
+    texels: Vec<Vec3>,
+    /// Per row: the cumulative weight of the rows above and including it.
+    rows: Vec<f32>,
+    /// Per texel: the cumulative weight within its row.
+    cols: Vec<f32>,
+    /// Per texel: its sampling weight (luminance plus a floor, times sin).
+    weight: Vec<f32>,
+    total: f32,
+    env_from_world: Mat3,
+    world_from_env: Mat3,
+    intensity: f32,
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+impl EnvSampler {
+    pub fn new(image: &EnvImage, intensity: f32, rotation_deg: f32) -> EnvSampler {
+        let (w, h) = (image.width as usize, image.height as usize);
+        let mean = image.texels.iter().map(|c| luminance(*c)).sum::<f32>() / (w * h) as f32;
+        // A floor of a tenth of the mean: no direction has zero density.
+        let floor = 0.1 * mean.max(1e-6);
+        let mut weight = vec![0.0f32; w * h];
+        let mut cols = vec![0.0f32; w * h];
+        let mut rows = vec![0.0f32; h];
+        let mut total = 0.0f32;
+        for (y, row_end) in rows.iter_mut().enumerate() {
+            let sin = ((y as f32 + 0.5) / h as f32 * PI).sin();
+            let mut acc = 0.0f32;
+            for x in 0..w {
+                let i = y * w + x;
+                weight[i] = (luminance(image.texels[i]) + floor) * sin;
+                acc += weight[i];
+                cols[i] = acc;
+            }
+            total += acc;
+            *row_end = total;
+        }
+        let world_from_env = Mat3::from_rotation_y(rotation_deg.to_radians());
+        EnvSampler {
+            width: w,
+            height: h,
+            texels: image.texels.clone(),
+            rows,
+            cols,
+            weight,
+            total,
+            env_from_world: world_from_env.transpose(),
+            world_from_env,
+            intensity,
+        }
+    }
+
+    /// The texel a direction (environment space) falls in.
+    fn texel(&self, d: Vec3) -> usize {
+        let uv = direction_to_uv(d);
+        let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as usize).min(self.height - 1);
+        y * self.width + x
+    }
+
+    /// Radiance from world direction `d`.
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        self.texels[self.texel(self.env_from_world * d)] * self.intensity
+    }
+
+    /// Density (per steradian) of drawing world direction `d`.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        let i = self.texel(self.env_from_world * d);
+        let y = i / self.width;
+        let sin = ((y as f32 + 0.5) / self.height as f32 * PI).sin();
+        let texel_omega = (2.0 * PI / self.width as f32) * (PI / self.height as f32) * sin;
+        if texel_omega <= 0.0 {
+            return 0.0;
+        }
+        self.weight[i] / self.total / texel_omega
+    }
+
+    /// A world direction drawn from `xi` (uniform in [0, 1)^2).
+    pub fn sample(&self, xi: Vec2) -> Vec3 {
+        let t = xi.y * self.total;
+        let y = self.rows.partition_point(|&r| r <= t).min(self.height - 1);
+        let row = &self.cols[y * self.width..(y + 1) * self.width];
+        let before = if y == 0 { 0.0 } else { self.rows[y - 1] };
+        let row_total = row[self.width - 1].max(1e-30);
+        let tx = (xi.x * row_total).min(row_total * 0.999_999);
+        let x = row.partition_point(|&c| c <= tx).min(self.width - 1);
+        // Where within the texel: the leftover of each choice.
+        let start = if x == 0 { 0.0 } else { row[x - 1] };
+        let fx = ((tx - start) / self.weight[y * self.width + x].max(1e-30)).clamp(0.0, 1.0);
+        let fy = ((t - before) / (row_total)).clamp(0.0, 1.0);
+        let uv = Vec2::new(
+            (x as f32 + fx) / self.width as f32,
+            (y as f32 + fy) / self.height as f32,
+        );
+        self.world_from_env * uv_to_direction(uv)
+    }
+}
+
+/// What a sampled estimate integrates at a point.
+pub enum Lobes<'a> {
+    Pbr(&'a PbrColor),
+    /// Blinn-Phong: diffuse albedo, specular colour, matched roughness.
+    BlinnPhong {
+        kd: Vec3,
+        ks: Vec3,
+        roughness: f32,
+    },
+}
+
+/// Point `i` of `n` of the Hammersley set, rotated by `shift` (mod 1).
+fn point(i: u32, n: u32, shift: Vec2) -> Vec2 {
+    let p = Vec2::new(
+        i as f32 / n as f32,
+        i.reverse_bits() as f32 * 2.328_306_4e-10,
+    ) + shift;
+    p - p.floor()
+}
+
+/// Two numbers in [0, 1) from a position (the pattern's rotation).
+fn position_hash(p: Vec3) -> Vec2 {
+    let mut h = p.x.to_bits().wrapping_mul(0x9E37_79B1)
+        ^ p.y.to_bits().wrapping_mul(0x85EB_CA77).rotate_left(13)
+        ^ p.z.to_bits().wrapping_mul(0xC2B2_AE3D).rotate_left(7);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    let g = h.wrapping_mul(0x846C_A68B) ^ (h >> 16);
+    Vec2::new(
+        (h >> 8) as f32 / (1u32 << 24) as f32,
+        (g >> 8) as f32 / (1u32 << 24) as f32,
+    )
+}
+
+/// An orthonormal frame whose third axis is `n`.
+fn frame(n: Vec3) -> Mat3 {
+    let t = n.any_orthonormal_vector();
+    Mat3::from_cols(t, n.cross(t), n)
+}
+
+/// GGX alpha of a perceptual roughness.
+fn alpha(roughness: f32) -> f32 {
+    (roughness * roughness).max(2e-3)
+}
+
+fn ggx_d(ndh: f32, a: f32) -> f32 {
+    if ndh <= 0.0 {
+        return 0.0;
+    }
+    let t = ndh * ndh * (a * a - 1.0) + 1.0;
+    a * a / (PI * t * t)
+}
+
+/// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
+/// `ng` for the rays' offset) from the environment, `samples` pairs of
+/// directions, with visibility through `tracer`.
+#[allow(clippy::too_many_arguments)]
+pub fn radiance(
+    env: &EnvSampler,
+    tracer: &Tracer,
+    p: Vec3,
+    n: Vec3,
+    ng: Vec3,
+    v: Vec3,
+    lobes: &Lobes,
+    samples: u32,
+) -> Vec3 {
+    let (c_diff, spec_weight, roughness) = match lobes {
+        Lobes::Pbr(c) => {
+            let s = pbr::specular_albedo(c.f0(), c.roughness, n.dot(v).abs());
+            (c.c_diff(), luminance(s), c.roughness)
+        }
+        Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness),
+    };
+    let a = alpha(roughness);
+    // Probability of drawing the diffuse lobe.
+    let q = {
+        let d = luminance(c_diff);
+        if d + spec_weight <= 0.0 {
+            1.0
+        } else {
+            d / (d + spec_weight)
+        }
+    };
+    let m = frame(n);
+    let brdf_pdf = |l: Vec3| {
+        let ndl = n.dot(l);
+        if ndl <= 0.0 {
+            return 0.0;
+        }
+        let h = (l + v).normalize_or_zero();
+        let spec = ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6));
+        q * ndl / PI + (1.0 - q) * spec
+    };
+    // f(l) cos(l): the integrand without radiance and visibility.
+    let f_cos = |l: Vec3| -> Vec3 {
+        let ndl = n.dot(l);
+        if ndl <= 0.0 {
+            return Vec3::ZERO;
+        }
+        match lobes {
+            Lobes::Pbr(c) => pbr::brdf(n, v, l, c) * ndl,
+            Lobes::BlinnPhong { kd, ks, .. } => {
+                // The normalized lobe: D (n.h) / (4 v.h) integrates to ~1.
+                let h = (l + v).normalize_or_zero();
+                let lobe = ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6));
+                *kd * (ndl / PI) + *ks * lobe
+            }
+        }
+    };
+    let visible = |l: Vec3| !tracer.occluded(p + ng * tracer.epsilon, l, f32::INFINITY);
+    let shift = position_hash(p);
+    let mut sum = Vec3::ZERO;
+    for i in 0..samples {
+        // From the environment.
+        let xi = point(i, samples, shift);
+        let l = env.sample(xi);
+        let fc = f_cos(l);
+        if fc != Vec3::ZERO && visible(l) {
+            let pe = env.pdf(l);
+            sum += fc * env.radiance(l) / (pe + brdf_pdf(l)).max(1e-12);
+        }
+        // From the BRDF.
+        let xi = point(i, samples, Vec2::new(shift.y, shift.x));
+        let l = if xi.x < q {
+            let u = Vec2::new(xi.x / q.max(1e-6), xi.y);
+            let r = u.x.sqrt();
+            let phi = 2.0 * PI * u.y;
+            m * Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+        } else {
+            let u = Vec2::new((xi.x - q) / (1.0 - q).max(1e-6), xi.y);
+            let phi = 2.0 * PI * u.x;
+            let cos_t = ((1.0 - u.y) / (1.0 + (a * a - 1.0) * u.y)).max(0.0).sqrt();
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let h = m * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+            h * (2.0 * v.dot(h)) - v
+        };
+        let fc = f_cos(l);
+        if fc != Vec3::ZERO && visible(l) {
+            let pb = brdf_pdf(l);
+            sum += fc * env.radiance(l) / (env.pdf(l) + pb).max(1e-12);
+        }
+    }
+    sum / samples as f32
+}
