@@ -371,3 +371,34 @@ fn the_sampled_reference_agrees_with_the_known_answers() {
         "{sampled} {prefiltered}"
     );
 }
+
+#[test]
+fn presets_light_without_a_file() {
+    let dir = scratch("env_preset");
+    // "neutral": a uniform radiance of 1, so a Lambertian sphere shows kd.
+    let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+        .replace("path = \"env.exr\"", "preset = \"neutral\"");
+    let f = render_frame(&load(&dir, &text), 0, 0);
+    let c = f.color[32 * 64 + 32];
+    assert!((c.x - 0.6).abs() < 0.003, "{c}");
+    // "studio": the key panel above front-left lights the sphere's
+    // upper left more than its lower right; nothing is black.
+    let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+        .replace("path = \"env.exr\"", "preset = \"studio\"");
+    let f = render_frame(&load(&dir, &text), 0, 0);
+    let (ul, lr) = (f.color[20 * 64 + 20].x, f.color[44 * 64 + 44].x);
+    assert!(ul > 2.0 * lr && lr > 0.05, "{ul} {lr}");
+    // Both, or neither: refused at the table.
+    for (keys, msg) in [("preset = \"studio\"", "not both"), ("", "needs `path`")] {
+        let t = sphere_scene(&dir, [0.0, 0.0, 5.0], keys, "");
+        let t = if keys.is_empty() {
+            t.replace("path = \"env.exr\"\n", "")
+        } else {
+            t
+        };
+        std::fs::write(dir.join("s.toml"), t).unwrap();
+        let e =
+            softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_err();
+        assert!(e.to_string().contains(msg), "{e}");
+    }
+}

@@ -46,8 +46,10 @@ pub struct SceneDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
-    /// `.hdr` or `.exr`, relative to the scene file.
-    pub path: S<String>,
+    /// `.hdr` or `.exr`, relative to the scene file (or `preset`).
+    pub path: Option<S<String>>,
+    /// A built-in environment: "studio" or "neutral".
+    pub preset: Option<S<EnvPreset>>,
     pub intensity: Option<S<f32>>,
     /// Degrees about +Y, counter-clockwise seen from above.
     pub rotation: Option<S<f32>>,
@@ -55,6 +57,14 @@ pub struct EnvironmentDesc {
     pub method: Option<S<EnvMethodName>>,
     /// Sampled: direction pairs a point (default 64).
     pub samples: Option<S<i64>>,
+}
+
+/// The built-in environments.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvPreset {
+    Studio,
+    Neutral,
 }
 
 /// The file's names of `[environment] method`.
@@ -540,9 +550,22 @@ impl SceneDesc {
             validate_camera(c, cam.get_ref())?;
         }
         if let Some(e) = &self.environment {
+            let span = e.span();
             let e = e.get_ref();
-            if e.path.get_ref().trim().is_empty() {
-                return Err(c.err(e.path.span(), "environment.path must not be empty"));
+            match (&e.path, &e.preset) {
+                (Some(p), None) if p.get_ref().trim().is_empty() => {
+                    return Err(c.err(p.span(), "environment.path must not be empty"));
+                }
+                (Some(_), Some(p)) => {
+                    return Err(c.err(p.span(), "environment: give `path` or `preset`, not both"));
+                }
+                (None, None) => {
+                    return Err(c.err(
+                        span,
+                        "[environment] needs `path` (an .hdr or .exr image) or `preset` (\"studio\" or \"neutral\")",
+                    ));
+                }
+                _ => {}
             }
             c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
             c.finite(&e.rotation, "environment.rotation")?;

@@ -137,17 +137,25 @@ fn environment(
     ctx: &Ctx,
     scene_dir: &Path,
 ) -> Result<Environment, Error> {
-    let path = scene_dir.join(e.path.get_ref().replace('\\', "/"));
-    if !path.is_file() {
-        return Err(Error::asset(
-            &path,
-            None,
-            format!(
-                "environment file not found (from {})",
-                ctx.location(e.path.span())
-            ),
-        ));
-    }
+    let image = match (&e.path, e.preset.as_ref().map(|p| *p.get_ref())) {
+        (Some(p), _) => {
+            let path = scene_dir.join(p.get_ref().replace('\\', "/"));
+            if !path.is_file() {
+                return Err(Error::asset(
+                    &path,
+                    None,
+                    format!(
+                        "environment file not found (from {})",
+                        ctx.location(p.span())
+                    ),
+                ));
+            }
+            EnvImage::load(&path)?
+        }
+        (None, Some(desc::EnvPreset::Neutral)) => EnvImage::uniform(glam::Vec3::ONE),
+        // Validation leaves only the studio here.
+        (None, _) => EnvImage::studio(),
+    };
     let method = match e.method.as_ref().map(|m| *m.get_ref()) {
         Some(desc::EnvMethodName::Sampled) => EnvMethod::Sampled {
             samples: get(&e.samples, 64) as u32,
@@ -156,7 +164,7 @@ fn environment(
     };
     Ok(Environment {
         method,
-        image: Arc::new(EnvImage::load(&path)?),
+        image: Arc::new(image),
         intensity: get(&e.intensity, 1.0),
         rotation: get(&e.rotation, 0.0),
     })
