@@ -48,6 +48,92 @@ impl Camera {
         }
     }
 
+    /// The camera that fits `points` tightly: it looks at them from
+    /// direction `toward_eye` (unit, from the points to the eye), up +Y
+    /// (or -Z when looking straight down), with the points' projection
+    /// filling `fill` (0.95: a 5% margin) of the frame's width or height at
+    /// aspect `aspect` and centred on it. Perspective cameras move as close
+    /// as that allows; orthographic ones set their height. Near and far
+    /// planes bracket the points' depths.
+    pub fn fitted(
+        name: String,
+        points: &[Vec3],
+        toward_eye: Vec3,
+        projection: Projection,
+        aspect: f32,
+        fill: f32,
+    ) -> Camera {
+        let back = toward_eye.normalize_or(Vec3::Z);
+        let up0 = if back.cross(Vec3::Y).length() < 1e-3 {
+            -Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        let right = up0.cross(back).normalize();
+        let up = back.cross(right);
+        // Coordinates in the camera's basis; z grows toward the eye.
+        let coords = points
+            .iter()
+            .map(|p| (p.dot(right), p.dot(up), p.dot(back)));
+        let (ex, ey, ez, projection) = match projection {
+            Projection::Perspective { fov_y } => {
+                let ty = (fov_y.to_radians() * 0.5).tan() * fill;
+                let tx = ty * aspect;
+                // Each side: the eye must satisfy |x - ex| <= t (ez - z).
+                let (mut a_pos, mut a_neg, mut b_pos, mut b_neg) =
+                    (f32::MIN, f32::MIN, f32::MIN, f32::MIN);
+                for (x, y, z) in coords {
+                    a_pos = a_pos.max(x + tx * z);
+                    a_neg = a_neg.max(-x + tx * z);
+                    b_pos = b_pos.max(y + ty * z);
+                    b_neg = b_neg.max(-y + ty * z);
+                }
+                let ez = ((a_pos + a_neg) / (2.0 * tx)).max((b_pos + b_neg) / (2.0 * ty));
+                (
+                    (a_pos - a_neg) * 0.5,
+                    (b_pos - b_neg) * 0.5,
+                    ez,
+                    Projection::Perspective { fov_y },
+                )
+            }
+            Projection::Orthographic { .. } => {
+                let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+                for (x, y, z) in coords {
+                    lo = lo.min(Vec3::new(x, y, z));
+                    hi = hi.max(Vec3::new(x, y, z));
+                }
+                let ext = (hi - lo).max(Vec3::splat(1e-6));
+                let height = (ext.y.max(ext.x / aspect) / fill).max(1e-6);
+                let ez = hi.z + ext.length().max(1e-3);
+                (
+                    (lo.x + hi.x) * 0.5,
+                    (lo.y + hi.y) * 0.5,
+                    ez,
+                    Projection::Orthographic { height },
+                )
+            }
+        };
+        let eye = right * ex + up * ey + back * ez;
+        let (mut near, mut far) = (f32::MAX, 0.0f32);
+        for p in points {
+            let d = (eye - *p).dot(back);
+            near = near.min(d);
+            far = far.max(d);
+        }
+        let far = (far * 1.25).max(1e-5);
+        let near = (near * 0.8).max(far * 1e-4);
+        let mid = ((near + far) * 0.5).max(1e-6);
+        Camera {
+            name,
+            eye,
+            target: eye - back * mid,
+            up,
+            projection,
+            near,
+            far: far.max(near * 2.0),
+        }
+    }
+
     pub fn forward(&self) -> Vec3 {
         (self.target - self.eye).normalize()
     }

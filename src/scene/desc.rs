@@ -258,6 +258,10 @@ pub struct CameraDesc {
     pub height: Option<S<f32>>,
     pub near: Option<S<f32>>,
     pub far: Option<S<f32>>,
+    /// Version 2, fitted cameras: degrees above the horizon (20).
+    pub elevation: Option<S<f32>>,
+    /// Version 2, fitted cameras: degrees about +Y, 0 = from +Z.
+    pub azimuth: Option<S<f32>>,
 }
 
 /// `[animation]`. Default: one frame, no turntable.
@@ -662,6 +666,8 @@ fn validate_camera(c: &Ctx, cam: &CameraDesc) -> Result<(), Error> {
     c.float_range(&cam.height, "camera.height", 1e-6, 1e9)?;
     c.float_range(&cam.near, "camera.near", 1e-7, 1e9)?;
     c.float_range(&cam.far, "camera.far", 1e-6, 1e12)?;
+    c.float_range(&cam.elevation, "camera.elevation", -89.0, 89.0)?;
+    c.finite(&cam.azimuth, "camera.azimuth")?;
     if let (Some(n), Some(f)) = (&cam.near, &cam.far)
         && f.get_ref() <= n.get_ref()
     {

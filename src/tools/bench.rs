@@ -209,6 +209,14 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     scene.lights = anchor_lights(&scene);
+    // The anchor's camera: the bounding sphere from +Z at fov 45 (the
+    // version 1 default; fitted cameras frame tighter).
+    scene.cameras = vec![crate::scene::Camera::framing(
+        "camera".into(),
+        scene.bounds_center,
+        scene.bounds_radius,
+        45.0,
+    )];
     let mut times = Vec::new();
     let mut png_ms = 0.0;
     let mut frame = Frame::new(0, 0);

@@ -1,16 +1,116 @@
 //! `[[camera]]` tables and the cameras of glTF files (`model.cameras =
 //! true`) to `Camera`: the scene's cameras first, then the imported ones
-//! (named by the file, made unique with a suffix); the default framing
-//! camera only when there are neither. Near and far planes not given are
-//! fitted to the models' bounding sphere.
+//! (named by the file, made unique with a suffix); the default camera only
+//! when there are neither.
+//!
+//! A camera without `eye` and `target` (and the default camera) fits the
+//! models tightly (version 2): seen from `elevation` degrees above the
+//! horizon (default 20) and `azimuth` degrees about +Y (0: from +Z), the
+//! models' vertices, as every frame of a turntable places them, fill 95%
+//! of the frame's width or height, centred. A model thin along one axis
+//! (under a tenth of its largest extent) is seen along that axis, tilted by
+//! the elevation, never edge-on.
 
 use glam::{Mat4, Vec3};
 
 use super::get;
 use crate::assets::gltf::{GltfCamera, GltfProjection};
 use crate::error::Error;
+use crate::scene::Model;
+use crate::scene::animation::Animation;
 use crate::scene::camera::{Camera, Projection, fitted_planes};
 use crate::scene::desc::{self, Ctx, S, SceneDesc};
+
+/// The default elevation of fitted cameras, degrees above the horizon.
+const ELEVATION: f32 = 20.0;
+/// The share of the frame's width or height the fitted models fill.
+const FILL: f32 = 0.95;
+/// Vertices a fit projects at most, per turntable angle.
+const FIT_POINTS: usize = 20_000;
+/// Turntable angles a fit covers at most.
+const FIT_ANGLES: u32 = 24;
+
+/// What fitted cameras fit: the models' vertices over the animation.
+pub(super) struct Subject {
+    points: Vec<Vec3>,
+    /// The thin axis, if the models are flat along one.
+    thin: Option<Vec3>,
+    aspect: f32,
+}
+
+impl Subject {
+    /// A sample of the models' vertices (at most `FIT_POINTS`) as every
+    /// frame of the turntable places them relative to the camera (at most
+    /// `FIT_ANGLES` frames, evenly spread).
+    pub(super) fn new(models: &[Model], animation: &Animation, aspect: f32) -> Subject {
+        let total: usize = models.iter().map(|m| m.mesh.positions.len()).sum();
+        let stride = total.div_ceil(FIT_POINTS).max(1);
+        let rest: Vec<Vec3> = models
+            .iter()
+            .flat_map(|m| {
+                m.mesh
+                    .positions
+                    .iter()
+                    .map(move |p| m.world_from_object.transform_point3(*p))
+            })
+            .step_by(stride)
+            .collect();
+        let (lo, hi) = rest.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let ext = (hi - lo).max(Vec3::ZERO);
+        let thin = [Vec3::X, Vec3::Y, Vec3::Z]
+            .into_iter()
+            .zip(ext.to_array())
+            .filter(|&(_, e)| e < 0.1 * ext.max_element())
+            .map(|(a, _)| a)
+            .next();
+        let mut points = rest.clone();
+        if animation.turntable.is_some() {
+            let n = animation.frames.min(FIT_ANGLES);
+            for k in 1..n {
+                let turn = animation.turn(k * animation.frames / n);
+                // The camera orbiting is the models turning the other way.
+                let m = if animation.rotates_camera() {
+                    turn.inverse()
+                } else {
+                    turn
+                };
+                points.extend(rest.iter().map(|p| m.transform_point3(*p)));
+            }
+        }
+        Subject {
+            points,
+            thin,
+            aspect,
+        }
+    }
+
+    /// A camera fitted to the subject from `elevation` and `azimuth`.
+    fn camera(&self, name: String, projection: Projection, elevation: f32, azimuth: f32) -> Camera {
+        let (e, a) = (elevation.to_radians(), azimuth.to_radians());
+        let toward_eye = match self.thin {
+            // Flat along Y (a terrain, a floor with props): from above,
+            // tilted by the elevation toward the azimuth.
+            Some(t) if t == Vec3::Y => Vec3::new(a.sin() * e.sin(), e.cos(), a.cos() * e.sin()),
+            // Flat along X or Z (a panel): along the axis, tilted up.
+            Some(t) => (t * e.cos() + Vec3::Y * e.sin()).normalize(),
+            None => Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos()),
+        };
+        if self.points.is_empty() {
+            return Camera::framing(name, Vec3::ZERO, 1.0, 45.0);
+        }
+        Camera::fitted(
+            name,
+            &self.points,
+            toward_eye,
+            projection,
+            self.aspect,
+            FILL,
+        )
+    }
+}
 
 /// The models' bounding sphere at rest, which default cameras frame.
 #[derive(Debug, Clone, Copy)]
@@ -23,11 +123,17 @@ pub(super) fn build(
     d: &SceneDesc,
     ctx: &Ctx,
     bounds: Bounds,
+    subject: &Subject,
     imported: &[(GltfCamera, Mat4)],
 ) -> Result<Vec<Camera>, Error> {
     if d.cameras.is_empty() && imported.is_empty() {
-        let Bounds { center, radius } = bounds;
-        return Ok(vec![Camera::framing("camera".into(), center, radius, 45.0)]);
+        let projection = Projection::Perspective { fov_y: 45.0 };
+        return Ok(vec![subject.camera(
+            "camera".into(),
+            projection,
+            ELEVATION,
+            0.0,
+        )]);
     }
     let mut cams: Vec<Camera> = Vec::new();
     let several = d.cameras.len() > 1;
@@ -47,7 +153,7 @@ pub(super) fn build(
         if cams.iter().any(|c| c.name == name) {
             return Err(ctx.err(c.span(), format!("two cameras are named `{name}`")));
         }
-        cams.push(from_desc(c, name, ctx, bounds)?);
+        cams.push(from_desc(c, name, ctx, bounds, subject)?);
     }
     for (g, world) in imported {
         let mut name = g.name.clone();
@@ -61,22 +167,65 @@ pub(super) fn build(
     Ok(cams)
 }
 
-/// One `[[camera]]`. Defaults: framed on the bounding sphere from +Z (a
-/// missing eye or target keeps the framing's offset), up +Y, fov 45.
-fn from_desc(c: &S<desc::CameraDesc>, name: String, ctx: &Ctx, b: Bounds) -> Result<Camera, Error> {
+/// One `[[camera]]`. Without `eye` and `target`: fitted (with its fov or
+/// orthographic projection, `elevation`, `azimuth`, and its `near`/`far`
+/// when given). With one of them: the other from the fitted camera's
+/// offset (a missing target is the models' center). Up +Y, fov 45.
+fn from_desc(
+    c: &S<desc::CameraDesc>,
+    name: String,
+    ctx: &Ctx,
+    b: Bounds,
+    subject: &Subject,
+) -> Result<Camera, Error> {
     let cd = c.get_ref();
     let fov = get(&cd.fov, 45.0);
     let up = Vec3::from(get(&cd.up, [0.0, 1.0, 0.0])).normalize();
-    let framing = || Camera::framing(name.clone(), b.center, b.radius, fov);
+    let orthographic = matches!(
+        cd.projection.as_ref().map(|p| *p.get_ref()),
+        Some(desc::Projection::Orthographic)
+    );
+    let fitted = || {
+        let projection = if orthographic {
+            Projection::Orthographic { height: 1.0 }
+        } else {
+            Projection::Perspective { fov_y: fov }
+        };
+        let (e, a) = (get(&cd.elevation, ELEVATION), get(&cd.azimuth, 0.0));
+        subject.camera(name.clone(), projection, e, a)
+    };
+    if cd.eye.is_none() && cd.target.is_none() {
+        let mut f = fitted();
+        if let Some(h) = &cd.height {
+            f.projection = match f.projection {
+                Projection::Orthographic { .. } => Projection::Orthographic {
+                    height: *h.get_ref(),
+                },
+                p => p,
+            };
+        }
+        f.near = get(&cd.near, f.near);
+        f.far = get(&cd.far, f.far.max(f.near * 2.0));
+        if f.far <= f.near {
+            return Err(ctx.err(
+                c.span(),
+                format!(
+                    "camera `{name}`: far ({}) must be greater than near ({})",
+                    f.far, f.near
+                ),
+            ));
+        }
+        return Ok(f);
+    }
     let (eye, target) = match (&cd.eye, &cd.target) {
         (None, None) => {
-            let f = framing();
+            let f = fitted();
             (f.eye, f.target)
         }
         (Some(e), None) => (Vec3::from(*e.get_ref()), b.center),
         (None, Some(t)) => {
             let t = Vec3::from(*t.get_ref());
-            let f = framing();
+            let f = fitted();
             (t + (f.eye - f.target), t)
         }
         (Some(e), Some(t)) => (Vec3::from(*e.get_ref()), Vec3::from(*t.get_ref())),

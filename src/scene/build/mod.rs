@@ -107,7 +107,10 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         .map(|l| lights::from_desc(l.get_ref()))
         .collect();
     lights.extend(models.lights);
-    let cameras = cameras::build(d, ctx, bounds, &models.cameras)?;
+    let animation = animation(&d.animation, bounds.center);
+    let aspect = settings.width as f32 / settings.height as f32;
+    let subject = cameras::Subject::new(&models.models, &animation, aspect);
+    let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras)?;
     let environment = d
         .environment
         .as_ref()
@@ -122,7 +125,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         lights,
         environment,
         cameras,
-        animation: animation(&d.animation, bounds.center),
+        animation,
         bounds_center: bounds.center,
         bounds_radius: bounds.radius,
         textures: models.textures,

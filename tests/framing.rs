@@ -1,0 +1,113 @@
+//! Fitted cameras (version 2): cameras without eye and target fill the
+//! frame with the models (a 5% margin), centred, over every frame of a
+//! turntable, and see a flat scene from above.
+
+mod common;
+
+use common::{render_frame, scene_in, scratch};
+
+/// The covered pixels' bounding box (x0, y0, x1, y1), inclusive.
+fn covered(f: &softraster::render::Frame) -> (u32, u32, u32, u32) {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for y in 0..f.height {
+        for x in 0..f.width {
+            if f.depth[(y * f.width + x) as usize].is_finite() {
+                (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+            }
+        }
+    }
+    (x0, y0, x1, y1)
+}
+
+fn obj(b: softraster::procedural::Builder) -> String {
+    b.to_obj("m", "none.mtl", "m")
+        .text
+        .replace("mtllib none.mtl\n", "")
+        .replace("usemtl m\n", "")
+}
+
+#[test]
+fn fitted_cameras_fill_the_frame_with_a_margin_over_a_turntable() {
+    use softraster::procedural::{cube, sphere};
+    let dir = scratch("framing");
+    // A sphere, a long bar, and the bar turning on a turntable.
+    let cases = [
+        ("sphere", obj(sphere(1.0, 48, 24)), "", 1),
+        (
+            "bar",
+            obj(cube([0.0; 3], 0.5)),
+            "scale = [8.0, 1.0, 1.0]\n",
+            1,
+        ),
+        (
+            "bar",
+            obj(cube([0.0; 3], 0.5)),
+            "scale = [8.0, 1.0, 1.0]\n",
+            12,
+        ),
+    ];
+    for (name, mesh, placement, frames) in cases {
+        let turntable = if frames > 1 {
+            format!("[animation]\nframes = {frames}\nturntable = {{ axis = [0.0, 1.0, 0.0] }}\n")
+        } else {
+            String::new()
+        };
+        let text = format!(
+            "[output]\nwidth = 160\nheight = 120\n{turntable}[[model]]\npath = \"{name}.obj\"\n{placement}"
+        );
+        let s = scene_in(&dir, &text, &[(&format!("{name}.obj"), &mesh)]);
+        let mut widest = (0u32, 0u32);
+        for frame in 0..frames {
+            let f = render_frame(&s, 0, frame);
+            let (x0, y0, x1, y1) = covered(&f);
+            // Never touching the border: the margin holds on every frame.
+            assert!(
+                x0 > 0 && y0 > 0 && x1 < 159 && y1 < 119,
+                "{name} frame {frame}: {x0} {y0} {x1} {y1}"
+            );
+            widest = (widest.0.max(x1 - x0 + 1), widest.1.max(y1 - y0 + 1));
+        }
+        // At least 65% of the width or height is covered (the fit's 95%
+        // on the binding axis, less the perspective of a turning model).
+        let fill = (widest.0 as f32 / 160.0).max(widest.1 as f32 / 120.0);
+        assert!(fill >= 0.65, "{name} ({frames} frames): {fill}");
+        if frames == 1 {
+            assert!(fill >= 0.9, "{name}: {fill}");
+        }
+    }
+}
+
+#[test]
+fn a_flat_scene_is_seen_from_above() {
+    use softraster::procedural::{cube, ground};
+    let dir = scratch("framing_flat");
+    // A 10x10 floor with a small box on it: thin along Y.
+    let mut text = obj(ground(5.0, 0.0, 4.0));
+    let boxes = obj(cube([1.0, 0.2, 1.0], 0.2));
+    text.push('\n');
+    let s = scene_in(
+        &dir,
+        "[output]\nwidth = 100\nheight = 100\n[[model]]\npath = \"floor.obj\"\n[[model]]\npath = \"box.obj\"\n",
+        &[("floor.obj", &text), ("box.obj", &boxes)],
+    );
+    let cam = &s.cameras[0];
+    let down = -cam.forward().y;
+    // Looking along -Y tilted by the 20-degree elevation: cos 20 = 0.94.
+    assert!((down - 20f32.to_radians().cos()).abs() < 1e-3, "{down}");
+    let f = render_frame(&s, 0, 0);
+    let (x0, y0, x1, y1) = covered(&f);
+    assert!((x1 - x0 + 1).max(y1 - y0 + 1) >= 90, "{x0} {y0} {x1} {y1}");
+    // Elevation and azimuth are keys of a fitted camera.
+    let s = scene_in(
+        &dir,
+        "[output]\nwidth = 100\nheight = 100\n[[model]]\npath = \"box.obj\"\n[[camera]]\nelevation = 45.0\nazimuth = 90.0\n",
+        &[("box.obj", &boxes)],
+    );
+    let fwd = s.cameras[0].forward();
+    // From +X (azimuth 90), 45 degrees up: looking toward -X and down.
+    assert!(
+        (fwd.x + 45f32.to_radians().cos()).abs() < 1e-3
+            && (fwd.y + 45f32.to_radians().sin()).abs() < 1e-3,
+        "{fwd}"
+    );
+}
