@@ -402,3 +402,49 @@ fn presets_light_without_a_file() {
         assert!(e.to_string().contains(msg), "{e}");
     }
 }
+
+#[test]
+fn the_ground_catcher_shows_only_the_shadows_of_the_models() {
+    let dir = scratch("ground");
+    let cube = softraster::procedural::cube([0.0; 3], 0.5)
+        .to_obj("cube", "none.mtl", "m")
+        .text
+        .replace("mtllib none.mtl\n", "")
+        .replace("usemtl m\n", "");
+    // A unit cube on the catcher, a light travelling 45 degrees down toward
+    // -X casting its shadow over x in (-1.5, -0.5); seen from straight
+    // above, 16 pixels a unit.
+    let text = |bg: &str| {
+        format!(
+            "[output]\nwidth = 64\nheight = 64\nbackground = {bg}\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+             [ground]\nshadow = true\n[[model]]\npath = \"cube.obj\"\n\
+             [[light]]\nkind = \"directional\"\ndirection = [-1.0, -1.0, 0.0]\nshadows = true\n\
+             [[camera]]\neye = [0.0, 10.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+             projection = \"orthographic\"\nheight = 4.0\n"
+        )
+    };
+    let s = scene_in(&dir, &text("[0.5, 0.5, 0.5]"), &[("cube.obj", &cube)]);
+    assert_eq!(s.ground.unwrap().height, -0.5);
+    let f = render_frame(&s, 0, 0);
+    let at = |x: f32, z: f32| {
+        let (px, py) = ((32.0 + x * 16.0) as usize, (32.0 + z * 16.0) as usize);
+        (f.color[py * 64 + px], f.depth[py * 64 + px])
+    };
+    // In the shadow: black; beside it: the background; neither is an object.
+    let (shadow, d) = at(-1.0, 0.0);
+    assert!(
+        shadow.truncate().max_element() < 0.01 && d.is_infinite(),
+        "{shadow}"
+    );
+    let (lit, _) = at(1.0, 0.0);
+    assert!((lit.x - 0.5).abs() < 1e-3, "{lit}");
+    let (side, _) = at(-1.0, 1.2);
+    assert!((side.x - 0.5).abs() < 1e-3, "{side}");
+    // Over a transparent background the shadow is alpha.
+    let s = scene_in(&dir, &text("\"transparent\""), &[("cube.obj", &cube)]);
+    let f = render_frame(&s, 0, 0);
+    let (px, py) = (32 - 16, 32);
+    let c = f.color[py * 64 + px];
+    assert!(c.w > 0.99 && c.truncate().max_element() < 0.01, "{c}");
+    assert_eq!(f.color[32 * 64 + 48].w, 0.0);
+}

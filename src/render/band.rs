@@ -17,6 +17,8 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use super::geometry::{Draw, Geometry};
+use super::ground::Ground;
+use super::rays::CameraRays;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::assets::texture::Gradients;
@@ -26,7 +28,7 @@ use crate::raster::coverage::{
 };
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
-use crate::scene::camera::Projection;
+use crate::raytrace::Tracer;
 use crate::scene::material::AlphaMode;
 use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
@@ -50,6 +52,8 @@ pub(super) struct FrameData<'a> {
     /// The environment seen through the camera, where the background
     /// shows it.
     pub env_bg: Option<EnvBackground<'a>>,
+    /// The ground shadow catcher, over the background.
+    pub ground: Option<Ground<'a>>,
     /// Texture filtering needs derivatives (trilinear, anisotropic).
     pub grads: bool,
     /// Shading reads the triangle's plane normal (flat shading, shadows,
@@ -67,6 +71,7 @@ impl<'a> FrameData<'a> {
         geo: &'a Geometry,
         pattern: &'static [(i8, i8)],
         grads: bool,
+        tracer: Option<&'a Tracer<'a>>,
     ) -> FrameData<'a> {
         let s = &fs.scene.settings;
         let alpha = geo
@@ -88,6 +93,7 @@ impl<'a> FrameData<'a> {
             reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),
             env_bg: EnvBackground::new(fs, &ctx, geo.grid.width, geo.grid.height),
+            ground: Ground::new(fs, &ctx, tracer, geo.grid.width, geo.grid.height),
             grads,
             geo_normal,
             ctx,
@@ -331,6 +337,10 @@ impl<'a> FrameData<'a> {
                         Some(e) => e.at(px, py),
                         None => self.bg,
                     };
+                    let bg = match &self.ground {
+                        Some(g) => g.over(bg, px, py),
+                        None => bg,
+                    };
                     if ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE) {
                         color[i] = bg;
                         depth[i] = f32::INFINITY;
@@ -551,11 +561,7 @@ pub(super) struct EnvBackground<'a> {
     env: &'a EnvLight,
     /// Prefiltering roughness; 0: the image itself.
     blur: f32,
-    forward: Vec3,
-    /// View-space extent of a pixel step along x and y (0: orthographic).
-    right: Vec3,
-    up: Vec3,
-    size: (f32, f32),
+    rays: CameraRays,
 }
 
 impl<'a> EnvBackground<'a> {
@@ -574,33 +580,15 @@ impl<'a> EnvBackground<'a> {
         if fs.scene.settings.shading.is_data_view() {
             return None;
         }
-        let env = ctx.env?;
-        let cam = &fs.camera;
-        let forward = cam.forward();
-        let side = forward.cross(cam.up).normalize_or(Vec3::X);
-        let up = side.cross(forward);
-        let (right, up) = match cam.projection {
-            Projection::Perspective { fov_y } => {
-                let t = (fov_y.to_radians() * 0.5).tan();
-                let aspect = width as f32 / height as f32;
-                (side * (t * aspect), up * t)
-            }
-            Projection::Orthographic { .. } => (Vec3::ZERO, Vec3::ZERO),
-        };
         Some(EnvBackground {
-            env,
+            env: ctx.env?,
             blur,
-            forward,
-            right,
-            up,
-            size: (width as f32, height as f32),
+            rays: CameraRays::new(&fs.camera, width, height),
         })
     }
 
     fn at(&self, px: i32, py: i32) -> Vec4 {
-        let x = (px as f32 + 0.5) / self.size.0 * 2.0 - 1.0;
-        let y = 1.0 - (py as f32 + 0.5) / self.size.1 * 2.0;
-        let d = self.forward + self.right * x + self.up * y;
+        let (_, d) = self.rays.ray(px, py);
         let c = if self.blur > 0.0 {
             self.env.prefiltered(d, self.blur)
         } else {

@@ -25,6 +25,8 @@ mod band;
 mod exposure;
 mod frame;
 mod geometry;
+mod ground;
+mod rays;
 mod setup;
 mod shadow_pass;
 mod vertex;
@@ -223,8 +225,11 @@ impl Renderer {
         let shadow_rays =
             s.shadows == ShadowMethod::Raytraced && fs.lights.iter().any(|l| l.shadows);
         let sampled = self.env_sampler(fs.scene);
-        let tracer = (shadow_rays || s.ao.method == AoMethod::Raytraced || sampled.is_some())
-            .then(|| self.tracer(fs));
+        let tracer = (shadow_rays
+            || s.ao.method == AoMethod::Raytraced
+            || sampled.is_some()
+            || fs.scene.ground.is_some())
+        .then(|| self.tracer(fs));
 
         let mut verts = vertex::transform_all(fs);
         let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref());
@@ -246,7 +251,7 @@ impl Renderer {
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
-        let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered);
+        let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered, tracer.as_ref());
         self.bands(&data, &geo, tracer.as_ref(), out);
     }
 

@@ -39,6 +39,16 @@ pub struct SceneDesc {
     pub animation: AnimationDesc,
     /// Version 2: image-based lighting.
     pub environment: Option<S<EnvironmentDesc>>,
+    /// Version 2: the shadow catcher.
+    #[serde(default)]
+    pub ground: GroundDesc,
+}
+
+/// `[ground]`. Default: no shadow catcher.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GroundDesc {
+    pub shadow: Option<S<bool>>,
 }
 
 /// `[environment]`: an equirectangular HDR image lighting the scene.

@@ -34,6 +34,18 @@ pub struct Light {
 }
 
 impl Light {
+    pub fn kind_is_directional(&self) -> bool {
+        matches!(self.kind, LightKind::Directional { .. })
+    }
+
+    /// A point or spot light's position, or `otherwise`.
+    pub fn position_or(&self, otherwise: Vec3) -> Vec3 {
+        match self.kind {
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+            LightKind::Directional { .. } => otherwise,
+        }
+    }
+
     /// The light moved by `m` (positions as points, directions as unit
     /// vectors; intensities unchanged).
     pub fn transformed(&self, m: Mat4) -> Light {

@@ -51,6 +51,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Image-based lighting (`[environment]`).
     pub environment: Option<environment::Environment>,
+    /// The shadow catcher under the models (`[ground] shadow = true`).
+    pub ground: Option<GroundPlane>,
     pub cameras: Vec<Camera>,
     pub animation: Animation,
     /// World-space bounding sphere of all models at rest.
@@ -61,6 +63,17 @@ pub struct Scene {
     /// What loading ignored (optional glTF extensions, line primitives...),
     /// for the command line to show.
     pub warnings: Vec<String>,
+}
+
+/// The plane of the ground shadow catcher: horizontal (+Y up) at the
+/// models' lowest point at rest, around their center.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundPlane {
+    pub height: f32,
+    pub center: Vec3,
+    /// The models' bounding radius: the catcher fades out between 2 and 3
+    /// of them from the center.
+    pub radius: f32,
 }
 
 impl Scene {

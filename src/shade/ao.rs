@@ -122,7 +122,7 @@ impl AoView {
 
 /// A hash of a pixel's coordinates to two numbers in [0, 1).
 #[inline]
-fn pixel_hash(x: u32, y: u32) -> (f32, f32) {
+pub fn pixel_hash(x: u32, y: u32) -> (f32, f32) {
     let mut h = x.wrapping_mul(0x9E37_79B1) ^ y.wrapping_mul(0x85EB_CA77);
     h ^= h >> 15;
     h = h.wrapping_mul(0x2C1B_3C6D);
@@ -158,26 +158,38 @@ pub fn raytraced(
             if !p.depth.is_finite() {
                 continue;
             }
-            let (tx, ty) = p.normal.any_orthonormal_pair();
             let origin = p.position + p.geo_normal * tracer.epsilon;
-            let (su, sv) = pixel_hash(x as u32, y as u32);
-            let mut open = 0u32;
-            for i in 0..n {
-                let u = ((i as f32 + 0.5) / n as f32 + su).fract();
-                let v = (radical_inverse(i) + sv).fract();
-                let r = u.sqrt();
-                let phi = TAU * v;
-                let dir = tx * (r * phi.cos())
-                    + ty * (r * phi.sin())
-                    + p.normal * (1.0 - u).max(0.0).sqrt();
-                if !tracer.occluded(origin, dir, t_max) {
-                    open += 1;
-                }
-            }
-            *o = open as f32 / n as f32;
+            let seed = pixel_hash(x as u32, y as u32);
+            *o = occlusion_at(tracer, origin, p.normal, n, t_max, seed);
         }
     });
     out
+}
+
+/// The unoccluded fraction of `n` cosine-weighted rays from `origin`
+/// around unit `normal` (within `t_max`), a stratified pattern shifted by
+/// `seed` (two numbers in [0, 1)).
+pub fn occlusion_at(
+    tracer: &Tracer,
+    origin: Vec3,
+    normal: Vec3,
+    n: u32,
+    t_max: f32,
+    (su, sv): (f32, f32),
+) -> f32 {
+    let (tx, ty) = normal.any_orthonormal_pair();
+    let mut open = 0u32;
+    for i in 0..n {
+        let u = ((i as f32 + 0.5) / n as f32 + su).fract();
+        let v = (radical_inverse(i) + sv).fract();
+        let r = u.sqrt();
+        let phi = TAU * v;
+        let dir = tx * (r * phi.cos()) + ty * (r * phi.sin()) + normal * (1.0 - u).max(0.0).sqrt();
+        if !tracer.occluded(origin, dir, t_max) {
+            open += 1;
+        }
+    }
+    open as f32 / n as f32
 }
 
 /// 4x4 ordered pattern (0..16), for the per-pixel slice rotation and step

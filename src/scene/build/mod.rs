@@ -111,6 +111,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let aspect = settings.width as f32 / settings.height as f32;
     let subject = cameras::Subject::new(&models.models, &animation, aspect);
     let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras)?;
+    let ground = get(&d.ground.shadow, false).then(|| ground_plane(&models.models, bounds));
     let environment = d
         .environment
         .as_ref()
@@ -124,6 +125,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         models: models.models,
         lights,
         environment,
+        ground,
         cameras,
         animation,
         bounds_center: bounds.center,
@@ -131,6 +133,28 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         textures: models.textures,
         warnings,
     })
+}
+
+/// The catcher's plane: at the models' lowest point at rest.
+fn ground_plane(models: &[super::Model], bounds: cameras::Bounds) -> super::GroundPlane {
+    let lowest = models
+        .iter()
+        .flat_map(|m| {
+            m.mesh
+                .positions
+                .iter()
+                .map(|p| m.world_from_object.transform_point3(*p).y)
+        })
+        .fold(f32::INFINITY, f32::min);
+    super::GroundPlane {
+        height: if lowest.is_finite() {
+            lowest
+        } else {
+            bounds.center.y
+        },
+        center: bounds.center,
+        radius: bounds.radius,
+    }
 }
 
 /// `[environment]`: the image read (relative to the scene file); a

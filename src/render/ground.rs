@@ -1,0 +1,153 @@
+//! The ground shadow catcher (`[ground] shadow = true`): an invisible plane
+//! under the models that shows only what they take from it, composited over
+//! the background: the shadows of shadow-casting lights and a soft contact
+//! occlusion. It is not an object: depth and the other buffers do not see
+//! it. Per background pixel whose view ray meets the plane:
+//!
+//!   factor = (sum_i E_i v_i + E_a ao) / (sum_i E_i + E_a)
+//!
+//! with E_i the light's irradiance on the plane and v_i its visibility (a
+//! ray through the scene's BVHs; 1 for lights that cast no shadows), E_a
+//! the irradiance of the environment from above (or of `[ambient]`), and
+//! ao the unoccluded fraction of 16 cosine-weighted rays within half the
+//! models' radius. The catcher fades out between 2 and 3 radii from the
+//! models' center.
+
+use glam::{Vec3, Vec4};
+
+use super::rays::CameraRays;
+use super::setup::FrameSetup;
+use crate::raytrace::Tracer;
+use crate::scene::Light;
+use crate::scene::settings::Background;
+use crate::shade::ShadeContext;
+use crate::shade::ao::{occlusion_at, pixel_hash};
+use crate::shade::light::incidence;
+
+/// Rays of contact occlusion per catcher pixel.
+const AO_SAMPLES: u32 = 16;
+
+pub(super) struct Ground<'a> {
+    rays: CameraRays,
+    height: f32,
+    center: Vec3,
+    radius: f32,
+    lights: &'a [Light],
+    tracer: &'a Tracer<'a>,
+    /// Luminance of the light from above that is not a light.
+    ambient: f32,
+    transparent: bool,
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+impl<'a> Ground<'a> {
+    /// The frame's catcher, when the scene asks for one.
+    pub fn new(
+        fs: &'a FrameSetup<'a>,
+        ctx: &ShadeContext<'a>,
+        tracer: Option<&'a Tracer<'a>>,
+        width: u32,
+        height: u32,
+    ) -> Option<Ground<'a>> {
+        let plane = fs.scene.ground.as_ref()?;
+        let tracer = tracer?;
+        if fs.scene.settings.shading.is_data_view() {
+            return None;
+        }
+        let ambient = match ctx.env {
+            Some(env) => luminance(env.irradiance(Vec3::Y)),
+            None => luminance(ctx.ambient) * std::f32::consts::PI,
+        };
+        Some(Ground {
+            rays: CameraRays::new(&fs.camera, width, height),
+            height: plane.height,
+            center: plane.center,
+            radius: plane.radius,
+            lights: &fs.lights,
+            tracer,
+            ambient,
+            transparent: fs.scene.settings.background == Background::Transparent,
+        })
+    }
+
+    /// `bg` with the catcher at pixel (px, py) composited over it: darkened
+    /// by the catcher's factor, or, over a transparent background, black
+    /// with the shadow's opacity as alpha.
+    pub fn over(&self, bg: Vec4, px: i32, py: i32) -> Vec4 {
+        let Some(f) = self.factor(px, py) else {
+            return bg;
+        };
+        if self.transparent {
+            Vec4::new(0.0, 0.0, 0.0, 1.0 - f)
+        } else {
+            (bg.truncate() * f).extend(bg.w)
+        }
+    }
+
+    /// The share of light the plane keeps at the pixel (1: none taken).
+    fn factor(&self, px: i32, py: i32) -> Option<f32> {
+        let (o, d) = self.rays.ray(px, py);
+        if d.y.abs() < 1e-6 {
+            return None;
+        }
+        let t = (self.height - o.y) / d.y;
+        if t <= 0.0 {
+            return None;
+        }
+        let p = o + d * t;
+        let r = Vec3::new(p.x - self.center.x, 0.0, p.z - self.center.z).length() / self.radius;
+        let fade = 1.0 - smoothstep(2.0, 3.0, r);
+        if fade <= 0.0 {
+            return None;
+        }
+        let origin = p + Vec3::Y * self.tracer.epsilon;
+        let (mut total, mut kept) = (self.ambient, 0.0);
+        for light in self.lights {
+            let Some(inc) = incidence(light, p) else {
+                continue;
+            };
+            let e = luminance(inc.e) * inc.l.y.max(0.0);
+            if e <= 0.0 {
+                continue;
+            }
+            total += e;
+            let t_max = if light.kind_is_directional() {
+                f32::INFINITY
+            } else {
+                1.0
+            };
+            let dir = if t_max.is_finite() {
+                light.position_or(p) - origin
+            } else {
+                inc.l
+            };
+            if !light.shadows || !self.tracer.occluded(origin, dir, t_max) {
+                kept += e;
+            }
+        }
+        if self.ambient > 0.0 {
+            let seed = pixel_hash(px as u32, py as u32);
+            let ao = occlusion_at(
+                self.tracer,
+                origin,
+                Vec3::Y,
+                AO_SAMPLES,
+                self.radius * 0.5,
+                seed,
+            );
+            kept += self.ambient * ao;
+        }
+        if total <= 0.0 {
+            return None;
+        }
+        Some(1.0 - fade * (1.0 - kept / total))
+    }
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}

@@ -1,0 +1,50 @@
+//! The camera's ray through each pixel center, for what is seen where no
+//! triangle is: the environment behind the models and the ground catcher.
+
+use glam::Vec3;
+
+use crate::scene::camera::{Camera, Projection};
+
+pub(super) struct CameraRays {
+    eye: Vec3,
+    forward: Vec3,
+    /// Half the view's extent along x and y: per unit of depth
+    /// (perspective) or in world units (orthographic).
+    right: Vec3,
+    up: Vec3,
+    orthographic: bool,
+    size: (f32, f32),
+}
+
+impl CameraRays {
+    pub fn new(cam: &Camera, width: u32, height: u32) -> CameraRays {
+        let forward = cam.forward();
+        let side = forward.cross(cam.up).normalize_or(Vec3::X);
+        let up = side.cross(forward);
+        let aspect = width as f32 / height as f32;
+        let (half_h, orthographic) = match cam.projection {
+            Projection::Perspective { fov_y } => ((fov_y.to_radians() * 0.5).tan(), false),
+            Projection::Orthographic { height } => (height * 0.5, true),
+        };
+        CameraRays {
+            eye: cam.eye,
+            forward,
+            right: side * (half_h * aspect),
+            up: up * half_h,
+            orthographic,
+            size: (width as f32, height as f32),
+        }
+    }
+
+    /// Origin and unit direction of the ray through pixel (px, py)'s center.
+    pub fn ray(&self, px: i32, py: i32) -> (Vec3, Vec3) {
+        let x = (px as f32 + 0.5) / self.size.0 * 2.0 - 1.0;
+        let y = 1.0 - (py as f32 + 0.5) / self.size.1 * 2.0;
+        let offset = self.right * x + self.up * y;
+        if self.orthographic {
+            (self.eye + offset, self.forward)
+        } else {
+            (self.eye, (self.forward + offset).normalize())
+        }
+    }
+}
