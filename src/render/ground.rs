@@ -128,16 +128,16 @@ impl<'a> Ground<'a> {
                 kept += e;
             }
         }
+        // Rays of half a radius from farther than 1.5 radii from the
+        // center (on the plane) cannot meet the models: open.
         if self.ambient > 0.0 {
-            let seed = pixel_hash(px as u32, py as u32);
-            let ao = occlusion_at(
-                self.tracer,
-                origin,
-                Vec3::Y,
-                AO_SAMPLES,
-                self.radius * 0.5,
-                seed,
-            );
+            let ao = if r > 1.5 {
+                1.0
+            } else {
+                let seed = pixel_hash(px as u32, py as u32);
+                let t_max = self.radius * 0.5;
+                occlusion_at(self.tracer, origin, Vec3::Y, AO_SAMPLES, t_max, seed)
+            };
             kept += self.ambient * ao;
         }
         if total <= 0.0 {

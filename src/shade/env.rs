@@ -41,7 +41,11 @@ struct Equirect {
 impl Equirect {
     /// Bilinear lookup, wrapping in u and clamping in v.
     fn sample(&self, d: Vec3) -> Vec3 {
-        let uv = direction_to_uv(d);
+        self.sample_uv(direction_to_uv(d))
+    }
+
+    /// Bilinear lookup at image coordinates `uv`.
+    fn sample_uv(&self, uv: Vec2) -> Vec3 {
         let x = uv.x * self.width as f32 - 0.5;
         let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
         let (x0, y0) = (x.floor(), y.floor());
@@ -174,12 +178,15 @@ impl EnvLight {
     /// Radiance along reflection direction `r` (world space), prefiltered
     /// for perceptual `roughness`.
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
-        let d = self.env_from_world * r;
+        let uv = direction_to_uv(self.env_from_world * r);
         let x = roughness.clamp(0.0, 1.0) * (LEVELS - 1) as f32;
         let k = (x.floor() as usize).min(LEVELS - 2);
         let f = x - k as f32;
-        let a = self.levels[k].sample(d);
-        let b = self.levels[k + 1].sample(d);
+        let a = self.levels[k].sample_uv(uv);
+        if f <= 0.0 {
+            return a * self.intensity;
+        }
+        let b = self.levels[k + 1].sample_uv(uv);
         a.lerp(b, f) * self.intensity
     }
 

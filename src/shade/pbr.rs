@@ -123,7 +123,11 @@ pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> V
     let spec = c.f0() * ab.x + Vec3::splat(ab.y);
     let diffuse = c.c_diff() * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
     let r = n * (2.0 * n.dot(v)) - v;
-    let so = ((ndv + ao).powf((-16.0 * c.roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0);
+    let so = if ao >= 1.0 {
+        1.0
+    } else {
+        ((ndv + ao).powf((-16.0 * c.roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0)
+    };
     (diffuse + env.prefiltered(r, c.roughness) * spec * so) * c.occlusion
 }
 
