@@ -94,7 +94,10 @@ fn zero_area_uvs_give_finite_pixels_with_normal_and_bump_maps() {
     solid_png(&dir.join("nm.png"), [128, 128, 255, 255]);
     solid_png(&dir.join("h.png"), [90, 90, 90, 255]);
     let render = |mtl: &str| {
-        let scene = format!("{TOP_DOWN}[[model]]\npath = \"quad.obj\"\n");
+        // One light along the view (the tolerance is for a 0.0039 tilt of
+        // the normal under it).
+        let light = "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\n";
+        let scene = format!("{TOP_DOWN}{light}[[model]]\npath = \"quad.obj\"\n");
         let s = scene_in(
             &dir,
             &scene,

@@ -72,18 +72,19 @@ impl EnvImage {
     /// The built-in studio (`preset = "studio"`), made by code: a neutral
     /// grey room (ceiling 0.35, walls 0.3 at the horizon, floor 0.12 as
     /// the floor's bounce), a large soft key panel above front-left
-    /// (radiance 6), a fill panel front-right (2), a rim strip behind the
-    /// model, above (4), and a top light (1.5). Soft edges everywhere: no
+    /// (radiance 3), a fill panel front-right (1), a rim strip behind the
+    /// model, above (2), and a top light (0.75): a white Lambertian
+    /// surface facing the key reflects about 0.9. Soft edges everywhere: no
     /// texel-sharp step for the prefilter to ring on.
     pub fn studio() -> EnvImage {
         let (w, h) = (512u32, 256u32);
         // (toward the panel, angular radius, softness, radiance); the
         // camera looks down -Z from +Z, so "front" is +Z.
         let panels = [
-            (Vec3::new(-0.55, 0.55, 0.63), 0.45f32, 0.25f32, 6.0f32),
-            (Vec3::new(0.75, 0.2, 0.63), 0.5, 0.3, 2.0),
-            (Vec3::new(0.15, 0.45, -0.88), 0.3, 0.2, 4.0),
-            (Vec3::new(0.0, 1.0, 0.0), 0.5, 0.4, 1.5),
+            (Vec3::new(-0.55, 0.55, 0.63), 0.45f32, 0.25f32, 3.0f32),
+            (Vec3::new(0.75, 0.2, 0.63), 0.5, 0.3, 1.0),
+            (Vec3::new(0.15, 0.45, -0.88), 0.3, 0.2, 2.0),
+            (Vec3::new(0.0, 1.0, 0.0), 0.5, 0.4, 0.75),
         ];
         let smooth = |e0: f32, e1: f32, x: f32| {
             let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);

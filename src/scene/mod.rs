@@ -46,8 +46,9 @@ pub struct Scene {
     pub settings: RenderSettings,
     pub output: OutputSettings,
     pub models: Vec<Model>,
-    /// Empty, and no environment: every camera gets a headlight (a
-    /// directional light along its view).
+    /// Empty, and no environment (a model imported no lights it asked
+    /// for): every camera gets a headlight (a directional light along its
+    /// view). A scene that names no light gets the studio environment.
     pub lights: Vec<Light>,
     /// Image-based lighting (`[environment]`).
     pub environment: Option<environment::Environment>,

@@ -111,12 +111,18 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let aspect = settings.width as f32 / settings.height as f32;
     let subject = cameras::Subject::new(&models.models, &animation, aspect);
     let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras)?;
-    let ground = get(&d.ground.shadow, false).then(|| ground_plane(&models.models, bounds));
-    let environment = d
-        .environment
-        .as_ref()
-        .map(|e| environment(e.get_ref(), ctx, &scene_dir))
-        .transpose()?;
+    let default_look = settings::default_look(d);
+    let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
+    let environment = match &d.environment {
+        Some(e) => Some(environment(e.get_ref(), ctx, &scene_dir)?),
+        None if default_look => Some(Environment {
+            method: EnvMethod::Prefiltered,
+            image: Arc::new(EnvImage::studio()),
+            intensity: 1.0,
+            rotation: 0.0,
+        }),
+        None => None,
+    };
     Ok(Scene {
         file: ctx.file.to_path_buf(),
         stem,

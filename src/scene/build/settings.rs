@@ -21,9 +21,28 @@ fn pick<T: Copy + Default>(v: &Option<desc::S<T>>) -> T {
     v.as_ref().map(|v| *v.get_ref()).unwrap_or_default()
 }
 
+/// The default look (version 2): a scene with no `[[light]]`, no
+/// `[environment]` and no model importing its file's lights is lit by the
+/// built-in studio, over its blurred background, with a ground shadow.
+pub(super) fn default_look(d: &SceneDesc) -> bool {
+    d.lights.is_empty()
+        && d.environment.is_none()
+        && !d
+            .models
+            .iter()
+            .any(|m| m.get_ref().lights.as_ref().is_some_and(|l| *l.get_ref()))
+}
+
 /// `[render]`, `output.width/height/background` and `[ambient]`.
 pub(super) fn render(d: &SceneDesc) -> RenderSettings {
     let (r, o) = (&d.render, &d.output);
+    let default_look = default_look(d);
+    let lit_by_environment = d.environment.is_some() || default_look;
+    let background = if default_look {
+        Background::Blurred(0.5)
+    } else {
+        Background::Color(Vec3::ZERO)
+    };
     RenderSettings {
         width: get(&o.width, 800) as u32,
         height: get(&o.height, 800) as u32,
@@ -42,14 +61,14 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
             r.exposure.as_ref().map(|e| *e.get_ref()),
             Some(desc::Exposure::Auto)
         ),
-        background: match get(&o.background, Background::Color(Vec3::ZERO)) {
+        background: match get(&o.background, background) {
             Background::Blurred(_) => Background::Blurred(get(&o.background_blur, 0.5)),
             b => b,
         },
         // With an environment lighting the scene, no ambient by default.
         ambient: Vec3::from(get(
             &d.ambient.color,
-            if d.environment.is_some() {
+            if lit_by_environment {
                 [0.0; 3]
             } else {
                 [0.03; 3]
@@ -244,12 +263,20 @@ mod tests {
         assert_eq!(s.depth, DepthMode::ReverseZ);
         assert_eq!(s.tonemap, Tonemap::Clamp);
         assert_eq!(s.exposure, 0.0);
-        assert_eq!(s.background, Background::Color(Vec3::ZERO));
-        assert_eq!(s.ambient, Vec3::splat(0.03));
+        // No light and no environment: the default look (studio, blurred
+        // background, no ambient).
+        assert!(default_look(&d));
+        assert_eq!(s.background, Background::Blurred(0.5));
+        assert_eq!(s.ambient, Vec3::ZERO);
         assert_eq!(s.shadows, ShadowMethod::Raytraced);
         assert_eq!(s.shadow_map_size, 2048);
         assert_eq!(s.shadow_bias, ShadowBias::default());
         assert_eq!(s.ao.method, AoMethod::Off);
+        // A light: version 1's defaults.
+        let lit = parse("[[model]]\npath = \"m.obj\"\n[[light]]\n");
+        assert!(!default_look(&lit));
+        assert_eq!(render(&lit).background, Background::Color(Vec3::ZERO));
+        assert_eq!(render(&lit).ambient, Vec3::splat(0.03));
         let ctx = Ctx {
             file: Path::new("dir/s.toml"),
             text: "",
