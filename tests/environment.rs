@@ -448,3 +448,40 @@ fn the_ground_catcher_shows_only_the_shadows_of_the_models() {
     assert!(c.w > 0.99 && c.truncate().max_element() < 0.01, "{c}");
     assert_eq!(f.color[32 * 64 + 48].w, 0.0);
 }
+
+#[test]
+fn the_sun_of_real_skies_becomes_a_shadow_casting_light() {
+    let Some(assets) = common::shared_assets() else {
+        return;
+    };
+    let dir = scratch("env_sun");
+    for hdri in ["sunset", "city"] {
+        let path = assets.join(format!("hdri/{hdri}.exr"));
+        let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "sun = true", "").replace(
+            "path = \"env.exr\"",
+            &format!("path = {:?}", path.display().to_string()),
+        );
+        let s = load(&dir, &text);
+        assert_eq!(s.lights.len(), 1, "{hdri}");
+        let l = s.lights[0];
+        let softraster::scene::light::LightKind::Directional {
+            direction,
+            irradiance,
+        } = l.kind
+        else {
+            panic!("{hdri}: {:?}", l.kind)
+        };
+        // From above the horizon (the sunset's sun is low), casting
+        // shadows, with a good share of what the sky gives a surface facing
+        // up once the sun is out of it.
+        let env = &s.environment.as_ref().unwrap().image;
+        let sky = env.texels.iter().map(|c| c.y).sum::<f32>() / env.texels.len() as f32
+            * std::f32::consts::PI;
+        println!(
+            "{hdri}: sun toward {:?}, irradiance {irradiance:.3}, sky {sky:.3}",
+            -direction
+        );
+        assert!(l.shadows && direction.y < 0.0, "{hdri}: {direction}");
+        assert!(irradiance > 0.25 * sky, "{hdri}: {irradiance} vs {sky}");
+    }
+}

@@ -120,6 +120,67 @@ impl EnvImage {
         }
     }
 
+    /// Takes the sun out of the image: the texels within 8 degrees of the
+    /// brightest one (on a 4x smaller copy) that are brighter than a
+    /// quarter of it are lowered to that quarter, and what they lose is
+    /// returned as a directional light: the unit direction it travels
+    /// along (environment space) and its irradiance (RGB). None for an
+    /// image without a clear peak (its peak under 20 times the mean).
+    pub fn extract_sun(&mut self) -> Option<(Vec3, Vec3)> {
+        use std::f32::consts::PI;
+        let (w, h) = (self.width as usize, self.height as usize);
+        let lum = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        let dir = |x: usize, y: usize| {
+            let theta = (y as f32 + 0.5) / h as f32 * PI;
+            let phi = ((x as f32 + 0.5) / w as f32 - 0.5) * 2.0 * PI;
+            Vec3::new(
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                -theta.sin() * phi.cos(),
+            )
+        };
+        // The peak of a 4x4 box-filtered copy (one hot texel is not a sun).
+        let (mut best, mut at) = (0.0f32, (0, 0));
+        for by in 0..h / 4 {
+            for bx in 0..w / 4 {
+                let mut s = 0.0;
+                for k in 0..16 {
+                    s += lum(self.texels[(by * 4 + k / 4) * w + bx * 4 + k % 4]);
+                }
+                if s > best {
+                    (best, at) = (s, (bx * 4 + 2, by * 4 + 2));
+                }
+            }
+        }
+        let mean = self.texels.iter().map(|c| lum(*c)).sum::<f32>() / (w * h) as f32;
+        let peak = best / 16.0;
+        if peak < 20.0 * mean || peak <= 0.0 {
+            return None;
+        }
+        let center = dir(at.0, at.1);
+        let (threshold, cos_max) = (0.25 * peak, 8f32.to_radians().cos());
+        let (mut energy, mut weighted) = (Vec3::ZERO, Vec3::ZERO);
+        for y in 0..h {
+            let omega =
+                (2.0 * PI / w as f32) * (PI / h as f32) * ((y as f32 + 0.5) / h as f32 * PI).sin();
+            for x in 0..w {
+                let d = dir(x, y);
+                let t = &mut self.texels[y * w + x];
+                let l = lum(*t);
+                if d.dot(center) < cos_max || l <= threshold {
+                    continue;
+                }
+                let kept = *t * (threshold / l);
+                let taken = (*t - kept) * omega;
+                energy += taken;
+                weighted += d * lum(taken);
+                *t = kept;
+            }
+        }
+        let toward = weighted.try_normalize()?;
+        Some((-toward, energy))
+    }
+
     /// A uniform environment of radiance `c`.
     pub fn uniform(c: Vec3) -> EnvImage {
         EnvImage {
@@ -173,5 +234,45 @@ mod tests {
         let e = EnvImage::new(16, 8, t).unwrap_err();
         assert!(e.contains("(5, 0)"), "{e}");
         assert!(EnvImage::new(16, 8, vec![Vec3::ONE; 128]).is_ok());
+    }
+
+    #[test]
+    fn the_sun_leaves_the_image_as_a_light_of_the_same_energy() {
+        use std::f32::consts::PI;
+        let (w, h) = (256u32, 128u32);
+        // A 4x4-texel sun around u = 0.75, v = 0.25: toward +X, 45 degrees up.
+        let texels: Vec<Vec3> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if (190..194).contains(&x) && (30..34).contains(&y) {
+                    Vec3::splat(5000.0)
+                } else {
+                    Vec3::splat(0.1)
+                }
+            })
+            .collect();
+        let omega = |y: u32| {
+            (2.0 * PI / w as f32) * (PI / h as f32) * ((y as f32 + 0.5) / h as f32 * PI).sin()
+        };
+        let total = |t: &[Vec3]| -> f32 {
+            t.iter()
+                .enumerate()
+                .map(|(i, c)| c.x * omega(i as u32 / w))
+                .sum()
+        };
+        let mut img = EnvImage::new(w, h, texels).unwrap();
+        let before = total(&img.texels);
+        let (dir, e) = img.extract_sun().unwrap();
+        let toward = -dir;
+        let want = Vec3::new(1.0, 1.0, 0.0).normalize();
+        assert!(toward.dot(want) > 0.999, "{toward}");
+        // Energy is moved, not made: the image keeps the rest.
+        assert!(
+            (total(&img.texels) + e.x - before).abs() < 1e-3 * before,
+            "{e}"
+        );
+        assert!(img.texels.iter().all(|c| c.x <= 5000.0 * 0.25 + 1e-3));
+        // No clear peak, no sun.
+        assert!(EnvImage::uniform(Vec3::ONE).extract_sun().is_none());
     }
 }

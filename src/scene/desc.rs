@@ -67,6 +67,8 @@ pub struct EnvironmentDesc {
     pub method: Option<S<EnvMethodName>>,
     /// Sampled: direction pairs a point (default 64).
     pub samples: Option<S<i64>>,
+    /// A shadow-casting directional light from the brightest region.
+    pub sun: Option<S<bool>>,
 }
 
 /// The built-in environments.

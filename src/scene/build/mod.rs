@@ -114,7 +114,11 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let default_look = settings::default_look(d);
     let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
     let environment = match &d.environment {
-        Some(e) => Some(environment(e.get_ref(), ctx, &scene_dir)?),
+        Some(e) => {
+            let (env, sun) = environment(e.get_ref(), ctx, &scene_dir)?;
+            lights.extend(sun);
+            Some(env)
+        }
         None if default_look => Some(Environment {
             method: EnvMethod::Prefiltered,
             image: Arc::new(EnvImage::studio()),
@@ -169,8 +173,8 @@ fn environment(
     e: &desc::EnvironmentDesc,
     ctx: &Ctx,
     scene_dir: &Path,
-) -> Result<Environment, Error> {
-    let image = match (&e.path, e.preset.as_ref().map(|p| *p.get_ref())) {
+) -> Result<(Environment, Option<super::Light>), Error> {
+    let mut image = match (&e.path, e.preset.as_ref().map(|p| *p.get_ref())) {
         (Some(p), _) => {
             let path = scene_dir.join(p.get_ref().replace('\\', "/"));
             if !path.is_file() {
@@ -195,12 +199,36 @@ fn environment(
         },
         _ => EnvMethod::Prefiltered,
     };
-    Ok(Environment {
-        method,
-        image: Arc::new(image),
-        intensity: get(&e.intensity, 1.0),
-        rotation: get(&e.rotation, 0.0),
-    })
+    let (intensity, rotation) = (get(&e.intensity, 1.0), get(&e.rotation, 0.0));
+    // `sun = true`: the brightest region becomes a shadow-casting light
+    // (turned and scaled like the image), and leaves the image.
+    let sun = if get(&e.sun, false) {
+        image.extract_sun().map(|(direction, irradiance)| {
+            let world = glam::Mat3::from_rotation_y(rotation.to_radians()) * direction;
+            let e = irradiance * intensity;
+            let peak = e.max_element().max(1e-12);
+            super::Light {
+                kind: super::light::LightKind::Directional {
+                    direction: world.normalize(),
+                    irradiance: peak,
+                },
+                color: e / peak,
+                shadows: true,
+                range: None,
+            }
+        })
+    } else {
+        None
+    };
+    Ok((
+        Environment {
+            method,
+            image: Arc::new(image),
+            intensity,
+            rotation,
+        },
+        sun,
+    ))
 }
 
 /// `[animation]`: one frame and no turntable by default; a turntable turns
