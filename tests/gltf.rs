@@ -487,3 +487,71 @@ fn strips_fans_and_unindexed_primitives_with_flat_normals_and_vertex_colors() {
         }
     }
 }
+
+/// A unit cube with `material` (JSON) seen face-on from +Z, lit by the
+/// neutral environment (radiance 1) and `lights` (TOML): the linear colour
+/// at the center of its front face.
+fn cube_face_color(name: &str, material: &str, used: &str, lights: &str) -> Vec3 {
+    let dir = common::scratch(name);
+    let (text, _) = gltf_text(
+        &cube(),
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": [{used}], "materials": [{material}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+    let scene = format!(
+        "[output]\nwidth = 32\nheight = 32\n[render]\nshading = \"pbr\"\n\
+         [environment]\npreset = \"neutral\"\n{lights}[[model]]\npath = \"c.gltf\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n"
+    );
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    render_frame(&s, 0, 0).color[16 * 32 + 16].truncate()
+}
+
+#[test]
+fn khr_materials_unlit_ior_and_specular() {
+    // Unlit: the base colour, whatever lights the scene.
+    let base = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5}"#;
+    let unlit = cube_face_color(
+        "gltf_unlit",
+        &format!(r#"{base}, "extensions": {{"KHR_materials_unlit": {{}}}}}}"#),
+        r#""KHR_materials_unlit""#,
+        "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 5.0\n",
+    );
+    assert!(
+        (unlit - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 1e-5,
+        "{unlit}"
+    );
+    // specularFactor 0: no specular lobe at all, so a uniform environment
+    // of radiance 1 shows the base colour exactly (Lambertian).
+    let matte = cube_face_color(
+        "gltf_specular0",
+        &format!(
+            r#"{base}, "extensions": {{"KHR_materials_specular": {{"specularFactor": 0.0}}}}}}"#
+        ),
+        r#""KHR_materials_specular""#,
+        "",
+    );
+    assert!(
+        (matte - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 2e-3,
+        "{matte}"
+    );
+    // The default dielectric (ior 1.5) reflects more than that, and a
+    // higher ior more still.
+    let plain = cube_face_color("gltf_ior15", &format!("{base}}}"), "", "");
+    let ior2 = cube_face_color(
+        "gltf_ior2",
+        &format!(r#"{base}, "extensions": {{"KHR_materials_ior": {{"ior": 2.0}}}}}}"#),
+        r#""KHR_materials_ior""#,
+        "",
+    );
+    assert!(
+        plain.x > matte.x + 0.01 && ior2.x > plain.x + 0.02,
+        "{matte} {plain} {ior2}"
+    );
+}

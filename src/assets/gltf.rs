@@ -29,6 +29,9 @@ use crate::error::Error;
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_unlit",
     "KHR_texture_transform",
 ];
 
@@ -93,6 +96,21 @@ pub struct GltfMaterial {
     pub alpha_mode: GltfAlphaMode,
     pub alpha_cutoff: f32,
     pub double_sided: bool,
+    /// KHR_materials_unlit: the base colour, without light.
+    pub unlit: bool,
+    /// KHR_materials_ior (1.5 without it).
+    pub ior: f32,
+    /// KHR_materials_specular: factor (the dielectric's F90 and weight on
+    /// F0), colour factor (on F0), and their textures (alpha; sRGB RGB).
+    pub specular: Option<GltfSpecular>,
+}
+
+#[derive(Debug, Clone)]
+pub struct GltfSpecular {
+    pub factor: f32,
+    pub texture: Option<TexInfo>,
+    pub color: Vec3,
+    pub color_texture: Option<TexInfo>,
 }
 
 impl GltfMaterial {
@@ -114,6 +132,9 @@ impl GltfMaterial {
             alpha_mode: GltfAlphaMode::Opaque,
             alpha_cutoff: 0.5,
             double_sided: false,
+            unlit: false,
+            ior: 1.5,
+            specular: None,
         }
     }
 
@@ -125,6 +146,16 @@ impl GltfMaterial {
             (self.normal_tex.as_ref(), false),
             (self.occlusion_tex.as_ref(), false),
             (self.emissive_tex.as_ref(), true),
+            (
+                self.specular.as_ref().and_then(|s| s.texture.as_ref()),
+                false,
+            ),
+            (
+                self.specular
+                    .as_ref()
+                    .and_then(|s| s.color_texture.as_ref()),
+                true,
+            ),
         ]
         .into_iter()
         .filter_map(|(t, srgb)| t.map(|t| (t, srgb)))
@@ -779,6 +810,17 @@ fn material(
         },
         alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
         double_sided: m.double_sided(),
+        unlit: m.unlit(),
+        ior: m
+            .ior()
+            .filter(|i| i.is_finite() && *i >= 1.0)
+            .unwrap_or(1.5),
+        specular: m.specular().map(|s| GltfSpecular {
+            factor: s.specular_factor().clamp(0.0, 1.0),
+            texture: info(s.specular_texture(), warnings),
+            color: Vec3::from(s.specular_color_factor()).max(Vec3::ZERO),
+            color_texture: info(s.specular_color_texture(), warnings),
+        }),
     }
 }
 

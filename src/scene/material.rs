@@ -71,6 +71,22 @@ pub struct Pbr {
     pub emissive: Vec3,
     /// sRGB.
     pub emissive_map: Option<TextureRef>,
+    /// KHR_materials_ior / KHR_materials_specular; None: ior 1.5 (F0
+    /// 0.04), F90 1.
+    pub specular: Option<DielectricSpecular>,
+}
+
+/// A dielectric's reflectance when the file gives it.
+#[derive(Debug, Clone)]
+pub struct DielectricSpecular {
+    /// ((ior - 1) / (ior + 1))^2 times the specular colour factor.
+    pub f0: Vec3,
+    /// The specular factor: F90, and the weight on F0.
+    pub weight: f32,
+    /// Its alpha multiplies `weight` (linear).
+    pub weight_map: Option<TextureRef>,
+    /// Its RGB multiplies `f0` (sRGB).
+    pub color_map: Option<TextureRef>,
 }
 
 impl Pbr {
@@ -86,6 +102,7 @@ impl Pbr {
             occlusion_strength: 1.0,
             emissive: Vec3::ZERO,
             emissive_map: None,
+            specular: None,
         }
     }
 }
@@ -132,6 +149,8 @@ pub struct Material {
     pub native: Native,
     /// glTF doubleSided: never culled, whatever `render.cull` says.
     pub double_sided: bool,
+    /// KHR_materials_unlit: lit modes show its colour without light.
+    pub unlit: bool,
 }
 
 impl Material {
@@ -161,6 +180,7 @@ impl Material {
             },
             native: Native::BlinnPhong,
             double_sided: false,
+            unlit: false,
         }
     }
 }
@@ -197,6 +217,8 @@ impl Material {
             p.metallic_roughness_map.as_ref(),
             p.occlusion_map.as_ref(),
             p.emissive_map.as_ref(),
+            p.specular.as_ref().and_then(|s| s.weight_map.as_ref()),
+            p.specular.as_ref().and_then(|s| s.color_map.as_ref()),
         ]
         .into_iter()
         .flatten()

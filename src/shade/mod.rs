@@ -114,6 +114,10 @@ impl ShadeContext<'_> {
 
     /// Linear RGB (or display values for the data views) of a surface point.
     pub fn shade(&self, s: &Surface) -> Vec3 {
+        // KHR_materials_unlit: the base colour, in every lit mode.
+        if s.material.unlit && !self.mode.is_data_view() {
+            return self.pbr_color(s).base;
+        }
         match self.mode {
             // The shading normal (normal and bump maps applied), world space.
             ShadingMode::Normals => self.mapped_normal(s) * 0.5 + Vec3::splat(0.5),
@@ -249,12 +253,18 @@ impl ShadeContext<'_> {
         } else {
             p.emissive * get(&p.emissive_map).map_or(Vec3::ONE, |c| c.truncate())
         };
+        let dielectric = p.specular.as_ref().map(|d| {
+            let color = get(&d.color_map).map_or(Vec3::ONE, |c| c.truncate());
+            let weight = d.weight * get(&d.weight_map).map_or(1.0, |c| c.w);
+            ((d.f0 * color).min(Vec3::ONE) * weight, weight)
+        });
         PbrColor {
             base,
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             occlusion,
             emissive,
+            dielectric,
         }
     }
 

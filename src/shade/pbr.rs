@@ -38,6 +38,9 @@ pub struct PbrColor {
     /// 1 = unoccluded (occlusion map with its strength applied).
     pub occlusion: f32,
     pub emissive: Vec3,
+    /// A dielectric's F0 and F90 when the material gives them (None: 0.04
+    /// and 1).
+    pub dielectric: Option<(Vec3, f32)>,
 }
 
 /// Smallest alpha: a perfect mirror would make D a delta that point lights
@@ -52,7 +55,20 @@ impl PbrColor {
 
     #[inline]
     pub fn f0(&self) -> Vec3 {
-        Vec3::splat(0.04).lerp(self.base, self.metallic)
+        match self.dielectric {
+            None => Vec3::splat(0.04).lerp(self.base, self.metallic),
+            Some((f0, _)) => f0.lerp(self.base, self.metallic),
+        }
+    }
+
+    /// Reflectance at grazing angles: 1, or a dielectric's specular
+    /// factor (metals: 1).
+    #[inline]
+    pub fn f90(&self) -> f32 {
+        match self.dielectric {
+            None => 1.0,
+            Some((_, w)) => w + (1.0 - w) * self.metallic,
+        }
     }
 
     #[inline]
@@ -75,7 +91,7 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     let vdh = v.dot(h).abs();
     let a2 = c.alpha() * c.alpha();
     let f0 = c.f0();
-    let fresnel = f0 + (Vec3::ONE - f0) * (1.0 - vdh).powi(5);
+    let fresnel = f0 + (Vec3::splat(c.f90()) - f0) * (1.0 - vdh).powi(5);
     let d = if ndh > 0.0 {
         let t = ndh * ndh * (a2 - 1.0) + 1.0;
         a2 / (PI * t * t)
@@ -93,9 +109,9 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
 /// analytic fit of the split-sum environment BRDF (clamped to [0, 1]: the
 /// fit overshoots slightly at grazing angles).
 #[inline]
-pub fn specular_albedo(f0: Vec3, roughness: f32, ndv: f32) -> Vec3 {
+pub fn specular_albedo(f0: Vec3, f90: f32, roughness: f32, ndv: f32) -> Vec3 {
     let (a, b) = env_brdf(roughness, ndv);
-    (f0 * a + Vec3::splat(b)).clamp(Vec3::ZERO, Vec3::ONE)
+    (f0 * a + Vec3::splat(b * f90)).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
 /// Scale and bias of f0 in the fit.
@@ -120,7 +136,7 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> Vec3 {
     let ndv = n.dot(v).abs().max(1e-4);
     let ab = env.brdf(ndv, c.roughness);
-    let spec = c.f0() * ab.x + Vec3::splat(ab.y);
+    let spec = c.f0() * ab.x + Vec3::splat(ab.y * c.f90());
     let diffuse = c.c_diff() * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
     let r = n * (2.0 * n.dot(v)) - v;
     let so = if ao >= 1.0 {
@@ -145,7 +161,7 @@ pub fn radiance(
     let mut out = c.emissive;
     for_each_lit(lights, shadow, p, n, |l, e| out += e * brdf(n, v, l, c));
     if ambient != Vec3::ZERO {
-        let spec = specular_albedo(c.f0(), c.roughness, n.dot(v).abs());
+        let spec = specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
         out += ambient * c.occlusion * (c.c_diff() * (Vec3::ONE - spec) + spec);
     }
     out
@@ -163,6 +179,7 @@ mod tests {
             roughness,
             occlusion: 1.0,
             emissive: Vec3::ZERO,
+            dielectric: None,
         }
     }
 
@@ -288,13 +305,13 @@ mod tests {
         // The fit's specular albedo stays within [0, 1].
         for r in [0.0, 0.25, 0.5, 1.0] {
             for ndv in [0.0, 0.3, 1.0] {
-                let s = specular_albedo(Vec3::splat(0.04), r, ndv).x;
+                let s = specular_albedo(Vec3::splat(0.04), 1.0, r, ndv).x;
                 assert!((0.0..=1.0).contains(&s), "{r} {ndv}: {s}");
             }
         }
         // Near the fit's known values: a smooth dielectric seen head-on
         // reflects about f0; a mirror metal about 1.
-        assert!((specular_albedo(Vec3::splat(0.04), 0.0, 1.0).x - 0.04).abs() < 0.01);
-        assert!(specular_albedo(Vec3::ONE, 0.0, 1.0).x > 0.95);
+        assert!((specular_albedo(Vec3::splat(0.04), 1.0, 0.0, 1.0).x - 0.04).abs() < 0.01);
+        assert!(specular_albedo(Vec3::ONE, 1.0, 0.0, 1.0).x > 0.95);
     }
 }

@@ -14,7 +14,8 @@ use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
 use crate::scene::material::{
-    AlphaMode, Material, Native, NormalMap, NormalSpace, Pbr, ns_from_roughness, roughness_from_ns,
+    AlphaMode, DielectricSpecular, Material, Native, NormalMap, NormalSpace, Pbr,
+    ns_from_roughness, roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -370,6 +371,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         occlusion_strength: 1.0,
         emissive: ke,
         emissive_map: map_ke.clone(),
+        specular: None,
     };
     Material {
         name: m.name.clone(),
@@ -394,7 +396,27 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         pbr,
         native: Native::BlinnPhong,
         double_sided: false,
+        unlit: false,
     }
+}
+
+/// KHR_materials_ior and KHR_materials_specular as the dielectric's F0 and
+/// F90 (None: the defaults, ior 1.5 and no specular extension).
+fn dielectric_specular(
+    g: &GltfMaterial,
+    tex: &dyn Fn(&Option<TexInfo>, bool) -> Option<TextureRef>,
+) -> Option<DielectricSpecular> {
+    if g.specular.is_none() && g.ior == 1.5 {
+        return None;
+    }
+    let r = (g.ior - 1.0) / (g.ior + 1.0);
+    let s = g.specular.as_ref();
+    Some(DielectricSpecular {
+        f0: Vec3::splat(r * r) * s.map_or(Vec3::ONE, |s| s.color),
+        weight: s.map_or(1.0, |s| s.factor),
+        weight_map: s.and_then(|s| tex(&s.texture, false)),
+        color_map: s.and_then(|s| tex(&s.color_texture, true)),
+    })
 }
 
 fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
@@ -422,6 +444,7 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
         occlusion_strength: g.occlusion_strength,
         emissive: g.emissive,
         emissive_map: emissive_map.clone(),
+        specular: dielectric_specular(g, &tex),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the
     // specular color at normal incidence (0.04 for dielectrics, the base
@@ -463,5 +486,6 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
         pbr,
         native: Native::Pbr,
         double_sided: g.double_sided,
+        unlit: g.unlit,
     }
 }
