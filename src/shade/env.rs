@@ -60,19 +60,23 @@ impl Equirect {
         top.lerp(bottom, fy)
     }
 
-    /// Half the size (a box over 2x2 texels), down to 2x1.
+    /// Half the size, each texel the solid-angle-weighted mean of the 2x2
+    /// it covers (an unweighted box would give the rows near the poles,
+    /// which cover little of the sphere, as much say as the equator's).
     fn half(&self) -> Equirect {
         let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
         let mut texels = vec![Vec3::ZERO; w * h];
+        let sin = |y: usize| ((y as f32 + 0.5) / self.height as f32 * PI).sin();
         texels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
-                let mut acc = Vec3::ZERO;
+                let (mut acc, mut weight) = (Vec3::ZERO, 0.0);
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let sx = (2 * x + dx).min(self.width - 1);
                     let sy = (2 * y + dy).min(self.height - 1);
-                    acc += self.texels[sy * self.width + sx];
+                    acc += self.texels[sy * self.width + sx] * sin(sy);
+                    weight += sin(sy);
                 }
-                *out = acc * 0.25;
+                *out = acc / weight;
             }
         });
         Equirect {
@@ -201,6 +205,17 @@ impl EnvLight {
         let top = at(x0, y0).lerp(at(x1, y0), tx);
         top.lerp(at(x0, y1).lerp(at(x1, y1), tx), ty)
     }
+}
+
+/// Where to look up the prefiltered radiance for a lobe of `roughness`
+/// reflecting about unit normal `n` along mirror direction `r`: rough
+/// lobes lean toward the normal (their off-specular peak), which the split
+/// sum's n = v = r prefilter does not see (Lagarde and de Rousiers 2014,
+/// "Moving Frostbite to PBR", the dominant direction).
+pub fn dominant_direction(n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
+    let a = roughness * roughness;
+    let f = (1.0 - a) * ((1.0 - a).sqrt() + a);
+    n.lerp(r, f).normalize_or(r)
 }
 
 /// The real SH basis, bands 0-2, at unit direction `d`.

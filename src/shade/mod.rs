@@ -221,8 +221,8 @@ impl ShadeContext<'_> {
         if c.ks == Vec3::ZERO {
             return diffuse;
         }
-        let r = n * (2.0 * n.dot(v)) - v;
         let roughness = crate::scene::material::roughness_from_ns(c.ns);
+        let r = env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, roughness);
         diffuse + c.ks * env.prefiltered(r, roughness)
     }
 

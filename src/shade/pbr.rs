@@ -138,7 +138,7 @@ pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> V
     let ab = env.brdf(ndv, c.roughness);
     let spec = c.f0() * ab.x + Vec3::splat(ab.y * c.f90());
     let diffuse = c.c_diff() * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
-    let r = n * (2.0 * n.dot(v)) - v;
+    let r = super::env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, c.roughness);
     let so = if ao >= 1.0 {
         1.0
     } else {
