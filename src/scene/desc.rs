@@ -566,26 +566,7 @@ impl SceneDesc {
             validate_camera(c, cam.get_ref())?;
         }
         if let Some(e) = &self.environment {
-            let span = e.span();
-            let e = e.get_ref();
-            match (&e.path, &e.preset) {
-                (Some(p), None) if p.get_ref().trim().is_empty() => {
-                    return Err(c.err(p.span(), "environment.path must not be empty"));
-                }
-                (Some(_), Some(p)) => {
-                    return Err(c.err(p.span(), "environment: give `path` or `preset`, not both"));
-                }
-                (None, None) => {
-                    return Err(c.err(
-                        span,
-                        "[environment] needs `path` (an .hdr or .exr image) or `preset` (\"studio\" or \"neutral\")",
-                    ));
-                }
-                _ => {}
-            }
-            c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
-            c.finite(&e.rotation, "environment.rotation")?;
-            c.int_range(&e.samples, "environment.samples", 1, 65536)?;
+            validate_environment(c, e)?;
         }
         let a = &self.animation;
         c.int_range(&a.frames, "animation.frames", 1, 1_000_000)?;
@@ -600,6 +581,30 @@ impl SceneDesc {
 
 fn get_i64(v: &Option<S<i64>>, default: i64) -> i64 {
     v.as_ref().map(|v| *v.get_ref()).unwrap_or(default)
+}
+
+fn validate_environment(c: &Ctx, e: &S<EnvironmentDesc>) -> Result<(), Error> {
+    let span = e.span();
+    let e = e.get_ref();
+    match (&e.path, &e.preset) {
+        (Some(p), None) if p.get_ref().trim().is_empty() => {
+            return Err(c.err(p.span(), "environment.path must not be empty"));
+        }
+        (Some(_), Some(p)) => {
+            return Err(c.err(p.span(), "environment: give `path` or `preset`, not both"));
+        }
+        (None, None) => {
+            return Err(c.err(
+                span,
+                "[environment] needs `path` (an .hdr or .exr image) or `preset` (\"studio\" or \"neutral\")",
+            ));
+        }
+        _ => {}
+    }
+    c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
+    c.finite(&e.rotation, "environment.rotation")?;
+    c.int_range(&e.samples, "environment.samples", 1, 65536)?;
+    Ok(())
 }
 
 fn validate_model(c: &Ctx, m: &ModelDesc) -> Result<(), Error> {
