@@ -485,3 +485,65 @@ fn the_sun_of_real_skies_becomes_a_shadow_casting_light() {
         assert!(irradiance > 0.25 * sky, "{hdri}: {irradiance} vs {sky}");
     }
 }
+
+#[test]
+fn keys_without_effect_warn_and_illum_0_takes_no_environment_light() {
+    let dir = scratch("env_warn");
+    let text = sphere_scene(
+        &dir,
+        [0.0, 0.0, 5.0],
+        "preset = \"neutral\"\nsamples = 8\nsun = true",
+        "",
+    )
+    .replace("path = \"env.exr\"\n", "")
+    .replace(
+        "projection = \"orthographic\"",
+        "elevation = 30.0\nprojection = \"orthographic\"",
+    );
+    let s = load(&dir, &text);
+    let all = s.warnings.join("\n");
+    for what in [
+        "environment.samples has no effect",
+        "camera.elevation has no effect",
+        "no sun light",
+    ] {
+        assert!(all.contains(what), "{what}: {all}");
+    }
+    // illum 0 is Kd alone: the environment adds nothing.
+    let f = |illum: u32| {
+        let t = sphere_scene(&dir, [0.0, 0.0, 5.0], "preset = \"neutral\"", "")
+            .replace("path = \"env.exr\"\n", "");
+        let d = scratch(&format!("env_illum{illum}"));
+        let obj = softraster::procedural::sphere(1.0, 96, 48)
+            .to_obj("sphere", "m.mtl", "m")
+            .text;
+        let mtl = MTL.replace("illum 1", &format!("illum {illum}"));
+        let s = scene_in(&d, &t, &[("sphere.obj", &obj), ("m.mtl", &mtl)]);
+        render_frame(&s, 0, 0).color[32 * 64 + 32].x
+    };
+    assert!(
+        (f(0) - 0.6).abs() < 1e-4 && (f(1) - 0.6).abs() < 0.003,
+        "{} {}",
+        f(0),
+        f(1)
+    );
+}
+
+#[test]
+fn a_renderer_does_not_keep_a_changed_intensity() {
+    use softraster::render::{Frame, Renderer};
+    let dir = scratch("env_stale");
+    write_env(&dir.join("env.exr"), 64, |_, _| [0.5; 3]);
+    let mut s = load(&dir, &sphere_scene(&dir, [0.0, 0.0, 5.0], "", ""));
+    let r = Renderer::new(&s);
+    r.render(&s, 0, 0, &mut Frame::new(0, 0));
+    s.environment.as_mut().unwrap().intensity = 2.0;
+    let mut f = Frame::new(0, 0);
+    r.render(&s, 0, 0, &mut f);
+    // kd 0.6 under radiance 0.5 x 2.
+    assert!(
+        (f.color[32 * 64 + 32].x - 0.6).abs() < 0.003,
+        "{}",
+        f.color[32 * 64 + 32]
+    );
+}

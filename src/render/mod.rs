@@ -75,6 +75,8 @@ pub struct Renderer {
     /// The scene's environment image, and its prefiltered lighting (built
     /// on the first frame).
     env_image: Option<Arc<EnvImage>>,
+    /// The environment's intensity and rotation its lighting is built with.
+    env_params: Option<(f32, f32)>,
     env: OnceLock<Option<EnvLight>>,
     /// `method = "sampled"`: the environment's sampling tables.
     env_sampler: OnceLock<Option<EnvSampler>>,
@@ -103,6 +105,10 @@ impl Renderer {
             mips: scene.textures.iter().map(|_| OnceLock::new()).collect(),
             textures: scene.textures.clone(),
             env_image: scene.environment.as_ref().map(|e| e.image.clone()),
+            env_params: scene
+                .environment
+                .as_ref()
+                .map(|e| (e.intensity, e.rotation)),
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
         }
@@ -145,8 +151,8 @@ impl Renderer {
         self.mips.get(id).is_some_and(|m| m.get().is_some())
     }
 
-    /// Whether `scene`'s meshes and textures are the ones this renderer
-    /// holds state for.
+    /// Whether `scene`'s meshes, textures and environment (image,
+    /// intensity, rotation) are the ones this renderer holds state for.
     fn serves(&self, scene: &Scene) -> bool {
         scene.models.len() == self.model_mesh.len()
             && scene
@@ -155,7 +161,9 @@ impl Renderer {
                 .zip(&self.model_mesh)
                 .all(|(m, &k)| Arc::ptr_eq(&m.mesh, &self.meshes[k]))
             && match (&scene.environment, &self.env_image) {
-                (Some(e), Some(i)) => Arc::ptr_eq(&e.image, i),
+                (Some(e), Some(i)) => {
+                    Arc::ptr_eq(&e.image, i) && self.env_params == Some((e.intensity, e.rotation))
+                }
                 (None, None) => true,
                 _ => false,
             }

@@ -196,15 +196,17 @@ impl ShadeContext<'_> {
     /// along the reflection with the GGX lobe that matches Ns (zero
     /// without an environment).
     fn env_blinn_phong(&self, s: &Surface, n: Vec3, c: &SurfaceColor) -> Vec3 {
-        let Some(env) = self.env else {
+        // illum 0 is the colour alone, without any light.
+        let Some(env) = self.env.filter(|_| c.illum > 0) else {
             return Vec3::ZERO;
         };
         let v = self.view_vector(s.position);
+        let roughness = crate::scene::material::roughness_from_ns(c.ns);
         if let Some((e, tracer, samples)) = self.env_sampled {
             let lobes = env_sampled::Lobes::BlinnPhong {
                 kd: c.kd,
                 ks: c.ks,
-                roughness: crate::scene::material::roughness_from_ns(c.ns),
+                roughness,
             };
             return env_sampled::radiance(
                 e,
@@ -221,7 +223,6 @@ impl ShadeContext<'_> {
         if c.ks == Vec3::ZERO {
             return diffuse;
         }
-        let roughness = crate::scene::material::roughness_from_ns(c.ns);
         let r = env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, roughness);
         diffuse + c.ks * env.prefiltered(r, roughness)
     }
@@ -412,8 +413,8 @@ impl ShadeContext<'_> {
 }
 
 /// Background pixel: linear color with alpha (0 for transparent); the
-/// environment backgrounds vary per pixel (`ShadeContext::env_background`)
-/// and are black here.
+/// environment backgrounds vary per pixel (the renderer looks them up
+/// along each pixel's ray) and are opaque black here.
 pub fn background(bg: Background) -> Vec4 {
     match bg {
         Background::Color(c) => c.extend(1.0),

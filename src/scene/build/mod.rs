@@ -116,6 +116,15 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let environment = match &d.environment {
         Some(e) => {
             let (env, sun) = environment(e.get_ref(), ctx, &scene_dir)?;
+            if let Some(v) = &e.get_ref().sun
+                && *v.get_ref()
+                && sun.is_none()
+            {
+                warnings.push(format!(
+                    "{}: environment.sun = true, but the image has no region bright enough to be a sun (its peak is under 20 times its mean): no sun light",
+                    ctx.location(v.span())
+                ));
+            }
             lights.extend(sun);
             Some(env)
         }

@@ -225,6 +225,32 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
             "output.background_blur has no effect: output.background is not \"blurred\"",
         );
     }
+    if let Some(e) = &d.environment {
+        let e = e.get_ref();
+        if !matches!(
+            e.method.as_ref().map(|m| *m.get_ref()),
+            Some(desc::EnvMethodName::Sampled)
+        ) {
+            warn(
+                e.samples.as_ref().map(|v| v.span()),
+                "environment.samples has no effect: environment.method is not \"sampled\"",
+            );
+        }
+    }
+    for c in &d.cameras {
+        let c = c.get_ref();
+        if c.eye.is_some() {
+            let why = "has no effect: the camera gives its eye (only fitted cameras take it)";
+            warn(
+                c.elevation.as_ref().map(|v| v.span()),
+                &format!("camera.elevation {why}"),
+            );
+            warn(
+                c.azimuth.as_ref().map(|v| v.span()),
+                &format!("camera.azimuth {why}"),
+            );
+        }
+    }
     if o.gif.is_none() {
         let why = "has no effect without output.gif";
         warn(
