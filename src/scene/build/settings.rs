@@ -13,7 +13,7 @@ use crate::scene::check_pattern;
 use crate::scene::desc::{self, Ctx, SceneDesc};
 use crate::scene::settings::{
     AoMethod, AoSettings, Background, OutputSettings, RenderSettings, ShadowBias, ShadowMethod,
-    TextureFilter,
+    TextureFilter, Tonemap,
 };
 
 /// An optional key's value, or the renderer's default for it.
@@ -52,7 +52,13 @@ pub(super) fn render(d: &SceneDesc) -> RenderSettings {
         address: pick(&r.address),
         cull: pick(&r.cull),
         depth: pick(&r.depth),
-        tonemap: pick(&r.tonemap),
+        // The default look keeps the studio's highlights: PBR Neutral
+        // leaves colours under 0.76 as they are and rolls off above.
+        tonemap: match &r.tonemap {
+            Some(t) => *t.get_ref(),
+            None if default_look => Tonemap::PbrNeutral,
+            None => Tonemap::default(),
+        },
         exposure: match r.exposure.as_ref().map(|e| *e.get_ref()) {
             Some(desc::Exposure::Stops(x)) => x,
             _ => 0.0,
@@ -268,9 +274,7 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::settings::{
-        AddressMode, CullMode, DepthMode, GifDither, ShadingMode, Tonemap,
-    };
+    use crate::scene::settings::{AddressMode, CullMode, DepthMode, GifDither, ShadingMode};
 
     fn parse(text: &str) -> SceneDesc {
         SceneDesc::parse(Path::new("s.toml"), text).unwrap()
@@ -287,7 +291,7 @@ mod tests {
         assert_eq!(s.address, AddressMode::Repeat);
         assert_eq!(s.cull, CullMode::Back);
         assert_eq!(s.depth, DepthMode::ReverseZ);
-        assert_eq!(s.tonemap, Tonemap::Clamp);
+        assert_eq!(s.tonemap, Tonemap::PbrNeutral);
         assert_eq!(s.exposure, 0.0);
         // No light and no environment: the default look (studio, blurred
         // background, no ambient).
@@ -303,6 +307,7 @@ mod tests {
         assert!(!default_look(&lit));
         assert_eq!(render(&lit).background, Background::Color(Vec3::ZERO));
         assert_eq!(render(&lit).ambient, Vec3::splat(0.03));
+        assert_eq!(render(&lit).tonemap, Tonemap::Clamp);
         let ctx = Ctx {
             file: Path::new("dir/s.toml"),
             text: "",
