@@ -339,7 +339,11 @@ fn load_options(sets: &[String], out_dir: Option<PathBuf>) -> Result<LoadOptions
         .iter()
         .map(|s| s.parse::<SetOverride>())
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(LoadOptions { sets, out_dir })
+    Ok(LoadOptions {
+        sets,
+        out_dir,
+        plain_look: false,
+    })
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {

@@ -487,3 +487,23 @@ fn a_model_file_renders_as_its_one_line_scene() {
     assert_eq!(code, 2);
     assert!(err.contains("--set render.ssaa=0"), "{err}");
 }
+
+#[test]
+fn the_measuring_tools_keep_version_1_defaults_for_scenes_without_lights() {
+    use softraster::scene::settings::{Background, Tonemap};
+    use softraster::scene::{LoadOptions, Scene};
+    let dir = common::scratch("plain_look");
+    write(&dir, "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let text = "[[model]]\npath = \"m.obj\"\n";
+    let look = Scene::from_text(&dir.join("s.toml"), text, &LoadOptions::default()).unwrap();
+    assert!(look.environment.is_some() && look.ground.is_some());
+    assert_eq!(look.settings.tonemap, Tonemap::PbrNeutral);
+    let plain = Scene::from_text(&dir.join("s.toml"), text, &LoadOptions::plain()).unwrap();
+    assert!(plain.environment.is_none() && plain.ground.is_none());
+    assert_eq!(plain.settings.tonemap, Tonemap::Clamp);
+    assert_eq!(
+        plain.settings.background,
+        Background::Color(glam::Vec3::ZERO)
+    );
+    assert_eq!(plain.settings.ambient, glam::Vec3::splat(0.03));
+}

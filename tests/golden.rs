@@ -47,6 +47,7 @@ impl Goldens {
                 .map(|s| s.parse::<SetOverride>().unwrap())
                 .collect(),
             out_dir: None,
+            plain_look: false,
         };
         let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
         let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);

@@ -321,7 +321,7 @@ fn render_state_carried_across_frames_changes_no_pixel() {
     ];
     let opts = LoadOptions {
         sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
-        out_dir: None,
+        ..Default::default()
     };
     let scene = Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
     let frame = |r: &Renderer, s: &Scene, f: u32| {

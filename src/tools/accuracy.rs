@@ -27,7 +27,7 @@ pub struct Row {
 }
 
 fn load(dir: &Path, text: &str) -> Result<Scene, Error> {
-    Scene::from_text(&dir.join("accuracy.toml"), text, &LoadOptions::default())
+    Scene::from_text(&dir.join("accuracy.toml"), text, &LoadOptions::plain())
 }
 
 /// Renders frames `frames` of `scene`: the frames and the median time.

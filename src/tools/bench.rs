@@ -195,7 +195,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     let mut scene = Scene::from_text(
         Path::new(&format!("bench-{case}.toml")),
         &text,
-        &LoadOptions::default(),
+        &LoadOptions::plain(),
     )?;
     // Mip chains are built when a frame first minifies a texture; the
     // benchmark builds them up front and counts them as loading.
@@ -452,7 +452,7 @@ pub fn filter_accuracy(dir: &Path, width: u32, height: u32) -> Result<Vec<Filter
              max_anisotropy = 16\nshading = \"unlit\"\n[[model]]\npath = \"plane.obj\"\n\
              [[camera]]\neye = [0.0, 0.6, 40.0]\ntarget = [3.0, 0.0, 20.0]\nfov = 50.0\nnear = 0.05\nfar = 200.0\n"
         );
-        Scene::from_text(&dir.join("filters.toml"), &text, &LoadOptions::default())
+        Scene::from_text(&dir.join("filters.toml"), &text, &LoadOptions::plain())
     };
     const SS: u32 = 16;
     let render = |s: &Scene| {

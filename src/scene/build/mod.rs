@@ -31,6 +31,21 @@ pub struct LoadOptions {
     pub sets: Vec<SetOverride>,
     /// `--out`: wins over `output.dir`.
     pub out_dir: Option<PathBuf>,
+    /// No default look: a scene without lights or environment gets a
+    /// headlight over black, no ground shadow, the clamp tone map (version
+    /// 1's defaults; the measuring tools use them so that their workloads
+    /// stay what they were).
+    pub plain_look: bool,
+}
+
+impl LoadOptions {
+    /// Version 1's defaults for scenes without lights (`plain_look`).
+    pub fn plain() -> LoadOptions {
+        LoadOptions {
+            plain_look: true,
+            ..LoadOptions::default()
+        }
+    }
 }
 
 impl Scene {
@@ -89,7 +104,8 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
-    let settings = settings::render(d);
+    let default_look = settings::default_look(d) && !opts.plain_look;
+    let settings = settings::render(d, default_look);
     let output = settings::output(
         d,
         ctx,
@@ -111,7 +127,6 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let aspect = settings.width as f32 / settings.height as f32;
     let subject = cameras::Subject::new(&models.models, &animation, aspect);
     let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras)?;
-    let default_look = settings::default_look(d);
     let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
     let environment = match &d.environment {
         Some(e) => {

@@ -33,10 +33,10 @@ pub(super) fn default_look(d: &SceneDesc) -> bool {
             .any(|m| m.get_ref().lights.as_ref().is_some_and(|l| *l.get_ref()))
 }
 
-/// `[render]`, `output.width/height/background` and `[ambient]`.
-pub(super) fn render(d: &SceneDesc) -> RenderSettings {
+/// `[render]`, `output.width/height/background` and `[ambient]`, with the
+/// defaults of the default look when `default_look`.
+pub(super) fn render(d: &SceneDesc, default_look: bool) -> RenderSettings {
     let (r, o) = (&d.render, &d.output);
-    let default_look = default_look(d);
     let lit_by_environment = d.environment.is_some() || default_look;
     let background = if default_look {
         Background::Blurred(0.5)
@@ -283,7 +283,7 @@ mod tests {
     #[test]
     fn defaults_when_the_file_says_nothing() {
         let d = parse("[[model]]\npath = \"m.obj\"\n");
-        let s = render(&d);
+        let s = render(&d, default_look(&d));
         assert_eq!((s.width, s.height, s.msaa, s.ssaa), (800, 800, 1, 1));
         assert_eq!(s.shading, ShadingMode::Auto);
         assert_eq!(s.texture_filter, TextureFilter::Anisotropic);
@@ -305,9 +305,12 @@ mod tests {
         // A light: version 1's defaults.
         let lit = parse("[[model]]\npath = \"m.obj\"\n[[light]]\n");
         assert!(!default_look(&lit));
-        assert_eq!(render(&lit).background, Background::Color(Vec3::ZERO));
-        assert_eq!(render(&lit).ambient, Vec3::splat(0.03));
-        assert_eq!(render(&lit).tonemap, Tonemap::Clamp);
+        assert_eq!(
+            render(&lit, default_look(&lit)).background,
+            Background::Color(Vec3::ZERO)
+        );
+        assert_eq!(render(&lit, default_look(&lit)).ambient, Vec3::splat(0.03));
+        assert_eq!(render(&lit, default_look(&lit)).tonemap, Tonemap::Clamp);
         let ctx = Ctx {
             file: Path::new("dir/s.toml"),
             text: "",
@@ -327,7 +330,7 @@ mod tests {
              tonemap = \"aces\"\nao = { method = \"ssao\" }\n\
              [output]\nbackground = \"transparent\"\ngif = \"a.gif\"\ngif_dither = \"floyd-steinberg\"\n",
         );
-        let s = render(&d);
+        let s = render(&d, default_look(&d));
         assert_eq!(s.shading, ShadingMode::BlinnPhong);
         assert_eq!(s.texture_filter, TextureFilter::Trilinear);
         assert_eq!(s.cull, CullMode::None);
@@ -348,8 +351,8 @@ mod tests {
     #[test]
     fn a_shadow_map_key_without_a_method_selects_pcf() {
         let d = parse("[[model]]\npath = \"m.obj\"\n[render]\nshadow_map_size = 1024\n");
-        assert_eq!(render(&d).shadows, ShadowMethod::Pcf);
+        assert_eq!(render(&d, default_look(&d)).shadows, ShadowMethod::Pcf);
         let d = parse("[[model]]\npath = \"m.obj\"\n[render]\nao = { method = \"raytraced\" }\n");
-        assert_eq!(render(&d).ao.samples, 64);
+        assert_eq!(render(&d, default_look(&d)).ao.samples, 64);
     }
 }
