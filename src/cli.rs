@@ -79,6 +79,19 @@ struct RenderArgs {
     /// No progress output.
     #[arg(long)]
     quiet: bool,
+    /// Treat every warning (a missing material library or texture, an
+    /// unknown MTL key, a setting without effect) as an error: exit 2.
+    #[arg(long)]
+    strict: bool,
+    /// Refuse (exit 2, with the estimate) to render when the estimated
+    /// memory exceeds SIZE (`512M`, `2G`, bytes); wins over
+    /// `render.max_memory`.
+    #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
+    max_memory: Option<u64>,
+}
+
+fn parse_memory(s: &str) -> Result<u64, String> {
+    softraster::scene::desc::parse_size(s)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -235,7 +248,7 @@ fn chart(args: ChartArgs) -> Result<(), Error> {
     if args.runs == 0 {
         return Err(Error::Argument("--runs must be at least 1".into()));
     }
-    let opts = load_options(&args.sets, None)?;
+    let opts = load_options(&args.sets, None, false)?;
     let out = args
         .out
         .clone()
@@ -333,8 +346,40 @@ fn gif(args: GifArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// `--max-memory` (or `render.max_memory`): the estimate against the
+/// limit, before the first frame.
+fn check_memory(scene: &Scene, flag: Option<u64>, args: &RenderArgs) -> Result<(), Error> {
+    let estimate = softraster::render::memory::estimate(scene, rayon::current_num_threads());
+    let Some(limit) = flag.or(scene.settings.max_memory) else {
+        return Ok(());
+    };
+    let what = if flag.is_some() {
+        "--max-memory"
+    } else {
+        "render.max_memory"
+    };
+    if estimate.total() > limit {
+        return Err(Error::Argument(format!(
+            "{}: the render needs about {estimate}, more than {what} {}",
+            args.scene.display(),
+            softraster::render::memory::human(limit)
+        )));
+    }
+    if !args.quiet {
+        eprintln!(
+            "memory: about {estimate}, within {what} {}",
+            softraster::render::memory::human(limit)
+        );
+    }
+    Ok(())
+}
+
 /// `--set` overrides (parsed) and `--out`, for loading a scene.
-fn load_options(sets: &[String], out_dir: Option<PathBuf>) -> Result<LoadOptions, Error> {
+fn load_options(
+    sets: &[String],
+    out_dir: Option<PathBuf>,
+    strict: bool,
+) -> Result<LoadOptions, Error> {
     let sets = sets
         .iter()
         .map(|s| s.parse::<SetOverride>())
@@ -343,11 +388,12 @@ fn load_options(sets: &[String], out_dir: Option<PathBuf>) -> Result<LoadOptions
         sets,
         out_dir,
         plain_look: false,
+        strict,
     })
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {
-    let opts = load_options(&args.sets, args.out.clone())?;
+    let opts = load_options(&args.sets, args.out.clone(), args.strict)?;
     let pool = thread_pool(args.threads)?;
     pool.install(|| {
         let t0 = std::time::Instant::now();
@@ -366,6 +412,7 @@ fn render(args: RenderArgs) -> Result<(), Error> {
                 eprintln!("warning: {w}");
             }
         }
+        check_memory(&scene, args.max_memory, &args)?;
         let plan = FramePlan::select(&scene, args.frames.as_deref(), args.camera.as_deref())?;
         let job = RenderJob {
             scene,

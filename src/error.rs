@@ -58,6 +58,13 @@ pub enum Error {
         message: String,
     },
 
+    /// `--strict` and the load gave warnings.
+    #[error("{}: --strict: {} warning(s) treated as errors:\n  {}", file.display(), warnings.len(), warnings.join("\n  "))]
+    Strict {
+        file: PathBuf,
+        warnings: Vec<String>,
+    },
+
     /// A command-line argument (or its library counterpart: a frame
     /// list, a `--set`, a camera name) is invalid.
     #[error("{0}")]
@@ -90,6 +97,7 @@ impl Error {
             Error::Scene { .. }
             | Error::SceneGlobal { .. }
             | Error::Asset { .. }
+            | Error::Strict { .. }
             | Error::Argument(_) => 2,
             Error::Io { .. } | Error::Encode { .. } | Error::Render(_) => 1,
         }

@@ -507,3 +507,66 @@ fn the_measuring_tools_keep_version_1_defaults_for_scenes_without_lights() {
     );
     assert_eq!(plain.settings.ambient, glam::Vec3::splat(0.03));
 }
+
+#[test]
+fn max_memory_refuses_before_rendering() {
+    let dir = common::scratch("max-memory");
+    let model = root().join("tests/wild/triangle.obj");
+    let m = model.to_string_lossy();
+    let out = dir.join("out");
+    let o = out.to_string_lossy();
+    // 2000x2000 needs far more than 8 MiB: refused, with the estimate,
+    // and no frame written.
+    let (code, err) = run(&[
+        "render",
+        &m,
+        "--out",
+        &o,
+        "--max-memory",
+        "8M",
+        "--set",
+        "output.width=2000",
+        "--set",
+        "output.height=2000",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("the render needs about") && err.contains("frame"),
+        "{err}"
+    );
+    assert!(err.contains("more than --max-memory 8.0 MiB"), "{err}");
+    assert!(!out.join("camera_0000.png").exists());
+    // The scene key, in the same words.
+    let (code, err) = run(&[
+        "render",
+        &m,
+        "--out",
+        &o,
+        "--set",
+        "render.max_memory=\"8M\"",
+        "--set",
+        "output.width=2000",
+        "--set",
+        "output.height=2000",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("more than render.max_memory 8.0 MiB"), "{err}");
+    // A bad size is an argument error; a generous limit renders.
+    let (code, err) = run(&["render", &m, "--out", &o, "--max-memory", "lots"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, err) = run(&[
+        "render",
+        &m,
+        "--out",
+        &o,
+        "--max-memory",
+        "2G",
+        "--set",
+        "output.width=64",
+        "--set",
+        "output.height=64",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("memory: about"), "{err}");
+    assert!(out.join("camera_0000.png").exists());
+}

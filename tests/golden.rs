@@ -48,6 +48,7 @@ impl Goldens {
                 .collect(),
             out_dir: None,
             plain_look: false,
+            strict: false,
         };
         let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
         let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);

@@ -19,7 +19,7 @@ use base64::Engine;
 use glam::{Affine2, Mat2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
-use super::mesh::{Group, Mesh};
+use super::mesh::{Group, Mesh, Primitive};
 use super::texture::Wrap;
 use super::texture::{AddressMode, TextureFilter};
 use crate::error::Error;
@@ -223,18 +223,53 @@ pub struct GltfModel {
     pub warnings: Vec<String>,
 }
 
+/// The version of a glTF 1.x file (`asset.version` "1.0", or a binary
+/// glTF with container version 1), None for anything else.
+fn version_1(bytes: &[u8]) -> Option<String> {
+    if bytes.starts_with(b"glTF") {
+        let v = u32::from_le_bytes(bytes.get(4..8)?.try_into().ok()?);
+        return (v == 1).then(|| "1.0 (binary)".to_string());
+    }
+    let json: serde_json::Value = serde_json::from_slice(bytes).ok()?;
+    let v = json.get("asset").and_then(|a| a.get("version"));
+    match v {
+        Some(serde_json::Value::String(s)) if s.starts_with("1.") => Some(s.clone()),
+        // 1.0 files may lack asset.version; their meshes, accessors and
+        // materials are objects keyed by id, not arrays.
+        None if json.get("meshes").is_some_and(|m| m.is_object()) => Some("1.0".into()),
+        _ => None,
+    }
+}
+
 pub fn load(path: &Path) -> Result<GltfModel, Error> {
     let bytes = std::fs::read(path)
         .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
     let err = |msg: String| Error::asset(path, None, msg);
+    if bytes.starts_with(b"glTF") && bytes.len() < 12 {
+        return Err(err(format!(
+            "truncated .glb: {} bytes, less than its 12-byte header",
+            bytes.len()
+        )));
+    }
     if bytes.starts_with(b"glTF") && bytes.len() >= 12 {
         let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        // (The gltf crate subtracts the header from this length unchecked.)
+        if declared < 12 {
+            return Err(err(format!(
+                "malformed .glb: its header declares {declared} bytes, less than the header itself"
+            )));
+        }
         if declared > bytes.len() {
             return Err(err(format!(
                 "truncated .glb: its header declares {declared} bytes, the file has {}",
                 bytes.len()
             )));
         }
+    }
+    if let Some(v) = version_1(&bytes) {
+        return Err(err(format!(
+            "glTF {v} is not supported; convert it to glTF 2.0 (e.g. with the Khronos glTF-Sample-Viewer's converter, `npx gltf-pipeline` from Cesium, or Blender's importer and exporter)"
+        )));
     }
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| err(format!("malformed glTF: {e}")))?;
@@ -256,16 +291,9 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
         any_color: false,
         any_tangent: false,
         default_material: None,
-        skipped_modes: BTreeSet::new(),
     };
     let mut placed = Placed::default();
     walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
-    for mode in &b.skipped_modes {
-        warnings.push(format!(
-            "{}: primitives of mode {mode} are not drawn (softraster draws triangles, strips and fans)",
-            path.display()
-        ));
-    }
     let mut mesh = b.finish();
     mesh.groups.retain(|g| !g.triangles.is_empty());
     Ok(GltfModel {
@@ -925,10 +953,58 @@ struct Builder {
     any_color: bool,
     any_tangent: bool,
     default_material: Option<usize>,
-    skipped_modes: BTreeSet<String>,
 }
 
 impl Builder {
+    /// Points, lines, line strips and loops: vertices as placed (normals
+    /// +Y, unused: they are drawn unlit), then the primitives.
+    fn add_points_or_lines(
+        &mut self,
+        prim: &gltf::Primitive,
+        buffers: &[Vec<u8>],
+        world: Mat4,
+        material: usize,
+    ) -> Result<(), String> {
+        let a = read_attributes(prim, buffers)?;
+        let base = self.mesh.positions.len() as u32;
+        let m = &mut self.mesh;
+        for (s, p) in a.positions.iter().enumerate() {
+            m.positions.push(world.transform_point3(*p));
+            m.normals.push(Vec3::Y);
+            for (list, set) in [&mut m.uvs, &mut m.uvs1].into_iter().zip(&a.uv) {
+                list.push(set.as_ref().map(|v| v[s]).unwrap_or(Vec2::ZERO));
+            }
+            m.colors
+                .push(a.colors.as_ref().map(|c| c[s]).unwrap_or(Vec4::ONE));
+            m.authored_tangents.push(Vec4::ZERO);
+        }
+        self.any_uv[0] |= a.uv[0].is_some();
+        self.any_uv[1] |= a.uv[1].is_some();
+        self.any_color |= a.colors.is_some();
+        let idx = &a.indices;
+        let seg = |i: u32, j: u32| Primitive {
+            vertices: [base + i, base + j],
+            material,
+        };
+        match prim.mode() {
+            Mode::Points => m.points.extend(idx.iter().map(|&i| Primitive {
+                vertices: [base + i],
+                material,
+            })),
+            Mode::Lines => m.lines.extend(idx.chunks_exact(2).map(|p| seg(p[0], p[1]))),
+            Mode::LineStrip => m.lines.extend(idx.windows(2).map(|p| seg(p[0], p[1]))),
+            _ => {
+                m.lines.extend(idx.windows(2).map(|p| seg(p[0], p[1])));
+                if let (Some(&first), Some(&last)) = (idx.first(), idx.last())
+                    && idx.len() > 2
+                {
+                    m.lines.push(seg(last, first));
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn add_primitive(
         &mut self,
         prim: &gltf::Primitive,
@@ -941,8 +1017,7 @@ impl Builder {
             mode,
             Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
         ) {
-            self.skipped_modes.insert(format!("{mode:?}"));
-            return Ok(());
+            return self.add_points_or_lines(prim, buffers, world, material);
         }
         let Attributes {
             positions,

@@ -14,6 +14,13 @@ pub struct Group {
     pub material: usize,
 }
 
+/// A point or line: its vertices and its material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Primitive<const N: usize> {
+    pub vertices: [u32; N],
+    pub material: usize,
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
@@ -34,6 +41,13 @@ pub struct Mesh {
     /// Counter-clockwise triangles (front faces).
     pub triangles: Vec<[u32; 3]>,
     pub groups: Vec<Group>,
+    /// Line segments (OBJ `l`, glTF lines, strips and loops): two vertices
+    /// and a material, drawn as anti-aliased lines `render.line_width`
+    /// pixels wide.
+    pub lines: Vec<Primitive<2>>,
+    /// Points (OBJ `p`, glTF points), drawn as discs `render.point_size`
+    /// pixels across.
+    pub points: Vec<Primitive<1>>,
     /// Per triangle corner (3 per triangle): unit tangent (xyz) and
     /// bitangent sign (w), MikkTSpace; empty unless a normal or bump map
     /// needs them (`compute_tangents`).
@@ -51,6 +65,40 @@ impl Mesh {
     pub fn has_uvs(&self) -> bool {
         !self.uvs.is_empty()
     }
+
+    /// Whether the surface is closed and consistently wound: every edge
+    /// (between positions, so UV seams and split normals do not open it)
+    /// is used once in each direction. Degenerate triangles are ignored.
+    pub fn is_closed(&self) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let mut weld: HashMap<[u32; 3], u32> = HashMap::new();
+        let ids: Vec<u32> = self
+            .positions
+            .iter()
+            .map(|p| {
+                let n = weld.len() as u32;
+                *weld
+                    .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                    .or_insert(n)
+            })
+            .collect();
+        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| ids[i as usize]);
+            if a == b || b == c || a == c {
+                continue;
+            }
+            for e in [(a, b), (b, c), (c, a)] {
+                *edges.entry(e).or_insert(0) += 1;
+            }
+        }
+        !edges.is_empty()
+            && edges
+                .iter()
+                .all(|(&(u, v), &n)| n == 1 && edges.get(&(v, u)) == Some(&1))
+    }
 }
 
 impl Mesh {
@@ -64,15 +112,24 @@ impl Mesh {
         let n = self.triangles.len() * 3;
         self.tangents = vec![glam::Vec4::ZERO; n];
         let uvs = if set == 1 { &self.uvs1 } else { &self.uvs };
-        if !uvs.is_empty() {
+        let faces = if uvs.len() == self.positions.len() {
+            self.mikk_safe_faces(uvs)
+        } else {
+            Vec::new()
+        };
+        if !faces.is_empty() {
             let mut g = MikkGeometry {
                 mesh: self,
                 uvs,
-                out: vec![glam::Vec4::ZERO; n],
+                faces: &faces,
+                out: vec![glam::Vec4::ZERO; faces.len() * 3],
             };
             mikktspace::generate_tangents(&mut g);
             let out = g.out;
-            self.tangents = out;
+            for (k, &f) in faces.iter().enumerate() {
+                self.tangents[f as usize * 3..f as usize * 3 + 3]
+                    .copy_from_slice(&out[k * 3..k * 3 + 3]);
+            }
         }
         for (c, t) in self.tangents.iter_mut().enumerate() {
             let vi = self.triangles[c / 3][c % 3] as usize;
@@ -97,27 +154,71 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// The triangles MikkTSpace may see: three distinct, finite positions
+    /// spanning a non-zero area, finite normals and UVs, in a set whose
+    /// extent is finite. mikktspace 0.3 is unsafe code that reads out of
+    /// bounds when every triangle is degenerate, panics on an infinite or
+    /// zero extent and loops forever on NaN; the rest get fallback tangents.
+    fn mikk_safe_faces(&self, uvs: &[Vec2]) -> Vec<u32> {
+        let ok = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+            let finite = t.iter().all(|&i| {
+                self.positions[i as usize].is_finite()
+                    && self.normals[i as usize].is_finite()
+                    && uvs[i as usize].is_finite()
+            });
+            finite && a != b && b != c && a != c && {
+                let n = (b - a).cross(c - a);
+                n.is_finite() && n != Vec3::ZERO
+            }
+        };
+        let faces: Vec<u32> = (0..self.triangles.len() as u32)
+            .filter(|&f| ok(&self.triangles[f as usize]))
+            .collect();
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for &f in &faces {
+            for &i in &self.triangles[f as usize] {
+                lo = lo.min(self.positions[i as usize]);
+                hi = hi.max(self.positions[i as usize]);
+            }
+        }
+        if faces.is_empty() || !(hi - lo).is_finite() {
+            return Vec::new();
+        }
+        faces
+    }
+}
+
+/// The mesh's safe faces, as MikkTSpace's geometry.
 struct MikkGeometry<'a> {
     mesh: &'a Mesh,
     uvs: &'a [Vec2],
+    faces: &'a [u32],
     out: Vec<glam::Vec4>,
+}
+
+impl MikkGeometry<'_> {
+    fn vertex(&self, face: usize, vert: usize) -> usize {
+        self.mesh.triangles[self.faces[face] as usize][vert] as usize
+    }
 }
 
 impl mikktspace::Geometry for MikkGeometry<'_> {
     fn num_faces(&self) -> usize {
-        self.mesh.triangles.len()
+        self.faces.len()
     }
     fn num_vertices_of_face(&self, _face: usize) -> usize {
         3
     }
     fn position(&self, face: usize, vert: usize) -> [f32; 3] {
-        self.mesh.positions[self.mesh.triangles[face][vert] as usize].to_array()
+        self.mesh.positions[self.vertex(face, vert)].to_array()
     }
     fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
-        self.mesh.normals[self.mesh.triangles[face][vert] as usize].to_array()
+        self.mesh.normals[self.vertex(face, vert)].to_array()
     }
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        let uv = self.uvs[self.mesh.triangles[face][vert] as usize];
+        let uv = self.uvs[self.vertex(face, vert)];
         [uv.x, 1.0 - uv.y]
     }
     fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
@@ -225,6 +326,65 @@ mod tests {
             let t = m.tangents[c];
             assert!(t.is_finite() && (t.truncate().length() - 1.0).abs() < 1e-4);
             assert!(t.truncate().dot(Vec3::Z).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn closed_meshes_are_told_from_open_ones() {
+        // A tetrahedron, counter-clockwise from outside.
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let mut m = Mesh {
+            positions: p,
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            ..Default::default()
+        };
+        assert!(m.is_closed());
+        // A seam: vertex 3 duplicated at the same position stays closed.
+        m.positions.push(Vec3::Z);
+        m.triangles[3] = [1, 2, 4];
+        assert!(m.is_closed());
+        // One face flipped: inconsistent winding.
+        m.triangles[3] = [2, 1, 4];
+        assert!(!m.is_closed());
+        // One face missing: open.
+        m.triangles.truncate(3);
+        assert!(!m.is_closed());
+        assert!(!Mesh::default().is_closed());
+    }
+
+    #[test]
+    fn tangents_of_hostile_meshes() {
+        // Found by fuzzing mikktspace 0.3: all faces degenerate (out-of-
+        // bounds reads), zero and infinite extents (panic), NaN (hang).
+        let mk = |positions: Vec<Vec3>, triangles: Vec<[u32; 3]>| Mesh {
+            normals: vec![Vec3::Z; positions.len()],
+            uvs: (0..positions.len())
+                .map(|i| Vec2::splat(i as f32))
+                .collect(),
+            positions,
+            triangles,
+            ..Default::default()
+        };
+        let cases = [
+            mk(vec![Vec3::ZERO, Vec3::X], vec![[0, 1, 1], [1, 1, 0]]),
+            mk(vec![Vec3::ONE; 3], vec![[0, 1, 2]]),
+            mk(
+                vec![
+                    Vec3::new(-3e38, 0.0, 0.0),
+                    Vec3::new(3e38, 0.0, 0.0),
+                    Vec3::Y,
+                ],
+                vec![[0, 1, 2]],
+            ),
+            mk(
+                vec![Vec3::NAN, Vec3::X, Vec3::Y],
+                vec![[0, 1, 2], [2, 1, 0]],
+            ),
+        ];
+        for mut m in cases {
+            m.compute_tangents(0);
+            assert_eq!(m.tangents.len(), m.triangles.len() * 3);
+            assert!(m.tangents.iter().all(|t| t.is_finite()), "{:?}", m.tangents);
         }
     }
 

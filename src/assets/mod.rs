@@ -1,9 +1,12 @@
-//! Asset loaders: meshes and materials from OBJ/MTL and glTF, textures from
-//! images.
+//! Asset loaders: meshes and materials from OBJ/MTL, glTF, STL and PLY,
+//! textures from images.
 
 pub mod environment;
 pub mod gltf;
 pub mod mesh;
 pub mod mip;
 pub mod obj;
+pub mod ply;
+pub mod stl;
+pub mod text;
 pub mod texture;

@@ -13,11 +13,31 @@ pub mod setup;
 /// Which triangles setup discards by their winding on screen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CullMode {
-    /// Counter-clockwise triangles face the camera; clockwise ones go.
+    /// Back for closed meshes and glTF materials that are not doubleSided,
+    /// None for the rest (the scene decides per draw; see `resolve`).
     #[default]
+    Auto,
+    /// Counter-clockwise triangles face the camera; clockwise ones go.
     Back,
     Front,
     None,
+}
+
+impl CullMode {
+    /// The mode for one draw under `Auto`: formats that state sidedness
+    /// (glTF's `doubleSided`) are taken at their word; for the others
+    /// (OBJ, STL, PLY) a closed mesh, whose back faces can never be seen,
+    /// is culled and an open one is drawn two-sided.
+    pub fn resolve(self, double_sided: bool, states_sidedness: bool, closed: bool) -> CullMode {
+        if double_sided {
+            return CullMode::None;
+        }
+        match self {
+            CullMode::Auto if states_sidedness || closed => CullMode::Back,
+            CullMode::Auto => CullMode::None,
+            m => m,
+        }
+    }
 }
 
 /// How view distance maps to stored depth.

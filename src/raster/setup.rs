@@ -137,6 +137,16 @@ pub fn setup(
         let iw = 1.0 / p.w as f64;
         let sx = (p.x as f64 * iw * 0.5 + 0.5) * w;
         let sy = (0.5 - p.y as f64 * iw * 0.5) * h;
+        // Clipping keeps vertices inside the guard band (2^14 pixels from
+        // the center); one beyond 1.25 times that (or not finite) comes
+        // from a numerical breakdown on extreme input and is dropped. With
+        // |dx|, |dy| <= 2.5 * 2^14 pixels = 2^(15.33 + SUBPIXEL_BITS) fixed
+        // point, area2 <= 2 * 2^60.7 < 2^63: no i64 overflow below.
+        const LIMIT: f64 = 1.25 * 16384.0;
+        let inside = |d: f64| d.abs() <= LIMIT; // false for NaN
+        if !(inside(sx - w * 0.5) && inside(sy - h * 0.5)) {
+            return None;
+        }
         x[k] = (sx * SUBPIXEL as f64).round() as i32;
         y[k] = (sy * SUBPIXEL as f64).round() as i32;
         z[k] = (p.z as f64 * iw) as f32;

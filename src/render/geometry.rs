@@ -93,12 +93,12 @@ pub(super) fn setup_and_bin(
         .map(|&(di, start, end)| {
             let d = draws[di];
             let material = &scene.models[d.model].materials[d.material];
-            // glTF doubleSided materials are never culled.
-            let cull = if material.double_sided {
-                CullMode::None
-            } else {
-                scene.settings.cull
-            };
+            let model = &scene.models[d.model];
+            let cull = scene.settings.cull.resolve(
+                material.double_sided,
+                material.native == crate::scene::material::Native::Pbr,
+                model.closed,
+            );
             let measure = densities && material.maps().next().is_some();
             let (tris, density) =
                 setup_range(fs, &verts[d.model], d, di, start..end, vp, cull, measure);

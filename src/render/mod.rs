@@ -26,6 +26,8 @@ mod exposure;
 mod frame;
 mod geometry;
 mod ground;
+mod lines;
+pub mod memory;
 mod rays;
 mod setup;
 mod shadow_pass;
@@ -261,6 +263,9 @@ impl Renderer {
         ctx.pixel_scale = width as f32 / s.width as f32;
         let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered, tracer.as_ref());
         self.bands(&data, &geo, tracer.as_ref(), out);
+        if !s.shading.is_data_view() {
+            lines::draw(fs, &verts, width as f32 / s.width as f32, out);
+        }
     }
 
     /// Visibility, AO and shading, band by band, into `out`.

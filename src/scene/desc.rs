@@ -128,6 +128,15 @@ pub struct RenderDesc {
     /// Extension: shadow-map bias in texels.
     pub shadow_bias: Option<S<ShadowBiasDesc>>,
     pub ao: Option<S<AoDesc>>,
+    /// Extension: refuse to render when the memory estimate exceeds this
+    /// (`"512M"`, `"2G"`, or bytes).
+    pub max_memory: Option<S<MemorySize>>,
+    /// Points (OBJ `p`, glTF points) are discs this many output pixels
+    /// across (default 4).
+    pub point_size: Option<S<f32>>,
+    /// Lines (OBJ `l`, glTF lines) are this many output pixels wide
+    /// (default 1.5).
+    pub line_width: Option<S<f32>>,
     pub tonemap: Option<S<Tonemap>>,
     /// Stops, or "auto" (version 2).
     pub exposure: Option<S<Exposure>>,
@@ -175,6 +184,61 @@ pub struct ModelDesc {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scale(pub [f32; 3]);
+
+/// A memory size in bytes, written `"512M"`, `"1.5G"` or as a number of
+/// bytes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MemorySize(pub u64);
+
+impl<'de> Deserialize<'de> for MemorySize {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = MemorySize;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a size like \"512M\" or \"2G\", or a number of bytes")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<MemorySize, E> {
+                parse_size(s).map(MemorySize).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<MemorySize, E> {
+                u64::try_from(v)
+                    .ok()
+                    .filter(|v| *v > 0)
+                    .map(MemorySize)
+                    .ok_or_else(|| E::invalid_value(de::Unexpected::Signed(v), &self))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Parses a memory size: bytes, or a number with K, M, G or T (powers of 1024;
+/// `KiB`, `MB` and the like read the same), e.g. `512M`, `1.5G`.
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("`{s}` is not a size: expected e.g. 512M, 2G or 1048576"))?;
+    let unit = unit.trim().to_ascii_uppercase();
+    let shift = match unit.trim_end_matches("IB").trim_end_matches('B') {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(format!("`{s}`: unknown unit `{unit}` (use K, M, G or T)")),
+    };
+    let bytes = v * (1u64 << shift) as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes > u64::MAX as f64 {
+        return Err(format!("`{s}` is not a usable size"));
+    }
+    Ok(bytes as u64)
+}
 
 /// Overrides of MTL values; keys are the MTL keys in lower case.
 #[derive(Debug, Deserialize, Default, Clone)]
@@ -326,7 +390,7 @@ file_names!(TextureFilter {
 file_names!(AddressMode {
     "repeat" => Repeat, "mirror" => Mirror, "clamp" => Clamp, "border" => Border,
 });
-file_names!(CullMode { "back" => Back, "front" => Front, "none" => None });
+file_names!(CullMode { "auto" => Auto, "back" => Back, "front" => Front, "none" => None });
 file_names!(DepthMode { "reverse-z" => ReverseZ, "standard" => Standard });
 file_names!(ShadowMethod {
     "off" => Off, "hard" => Hard, "pcf" => Pcf, "raytraced" => Raytraced,
@@ -514,6 +578,8 @@ impl SceneDesc {
             ));
         }
         c.int_range(&r.ssaa, "render.ssaa", 1, 16)?;
+        c.float_range(&r.point_size, "render.point_size", 0.5, 256.0)?;
+        c.float_range(&r.line_width, "render.line_width", 0.25, 256.0)?;
         if let Some(k) = &r.ssaa {
             let side = get_i64(&o.width, 800).max(get_i64(&o.height, 800));
             if side * k.get_ref() > 16384 {
@@ -811,6 +877,23 @@ mod tests {
 
     fn parse(t: &str) -> Result<SceneDesc, Error> {
         SceneDesc::parse(Path::new("t.toml"), t)
+    }
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("1048576"), Ok(1 << 20));
+        assert_eq!(parse_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_size("512MiB"), Ok(512 << 20));
+        assert_eq!(parse_size("1.5G"), Ok(3 << 29));
+        assert_eq!(parse_size("2 gb"), Ok(2 << 30));
+        assert!(parse_size("lots").is_err());
+        assert!(parse_size("5X").is_err());
+        assert!(parse_size("0").is_err());
+        let m = "[[model]]\npath = \"a.obj\"\n";
+        let s = parse(&format!("{m}[render]\nmax_memory = \"64M\"\n")).unwrap();
+        assert_eq!(s.render.max_memory.map(|m| m.get_ref().0), Some(64 << 20));
+        let e = parse(&format!("{m}[render]\nmax_memory = \"a lot\"\n")).unwrap_err();
+        assert!(e.to_string().contains("is not a size"), "{e}");
     }
 
     #[test]

@@ -36,6 +36,9 @@ pub struct Model {
     pub materials: Vec<Material>,
     /// Placement at rest (before any turntable turn).
     pub world_from_object: Mat4,
+    /// Every edge shared by exactly two faces in opposite directions
+    /// (`Mesh::is_closed`): `render.cull = "auto"` culls its back faces.
+    pub closed: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -99,7 +102,9 @@ pub fn expand_pattern(pattern: &str, scene: &str, camera: &str, frame: u32) -> S
             "scene" => out.push_str(scene),
             "camera" => out.push_str(camera),
             "frame" => {
-                let width: usize = fmt.trim_start_matches('0').parse().unwrap_or(0);
+                // check_pattern refuses wider fields; the cap keeps
+                // `format!` in range whatever it is handed.
+                let width: usize = fmt.trim_start_matches('0').parse().unwrap_or(0).min(9);
                 out.push_str(&format!("{frame:0width$}"));
             }
             _ => out.push_str(&rest[open..=open + close]),
@@ -124,6 +129,14 @@ pub fn check_pattern(pattern: &str) -> Result<(), String> {
             return Err(format!(
                 "unknown field `{{{field}}}` in `{pattern}`: expected {{scene}}, {{camera}}, {{frame}} or {{frame:04}}"
             ));
+        }
+        if name == "frame" && fmt.len() > 1 {
+            let width: usize = fmt.trim_start_matches('0').parse().unwrap_or(usize::MAX);
+            if width > 9 {
+                return Err(format!(
+                    "`{{{field}}}` in `{pattern}`: a frame number has at most 9 digits (u32); use a width of 1 to 9, e.g. {{frame:04}}"
+                ));
+            }
         }
         rest = &rest[open + close + 1..];
     }
@@ -153,5 +166,10 @@ mod tests {
         assert!(check_pattern("{cam}").is_err());
         assert!(check_pattern("a/{frame}").is_err());
         assert!(check_pattern("{frame").is_err());
+        assert!(check_pattern("{frame:09}").is_ok());
+        assert!(check_pattern("{frame:010}").is_err());
+        assert!(check_pattern("{frame:070000}").is_err());
+        assert!(check_pattern("{frame:0999999999999999999999}").is_err());
+        assert_eq!(expand_pattern("{frame:070000}", "s", "c", 7), "000000007");
     }
 }

@@ -141,6 +141,12 @@ pub struct RenderSettings {
     pub msaa: u32,
     /// Supersampling factor per axis (1: off).
     pub ssaa: u32,
+    /// `render.max_memory` (bytes): refuse to render when the estimate
+    /// (`render::memory`) exceeds it. `--max-memory` wins.
+    pub max_memory: Option<u64>,
+    /// Output pixels across a point and a line.
+    pub point_size: f32,
+    pub line_width: f32,
 }
 
 /// Shadow-map bias, in texels of the map at the receiver.

@@ -234,7 +234,8 @@ impl Shadows<'_> {
         };
         // The plane's slope, capped like the slope bias.
         let cap = z_per_texel * MAX_TAN;
-        let (gx, gy) = (gx.clamp(-cap, cap), gy.clamp(-cap, cap));
+        // (min/max, not clamp: with extreme geometry cap can be NaN.)
+        let (gx, gy) = (gx.max(-cap).min(cap), gy.max(-cap).min(cap));
         if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size {
             return 1.0;
         }

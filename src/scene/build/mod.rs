@@ -33,9 +33,12 @@ pub struct LoadOptions {
     pub out_dir: Option<PathBuf>,
     /// No default look: a scene without lights or environment gets a
     /// headlight over black, no ground shadow, the clamp tone map (version
-    /// 1's defaults; the measuring tools use them so that their workloads
-    /// stay what they were).
+    /// 1's defaults, back-face culling included; the measuring tools use
+    /// them so that their workloads stay what they were).
     pub plain_look: bool,
+    /// `--strict`: every warning (a missing material library or texture,
+    /// an unknown MTL key, a setting without effect) is an error.
+    pub strict: bool,
 }
 
 impl LoadOptions {
@@ -76,14 +79,21 @@ impl Scene {
     pub fn from_text(path: &Path, text: &str, opts: &LoadOptions) -> Result<Scene, Error> {
         let desc = SceneDesc::parse(path, text)?;
         let ctx = Ctx { file: path, text };
-        build(&desc, &ctx, opts)
+        let scene = build(&desc, &ctx, opts)?;
+        if opts.strict && !scene.warnings.is_empty() {
+            return Err(Error::Strict {
+                file: path.to_path_buf(),
+                warnings: scene.warnings,
+            });
+        }
+        Ok(scene)
     }
 }
 
 /// The one-line scene of a model file, or None for other files.
 fn model_as_scene(path: &Path) -> Option<String> {
     let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
-    if !matches!(ext.as_str(), "gltf" | "glb" | "obj") {
+    if !matches!(ext.as_str(), "gltf" | "glb" | "obj" | "stl" | "ply") {
         return None;
     }
     let name = path.file_name()?.to_string_lossy().into_owned();
@@ -105,7 +115,12 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
     let default_look = settings::default_look(d) && !opts.plain_look;
-    let settings = settings::render(d, default_look);
+    let mut settings = settings::render(d, default_look);
+    if opts.plain_look && d.render.cull.is_none() {
+        // Version 1 culled back faces everywhere; the measuring tools'
+        // workloads (the llvmpipe anchor culls) stay what they were.
+        settings.cull = crate::scene::settings::CullMode::Back;
+    }
     let output = settings::output(
         d,
         ctx,

@@ -74,7 +74,7 @@ pub(super) fn build(
     );
     let normals_view = settings.shading == crate::scene::settings::ShadingMode::Normals;
     let (textures, by_key) = if textured {
-        decode_textures(d, &files, &model_mats, normals_view)?
+        decode_textures(d, &files, &model_mats, normals_view, warnings)?
     } else {
         (Vec::new(), BTreeMap::new())
     };
@@ -99,9 +99,15 @@ pub(super) fn build(
             if let SourceMaterial::Mtl(mm) = mm
                 && let Some(spec) = &mm.mtl.disp
             {
-                displace(&mut mesh, gi, spec, mm.disp_scale)?;
+                // Lenient: a displacement map that cannot be read leaves
+                // the surface as it is.
+                if let Err(e) = displace(&mut mesh, gi, spec, mm.disp_scale) {
+                    warnings.push(format!("{e}; the surface is not displaced"));
+                }
             }
         }
+        // After displacement, which can move positions anywhere.
+        check_magnitude(md, ctx, &mesh, world)?;
         if textured && let Some(set) = tangent_set(&materials) {
             mesh.compute_tangents(set);
         }
@@ -112,6 +118,7 @@ pub(super) fn build(
                 .as_ref()
                 .map(|n| n.get_ref().clone())
                 .unwrap_or_else(|| format!("model{i}")),
+            closed: mesh.is_closed(),
             mesh: Arc::new(mesh),
             materials,
             world_from_object: world,
@@ -206,6 +213,7 @@ fn decode_textures(
     files: &Files,
     model_mats: &[Vec<SourceMaterial>],
     normals_view: bool,
+    warnings: &mut Vec<String>,
 ) -> Result<(Vec<Arc<Texture>>, TextureKeys), Error> {
     let mut wanted: BTreeMap<(PathBuf, bool), ImageSource> = BTreeMap::new();
     for (m, mats) in d.models.iter().zip(model_mats) {
@@ -223,25 +231,33 @@ fn decode_textures(
         }
     }
     let keys: Vec<_> = wanted.iter().collect();
-    let decoded: Vec<Arc<Texture>> = keys
+    let results: Vec<Result<Texture, Error>> = keys
         .par_iter()
-        .enumerate()
-        .map(|(id, ((_, srgb), img))| {
-            let t = match img {
-                ImageSource::File(p) => Texture::load(p, *srgb),
-                ImageSource::Memory { name, bytes } => Texture::from_bytes(bytes, name, *srgb),
-            };
-            t.map(|mut t| {
-                t.id = id;
-                Arc::new(t)
-            })
+        .map(|((_, srgb), img)| match img {
+            ImageSource::File(p) => Texture::load(p, *srgb),
+            ImageSource::Memory { name, bytes } => Texture::from_bytes(bytes, name, *srgb),
         })
-        .collect::<Result<_, _>>()?;
-    let by_key = keys
-        .iter()
-        .map(|(k, _)| (*k).clone())
-        .zip(decoded.iter().cloned())
         .collect();
+    // Lenient: a texture that cannot be read is a warning, and the
+    // materials that use it render without that map. Ids follow the
+    // readable images' sorted order.
+    let mut decoded = Vec::new();
+    let mut by_key = TextureKeys::new();
+    for ((key, _), r) in keys.iter().zip(results) {
+        match r {
+            Ok(mut t) => {
+                t.id = decoded.len();
+                let t = Arc::new(t);
+                decoded.push(t.clone());
+                by_key.insert((*key).clone(), t);
+            }
+            Err(e) => {
+                if !warnings.iter().any(|w| w.starts_with(&e.to_string())) {
+                    warnings.push(format!("{e}; rendering without this map"));
+                }
+            }
+        }
+    }
     Ok((decoded, by_key))
 }
 
@@ -340,6 +356,24 @@ impl SourceModel {
                 warnings: std::mem::take(&mut g.warnings),
                 gltf: Some(g),
             })
+        } else if ext == "stl" || ext == "ply" {
+            let mesh = if ext == "stl" {
+                crate::assets::stl::load(path)?
+            } else {
+                crate::assets::ply::load(path)?
+            };
+            Ok(SourceModel {
+                mesh,
+                materials: vec![SourceMaterial::Mtl(Box::new(MtlSource::new(
+                    obj::MtlMaterial {
+                        name: "default".into(),
+                        synthetic: true,
+                        ..Default::default()
+                    },
+                )))],
+                gltf: None,
+                warnings: Vec::new(),
+            })
         } else {
             let o = obj::load(path)?;
             Ok(SourceModel {
@@ -350,10 +384,46 @@ impl SourceModel {
                     .map(|m| SourceMaterial::Mtl(Box::new(MtlSource::new(m))))
                     .collect(),
                 gltf: None,
-                warnings: Vec::new(),
+                warnings: o.warnings,
             })
         }
     }
+}
+
+/// Largest world-space coordinate magnitude accepted: squared distances
+/// of such points (1e36) stay finite in f32, with room for the products
+/// of camera and light transforms.
+const MAX_COORDINATE: f32 = 1e18;
+
+/// Refuses a model whose placed positions are not finite or so large that
+/// f32 arithmetic on them (squares, projections) would overflow.
+fn check_magnitude(md: &desc::ModelDesc, ctx: &Ctx, mesh: &Mesh, world: Mat4) -> Result<(), Error> {
+    let worst = mesh
+        .positions
+        .iter()
+        .map(|p| world.transform_point3(*p).abs().max_element())
+        .fold(0.0f32, |a, b| {
+            if b.is_nan() || a.is_nan() {
+                f32::NAN
+            } else {
+                a.max(b)
+            }
+        });
+    if worst <= MAX_COORDINATE {
+        return Ok(());
+    }
+    let what = if worst.is_nan() {
+        "placed (or displaced) positions are not finite".to_string()
+    } else {
+        format!("placed positions reach {worst:e}")
+    };
+    Err(ctx.err(
+        md.path.span(),
+        format!(
+            "{}: {what}; coordinates beyond {MAX_COORDINATE:e} overflow 32-bit float arithmetic: scale the model down (model.scale or normalize = true)",
+            md.path.get_ref()
+        ),
+    ))
 }
 
 fn resolve(base: &Path, p: &str) -> PathBuf {

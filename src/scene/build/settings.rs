@@ -51,6 +51,9 @@ pub(super) fn render(d: &SceneDesc, default_look: bool) -> RenderSettings {
         max_anisotropy: get(&r.max_anisotropy, 16) as f32,
         address: pick(&r.address),
         cull: pick(&r.cull),
+        max_memory: r.max_memory.as_ref().map(|m| m.get_ref().0),
+        point_size: get(&r.point_size, 4.0),
+        line_width: get(&r.line_width, 1.5),
         depth: pick(&r.depth),
         // The default look keeps the studio's highlights: PBR Neutral
         // leaves colours under 0.76 as they are and rolls off above.
@@ -289,7 +292,7 @@ mod tests {
         assert_eq!(s.texture_filter, TextureFilter::Anisotropic);
         assert_eq!(s.max_anisotropy, 16.0);
         assert_eq!(s.address, AddressMode::Repeat);
-        assert_eq!(s.cull, CullMode::Back);
+        assert_eq!(s.cull, CullMode::Auto);
         assert_eq!(s.depth, DepthMode::ReverseZ);
         assert_eq!(s.tonemap, Tonemap::PbrNeutral);
         assert_eq!(s.exposure, 0.0);

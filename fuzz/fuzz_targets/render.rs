@@ -1,0 +1,103 @@
+//! The render path: a tiny scene built from fuzzed geometry (raw f32 bits,
+//! so extreme and tiny magnitudes), a fuzzed light, camera, shadow, AO,
+//! cull and anti-aliasing settings, rendered at 32x32. This is the target
+//! that finds arithmetic overflow (debug assertions are on).
+
+#![no_main]
+#[path = "common.rs"]
+mod common;
+
+use common::toml_f32;
+use libfuzzer_sys::fuzz_target;
+
+struct Bytes<'a>(&'a [u8]);
+
+impl Bytes<'_> {
+    fn u8(&mut self) -> u8 {
+        let (b, rest) = self
+            .0
+            .split_first()
+            .map(|(b, r)| (*b, r))
+            .unwrap_or((0, &[]));
+        self.0 = rest;
+        b
+    }
+    /// A quarter of the time raw f32 bits (extreme, tiny, non-finite
+    /// values), otherwise a modest number (-128..128 in steps of 1/256),
+    /// so most scenes load and render.
+    fn f32(&mut self) -> f32 {
+        if self.u8() % 4 == 0 {
+            f32::from_le_bytes([self.u8(), self.u8(), self.u8(), self.u8()])
+        } else {
+            i16::from_le_bytes([self.u8(), self.u8()]) as f32 / 256.0
+        }
+    }
+    fn pick<'s>(&mut self, options: &[&'s str]) -> &'s str {
+        options[self.u8() as usize % options.len()]
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut b = Bytes(data);
+    let n_verts = 3 + b.u8() as usize % 30;
+    let n_tris = 1 + b.u8() as usize % 40;
+    let mut obj = String::new();
+    for _ in 0..n_verts {
+        let (x, y, z) = (b.f32(), b.f32(), b.f32());
+        obj += &format!("v {x:?} {y:?} {z:?}\n");
+    }
+    for _ in 0..n_tris {
+        let (i, j, k) = (
+            1 + b.u8() as usize % n_verts,
+            1 + b.u8() as usize % n_verts,
+            1 + b.u8() as usize % n_verts,
+        );
+        obj += &format!("f {i} {j} {k}\n");
+    }
+    let dir = common::dir();
+    if std::fs::write(dir.join("render.obj"), obj).is_err() {
+        return;
+    }
+    let light = b.pick(&["point", "directional", "spot"]);
+    let (lx, ly, lz) = (b.f32(), b.f32(), b.f32());
+    let shadows = b.pick(&["\"hard\"", "\"pcf\"", "\"raytraced\""]);
+    let ao = b.pick(&[
+        "",
+        "ao = { method = \"ssao\" }\n",
+        "ao = { method = \"raytraced\", samples = 2 }\n",
+    ]);
+    let cull = b.pick(&["auto", "back", "front", "none"]);
+    let msaa = b.pick(&["1", "4"]);
+    let ssaa = b.pick(&["1", "2"]);
+    let ground = b.pick(&["false", "true"]);
+    let camera = match b.u8() % 3 {
+        0 => String::new(),
+        1 => format!(
+            "[[camera]]\neye = [{}, {}, {}]\ntarget = [0.0, 0.0, 0.0]\nfov = {}\n",
+            toml_f32(b.f32()),
+            toml_f32(b.f32()),
+            toml_f32(b.f32()),
+            toml_f32(b.f32())
+        ),
+        _ => format!(
+            "[[camera]]\nelevation = {}\nazimuth = {}\n",
+            toml_f32(b.f32()),
+            toml_f32(b.f32())
+        ),
+    };
+    let scale = toml_f32(b.f32());
+    let scene = format!(
+        "[output]\nwidth = 32\nheight = 32\n\
+         [render]\nshadows = {shadows}\ncull = \"{cull}\"\nmsaa = {msaa}\nssaa = {ssaa}\n{ao}\
+         [ground]\nshadow = {ground}\n\
+         [[model]]\npath = \"render.obj\"\nscale = {scale}\n\
+         [[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\ndirection = [{}, {}, {}]\nshadows = true\n{camera}",
+        toml_f32(lx),
+        toml_f32(ly),
+        toml_f32(lz),
+        toml_f32(-lx),
+        toml_f32(-ly),
+        toml_f32(-lz),
+    );
+    common::load_and_render("render.toml", &scene, true);
+});

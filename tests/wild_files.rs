@@ -1,0 +1,146 @@
+//! The corpus of odd and malformed files in `tests/wild/`: each file's
+//! outcome (renders, warns, blank, refused, refused under --strict) as
+//! `tests/wild/EXPECTED` states it, and never a panic or a crash.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+#[derive(Debug)]
+struct Case {
+    file: String,
+    outcome: String,
+    message: String,
+}
+
+fn cases(dir: &Path) -> Vec<Case> {
+    let text = std::fs::read_to_string(dir.join("EXPECTED")).expect("tests/wild/EXPECTED");
+    text.lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .map(|l| {
+            let mut w = l.splitn(3, char::is_whitespace);
+            let file = w.next().unwrap().to_string();
+            let rest = w.next().map(str::trim).unwrap_or("");
+            let rest = format!("{rest} {}", w.next().unwrap_or(""));
+            let rest = rest.trim();
+            let (outcome, message) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+            Case {
+                file,
+                outcome: outcome.to_string(),
+                message: message.trim().to_string(),
+            }
+        })
+        .collect()
+}
+
+/// Pixels with any coverage in the PNG the render wrote.
+fn visible_pixels(out: &Path) -> usize {
+    let Some(png) = std::fs::read_dir(out).ok().and_then(|d| {
+        d.flatten()
+            .map(|e| e.path())
+            .find(|p| p.extension().is_some_and(|e| e == "png"))
+    }) else {
+        return 0;
+    };
+    let img = image::open(&png).expect("a readable PNG").to_rgba8();
+    img.pixels().filter(|p| p.0[3] > 0).count()
+}
+
+fn check(dir: &Path, scratch: &Path, i: usize, c: &Case) -> Result<(), String> {
+    let out = scratch.join(format!("{i}"));
+    let file = dir.join(&c.file);
+    let (file_s, out_s) = (file.to_string_lossy(), out.to_string_lossy());
+    let mut args = vec![
+        "render",
+        &*file_s,
+        "--out",
+        &*out_s,
+        "--set",
+        "output.width=48",
+        "--set",
+        "output.height=48",
+        "--set",
+        "output.background=\"transparent\"",
+        "--set",
+        "ground.shadow=false",
+    ];
+    if c.outcome == "strict" {
+        args.push("--strict");
+    }
+    let (code, _, err) = common::run(&args);
+    let fail = |why: &str| {
+        Err(format!(
+            "{} ({}): {why}; exit {code}, stderr:\n{err}",
+            c.file, c.outcome
+        ))
+    };
+    if code == 101 || code < 0 || err.contains("panicked") {
+        return fail("crashed");
+    }
+    let warned = err.lines().any(|l| l.starts_with("warning:"));
+    let has_message = err.contains(&c.message);
+    match c.outcome.as_str() {
+        "renders" | "warns" | "blank" if code != 0 => fail("expected exit 0"),
+        "renders" if warned => fail("expected no warning"),
+        "warns" if !(warned && has_message) => fail("expected a warning with the message"),
+        "renders" | "warns" if visible_pixels(&out) < 5 => fail("expected visible pixels"),
+        "refused" | "strict" if code != 2 || !has_message => {
+            fail("expected exit 2 with the message")
+        }
+        "renders" | "warns" | "blank" | "refused" | "strict" => Ok(()),
+        other => fail(&format!("unknown outcome `{other}` in EXPECTED")),
+    }
+}
+
+#[test]
+fn every_file_in_the_corpus_has_its_outcome() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    let scratch = common::scratch("wild");
+    let cases = cases(&dir);
+    assert!(cases.len() >= 60, "the corpus has {} cases", cases.len());
+    // Every file in the directory is listed (textures and libraries are
+    // read through the models that name them).
+    for e in std::fs::read_dir(&dir).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let model = ["obj", "stl", "ply", "gltf", "glb", "toml"]
+            .iter()
+            .any(|x| name.ends_with(&format!(".{x}")));
+        assert!(
+            !model || cases.iter().any(|c| c.file == name),
+            "{name} is not in tests/wild/EXPECTED"
+        );
+    }
+    let (dir, scratch) = (&dir, &scratch);
+    let half = cases.len() / 2;
+    let failures: Vec<String> = std::thread::scope(|s| {
+        let (a, b) = cases.split_at(half);
+        let run = move |part: &[Case], offset: usize| {
+            part.iter()
+                .enumerate()
+                .filter_map(|(i, c)| check(dir, scratch, offset + i, c).err())
+                .collect::<Vec<_>>()
+        };
+        let ha = s.spawn(move || run(a, 0));
+        let hb = s.spawn(move || run(b, half));
+        let mut f = ha.join().unwrap();
+        f.extend(hb.join().unwrap());
+        f
+    });
+    let counts = |o: &str| cases.iter().filter(|c| c.outcome == o).count();
+    eprintln!(
+        "corpus: {} cases: {} render, {} warn, {} blank, {} refused, {} refused with --strict",
+        cases.len(),
+        counts("renders"),
+        counts("warns"),
+        counts("blank"),
+        counts("refused"),
+        counts("strict")
+    );
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n\n")
+    );
+}
