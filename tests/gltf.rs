@@ -555,3 +555,152 @@ fn khr_materials_unlit_ior_and_specular() {
         "{matte} {plain} {ior2}"
     );
 }
+
+/// The cube with KHR_mesh_quantization (i16 positions dequantized by the
+/// node's scale, i8 normalized normals, u16 normalized texture
+/// coordinates) in EXT_meshopt_compression views over a fallback buffer.
+fn compressed_cube_gltf(p: &Prim, filter_normals: bool) -> String {
+    use base64::Engine;
+    const Q: f32 = 16384.0;
+    let n = p.positions.len();
+    let pos: Vec<[i16; 4]> = p
+        .positions
+        .iter()
+        .map(|v| [(v[0] * Q) as i16, (v[1] * Q) as i16, (v[2] * Q) as i16, 0])
+        .collect();
+    let mut nrm: Vec<[i8; 4]> = p
+        .normals
+        .iter()
+        .map(|v| {
+            [
+                (v[0] * 127.0) as i8,
+                (v[1] * 127.0) as i8,
+                (v[2] * 127.0) as i8,
+                0,
+            ]
+        })
+        .collect();
+    if filter_normals {
+        // Octahedral encoding (what gltfpack writes for normals).
+        let f: Vec<[f32; 4]> = p.normals.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+        nrm = meshopt::encoding::encode_filter_oct::<i8>(&f, 8);
+    }
+    let uv: Vec<[u16; 2]> = p
+        .uv0
+        .iter()
+        .map(|t| {
+            [
+                (t[0] * 65535.0).round() as u16,
+                (t[1] * 65535.0).round() as u16,
+            ]
+        })
+        .collect();
+    let parts = [
+        meshopt::encoding::encode_vertex_buffer(&pos).unwrap(),
+        meshopt::encoding::encode_vertex_buffer(&nrm).unwrap(),
+        meshopt::encoding::encode_vertex_buffer(&uv).unwrap(),
+        meshopt::encoding::encode_index_buffer(&p.indices, n).unwrap(),
+    ];
+    let sizes = [n * 8, n * 4, n * 4, p.indices.len() * 4];
+    let modes = [
+        ("ATTRIBUTES", 8),
+        ("ATTRIBUTES", 4),
+        ("ATTRIBUTES", 4),
+        ("TRIANGLES", 4),
+    ];
+    let mut blob = Vec::new();
+    let (mut views, mut fallback_at) = (Vec::new(), 0);
+    for (k, part) in parts.iter().enumerate() {
+        let filter = if k == 1 && filter_normals {
+            r#", "filter": "OCTAHEDRAL""#
+        } else {
+            ""
+        };
+        let stride = if k < 3 {
+            format!(r#", "byteStride": {}"#, modes[k].1)
+        } else {
+            String::new()
+        };
+        let count = if k < 3 { n } else { p.indices.len() };
+        views.push(format!(
+            r#"{{"buffer": 1, "byteOffset": {fallback_at}, "byteLength": {}{stride}, "extensions": {{"EXT_meshopt_compression": {{"buffer": 0, "byteOffset": {}, "byteLength": {}, "byteStride": {}, "count": {count}, "mode": "{}"{filter}}}}}}}"#,
+            sizes[k],
+            blob.len(),
+            part.len(),
+            modes[k].1,
+            modes[k].0
+        ));
+        blob.extend(part);
+        while blob.len() % 4 != 0 {
+            blob.push(0);
+        }
+        fallback_at += sizes[k];
+    }
+    let uri = base64::engine::general_purpose::STANDARD.encode(&blob);
+    let s = 1.0 / Q;
+    format!(
+        r#"{{"asset": {{"version": "2.0"}},
+        "extensionsUsed": ["EXT_meshopt_compression", "KHR_mesh_quantization"],
+        "extensionsRequired": ["EXT_meshopt_compression", "KHR_mesh_quantization"],
+        "buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{uri}"}},
+                    {{"byteLength": {fallback_at}, "extensions": {{"EXT_meshopt_compression": {{"fallback": true}}}}}}],
+        "bufferViews": [{}],
+        "accessors": [
+          {{"bufferView": 0, "componentType": 5122, "count": {n}, "type": "VEC3", "min": [-8192, -8192, -8192], "max": [8192, 8192, 8192]}},
+          {{"bufferView": 1, "componentType": 5120, "normalized": true, "count": {n}, "type": "VEC3"}},
+          {{"bufferView": 2, "componentType": 5123, "normalized": true, "count": {n}, "type": "VEC2"}},
+          {{"bufferView": 3, "componentType": 5125, "count": {}, "type": "SCALAR"}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}, "indices": 3, "material": 0}}]}}],
+        "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}}}],
+        "textures": [{{"source": 0}}], "images": [{{"uri": "tex.png"}}],
+        "nodes": [{{"mesh": 0, "scale": [{s}, {s}, {s}]}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+        blob.len(),
+        views.join(", "),
+        p.indices.len()
+    )
+}
+
+#[test]
+fn meshopt_compressed_quantized_files_render_like_plain_ones() {
+    let dir = common::scratch("gltf_meshopt");
+    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
+    let p = common::cube();
+    let (plain, _) = gltf_text(
+        &p,
+        r#", "material": 0"#,
+        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+        "textures": [{"source": 0}], "images": [{"uri": "tex.png"}]"#,
+        None,
+    );
+    std::fs::write(dir.join("plain.gltf"), plain).unwrap();
+    std::fs::write(dir.join("packed.gltf"), compressed_cube_gltf(&p, false)).unwrap();
+    std::fs::write(dir.join("oct.gltf"), compressed_cube_gltf(&p, true)).unwrap();
+    let scene = |model: &str| {
+        format!(
+            "[output]\nwidth = 80\nheight = 80\n[render]\ntexture_filter = \"nearest\"\n\
+             [[model]]\npath = \"{model}\"\n\
+             [[light]]\nkind = \"directional\"\ndirection = [-0.4, -0.7, -0.5]\n\
+             [[camera]]\neye = [1.6, 1.2, 2.0]\ntarget = [0.0, 0.0, 0.0]\n"
+        )
+    };
+    let plain = common::scene_in(&dir, &scene("plain.gltf"), &[]);
+    let a = resolve(&render_frame(&plain, 0, 0), &plain.settings);
+    let covered = a.data.chunks(3).filter(|c| c != &[0, 0, 0]).count();
+    assert!(covered > 1500, "the cube covers {covered} pixels");
+    for (model, tolerance) in [("packed.gltf", 0), ("oct.gltf", 2)] {
+        let s = common::scene_in(&dir, &scene(model), &[]);
+        assert!(s.warnings.is_empty(), "{model}: {:?}", s.warnings);
+        let b = resolve(&render_frame(&s, 0, 0), &s.settings);
+        let worst = a
+            .data
+            .iter()
+            .zip(&b.data)
+            .map(|(x, y)| x.abs_diff(*y))
+            .max()
+            .unwrap();
+        // Exact quantization gives the same pixels; octahedral normals
+        // (8 bits) are within a level or two.
+        assert!(worst <= tolerance, "{model}: a channel differs by {worst}");
+    }
+}

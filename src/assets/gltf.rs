@@ -17,8 +17,10 @@ use std::sync::Arc;
 
 use base64::Engine;
 use glam::{Affine2, Mat2, Mat3, Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
+use super::accessor::read_floats;
 use super::mesh::{Group, Mesh, Primitive};
 use super::texture::Wrap;
 use super::texture::{AddressMode, TextureFilter};
@@ -27,11 +29,13 @@ use crate::error::Error;
 /// Extensions that change how softraster draws a file; a file that
 /// requires any other one is refused.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "EXT_meshopt_compression",
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_unlit",
+    "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
 
@@ -277,7 +281,8 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
     let mut warnings = extensions(doc, path).map_err(err)?;
     validate(doc).map_err(err)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let buffers = load_buffers(doc, gltf.blob.as_deref(), dir, path)?;
+    let mut buffers = load_buffers(doc, gltf.blob.as_deref(), dir, path)?;
+    super::meshopt::decode_views(doc, &mut buffers).map_err(err)?;
     check_accessors(doc, &buffers).map_err(err)?;
     let images = image_sources(doc, &buffers, dir, path).map_err(err)?;
 
@@ -413,7 +418,13 @@ fn validate(doc: &gltf::Document) -> Result<(), String> {
     let root = doc.as_json();
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, e| {
-        errors.push(format!("{}: {e}", path()))
+        let path = path().to_string();
+        // Required extensions are `extensions()`'s to judge: the gltf
+        // crate does not know EXT_meshopt_compression and
+        // KHR_mesh_quantization, which softraster decodes itself.
+        if !path.starts_with("extensionsRequired") {
+            errors.push(format!("{path}: {e}"))
+        }
     });
     match errors.len() {
         0 => Ok(()),
@@ -429,8 +440,30 @@ fn load_buffers(
     path: &Path,
 ) -> Result<Vec<Vec<u8>>, Error> {
     let mut out = Vec::new();
+    // Room for meshopt-decoded views, bounded by what the real buffers
+    // could decode to.
+    let real: usize = doc
+        .buffers()
+        .filter(|b| !super::meshopt::is_fallback(b))
+        .map(|b| b.length())
+        .sum();
     for b in doc.buffers() {
         let i = b.index();
+        let no_data = matches!(b.source(), gltf::buffer::Source::Bin) && blob.is_none();
+        if super::meshopt::is_fallback(&b) && no_data {
+            if b.length() > real.saturating_mul(256) + (1 << 20) {
+                return Err(Error::asset(
+                    path,
+                    None,
+                    format!(
+                        "buffer {i}: a meshopt fallback of {} bytes is out of proportion",
+                        b.length()
+                    ),
+                ));
+            }
+            out.push(vec![0; b.length()]);
+            continue;
+        }
         let data = match b.source() {
             gltf::buffer::Source::Bin => blob.map(<[u8]>::to_vec).ok_or_else(|| {
                 Error::asset(
@@ -701,17 +734,44 @@ struct Attributes {
 fn read_attributes(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Attributes, String> {
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
-    let positions: Vec<Vec3> = reader
-        .read_positions()
-        .ok_or_else(|| {
-            if prim.get(&gltf::Semantic::Positions).is_none() {
-                "it has no POSITION attribute".to_string()
-            } else {
-                unreadable("POSITION")
-            }
-        })?
-        .map(Vec3::from)
-        .collect();
+    // KHR_mesh_quantization: integer positions, normals, tangents and
+    // texture coordinates, which the gltf crate reads as f32 only.
+    // Each attribute's accessor must have its type (the gltf crate's
+    // readers assume it); integer ones are read here.
+    for (sem, dims, name) in [
+        (gltf::Semantic::Positions, Dimensions::Vec3, "POSITION"),
+        (gltf::Semantic::Normals, Dimensions::Vec3, "NORMAL"),
+        (gltf::Semantic::Tangents, Dimensions::Vec4, "TANGENT"),
+        (gltf::Semantic::TexCoords(0), Dimensions::Vec2, "TEXCOORD_0"),
+        (gltf::Semantic::TexCoords(1), Dimensions::Vec2, "TEXCOORD_1"),
+    ] {
+        if let Some(a) = prim.get(&sem)
+            && a.dimensions() != dims
+        {
+            return Err(format!(
+                "its {name} accessor is {:?}, not {dims:?}",
+                a.dimensions()
+            ));
+        }
+    }
+    let quantized = |s: gltf::Semantic| prim.get(&s).filter(|a| a.data_type() != DataType::F32);
+    let positions: Vec<Vec3> = match quantized(gltf::Semantic::Positions) {
+        Some(a) => read_floats::<3>(&a, buffers)?
+            .into_iter()
+            .map(Vec3::from)
+            .collect(),
+        None => reader
+            .read_positions()
+            .ok_or_else(|| {
+                if prim.get(&gltf::Semantic::Positions).is_none() {
+                    "it has no POSITION attribute".to_string()
+                } else {
+                    unreadable("POSITION")
+                }
+            })?
+            .map(Vec3::from)
+            .collect(),
+    };
     let n = positions.len();
     let same_len = |what: &str, len: usize| {
         if len == n {
@@ -720,19 +780,44 @@ fn read_attributes(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Attrib
             Err(format!("{what} has {len} elements but POSITION has {n}"))
         }
     };
-    let normals: Option<Vec<Vec3>> = match reader.read_normals() {
-        Some(r) => Some(r.map(Vec3::from).collect()),
-        None if prim.get(&gltf::Semantic::Normals).is_some() => {
-            return Err(unreadable("NORMAL"));
-        }
-        None => None,
+    let normals: Option<Vec<Vec3>> = match quantized(gltf::Semantic::Normals) {
+        Some(a) => Some(
+            read_floats::<3>(&a, buffers)?
+                .into_iter()
+                .map(Vec3::from)
+                .collect(),
+        ),
+        None => match reader.read_normals() {
+            Some(r) => Some(r.map(Vec3::from).collect()),
+            None if prim.get(&gltf::Semantic::Normals).is_some() => {
+                return Err(unreadable("NORMAL"));
+            }
+            None => None,
+        },
     };
-    let tangents: Option<Vec<Vec4>> = reader.read_tangents().map(|r| r.map(Vec4::from).collect());
-    let uv: [Option<Vec<Vec2>>; 2] = [0, 1].map(|s| {
-        reader
-            .read_tex_coords(s)
-            .map(|r| r.into_f32().map(Vec2::from).collect())
-    });
+    let tangents: Option<Vec<Vec4>> = match quantized(gltf::Semantic::Tangents) {
+        Some(a) => Some(
+            read_floats::<4>(&a, buffers)?
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+        ),
+        None => reader.read_tangents().map(|r| r.map(Vec4::from).collect()),
+    };
+    let mut uv: [Option<Vec<Vec2>>; 2] = [None, None];
+    for (s, slot) in uv.iter_mut().enumerate() {
+        *slot = match quantized(gltf::Semantic::TexCoords(s as u32)) {
+            Some(a) => Some(
+                read_floats::<2>(&a, buffers)?
+                    .into_iter()
+                    .map(Vec2::from)
+                    .collect(),
+            ),
+            None => reader
+                .read_tex_coords(s as u32)
+                .map(|r| r.into_f32().map(Vec2::from).collect()),
+        };
+    }
     let colors: Option<Vec<Vec4>> = reader
         .read_colors(0)
         .map(|r| r.into_rgba_f32().map(Vec4::from).collect());

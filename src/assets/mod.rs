@@ -1,9 +1,11 @@
 //! Asset loaders: meshes and materials from OBJ/MTL, glTF, STL and PLY,
 //! textures from images.
 
+pub mod accessor;
 pub mod environment;
 pub mod gltf;
 pub mod mesh;
+pub mod meshopt;
 pub mod mip;
 pub mod obj;
 pub mod ply;
