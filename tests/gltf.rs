@@ -704,3 +704,111 @@ fn meshopt_compressed_quantized_files_render_like_plain_ones() {
         assert!(worst <= tolerance, "{model}: a channel differs by {worst}");
     }
 }
+
+/// The cube as one Draco stream (positions 16 bits, normals 12, texture
+/// coordinates 14), in a glTF whose accessors have no views.
+fn draco_cube_gltf(p: &Prim) -> String {
+    use base64::Engine;
+    use draco_core::{DataType, FaceIndex, GeometryAttributeType, PointAttribute, PointIndex};
+    let n = p.positions.len();
+    let mut mesh = draco_core::Mesh::new();
+    let mut add = |ty, comps: usize, values: Vec<f32>| {
+        let mut a = PointAttribute::new();
+        a.init(ty, comps as u8, DataType::Float32, false, n);
+        for i in 0..n {
+            let bytes: Vec<u8> = values[i * comps..(i + 1) * comps]
+                .iter()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
+            a.buffer_mut().write(i * comps * 4, &bytes);
+        }
+        mesh.add_attribute(a)
+    };
+    let pos = add(GeometryAttributeType::Position, 3, p.positions.concat());
+    let nrm = add(GeometryAttributeType::Normal, 3, p.normals.concat());
+    let uv = add(GeometryAttributeType::TexCoord, 2, p.uv0.concat());
+    mesh.set_num_faces(p.indices.len() / 3);
+    for (f, t) in p.indices.chunks_exact(3).enumerate() {
+        mesh.set_face(
+            FaceIndex(f as u32),
+            [PointIndex(t[0]), PointIndex(t[1]), PointIndex(t[2])],
+        );
+    }
+    let ids: Vec<u32> = [pos, nrm, uv]
+        .iter()
+        .map(|&a| mesh.attribute(a).unique_id())
+        .collect();
+    let mut options = draco_core::EncoderOptions::new();
+    options.set_attribute_quantization(pos, 16);
+    options.set_attribute_quantization(nrm, 12);
+    options.set_attribute_quantization(uv, 14);
+    let mut encoder = draco_core::MeshEncoder::new();
+    encoder.set_mesh(mesh);
+    let mut out = draco_core::EncoderBuffer::new();
+    encoder.encode(&options, &mut out).unwrap();
+    let bytes = out.data().to_vec();
+    let uri = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    format!(
+        r#"{{"asset": {{"version": "2.0"}},
+        "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
+        "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{uri}"}}],
+        "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": {len}}}],
+        "accessors": [
+          {{"componentType": 5126, "count": {n}, "type": "VEC3", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}},
+          {{"componentType": 5126, "count": {n}, "type": "VEC3"}},
+          {{"componentType": 5126, "count": {n}, "type": "VEC2"}},
+          {{"componentType": 5125, "count": {}, "type": "SCALAR"}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}}, "indices": 3, "material": 0,
+            "extensions": {{"KHR_draco_mesh_compression": {{"bufferView": 0, "attributes": {{"POSITION": {}, "NORMAL": {}, "TEXCOORD_0": {}}}}}}}}}]}}],
+        "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0}}}}],
+        "textures": [{{"source": 0}}], "images": [{{"uri": "tex.png"}}],
+        "nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+        p.indices.len(),
+        ids[0],
+        ids[1],
+        ids[2],
+        len = bytes.len()
+    )
+}
+
+#[test]
+fn draco_compressed_files_render_like_plain_ones() {
+    let dir = common::scratch("gltf_draco");
+    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
+    let p = common::cube();
+    let (plain, _) = gltf_text(
+        &p,
+        r#", "material": 0"#,
+        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+        "textures": [{"source": 0}], "images": [{"uri": "tex.png"}]"#,
+        None,
+    );
+    std::fs::write(dir.join("plain.gltf"), plain).unwrap();
+    std::fs::write(dir.join("draco.gltf"), draco_cube_gltf(&p)).unwrap();
+    let scene = |model: &str| {
+        format!(
+            "[output]\nwidth = 80\nheight = 80\n[render]\ntexture_filter = \"nearest\"\n\
+             [[model]]\npath = \"{model}\"\n\
+             [[light]]\nkind = \"directional\"\ndirection = [-0.4, -0.7, -0.5]\n\
+             [[camera]]\neye = [1.6, 1.2, 2.0]\ntarget = [0.0, 0.0, 0.0]\n"
+        )
+    };
+    let plain = common::scene_in(&dir, &scene("plain.gltf"), &[]);
+    let a = resolve(&render_frame(&plain, 0, 0), &plain.settings);
+    let s = common::scene_in(&dir, &scene("draco.gltf"), &[]);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.models[0].mesh.triangles.len(), 12);
+    let b = resolve(&render_frame(&s, 0, 0), &s.settings);
+    // 16-bit positions move edges by at most 1/65535 of the cube: a
+    // handful of edge pixels may differ, the rest match within a level.
+    let differing = a
+        .data
+        .chunks(3)
+        .zip(b.data.chunks(3))
+        .filter(|(x, y)| x.iter().zip(y.iter()).any(|(u, v)| u.abs_diff(*v) > 2))
+        .count();
+    let covered = a.data.chunks(3).filter(|c| c != &[0, 0, 0]).count();
+    assert!(covered > 1500, "the cube covers {covered} pixels");
+    assert!(differing <= 8, "{differing} pixels differ");
+}

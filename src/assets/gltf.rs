@@ -30,6 +30,7 @@ use crate::error::Error;
 /// requires any other one is refused.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_meshopt_compression",
+    "KHR_draco_mesh_compression",
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
@@ -296,6 +297,10 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
         any_color: false,
         any_tangent: false,
         default_material: None,
+        views: doc
+            .views()
+            .map(|v| (v.buffer().index(), v.offset(), v.length()))
+            .collect(),
     };
     let mut placed = Placed::default();
     walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
@@ -416,13 +421,20 @@ fn walk_nodes(
 fn validate(doc: &gltf::Document) -> Result<(), String> {
     use gltf::json::validation::Validate;
     let root = doc.as_json();
+    let draco = doc
+        .extensions_used()
+        .any(|e| e == "KHR_draco_mesh_compression");
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, e| {
         let path = path().to_string();
         // Required extensions are `extensions()`'s to judge: the gltf
         // crate does not know EXT_meshopt_compression and
         // KHR_mesh_quantization, which softraster decodes itself.
-        if !path.starts_with("extensionsRequired") {
+        // Draco primitives' accessors have no views: the stream holds
+        // their data.
+        let draco_accessor =
+            draco && path.starts_with("accessors[") && path.ends_with(".bufferView");
+        if !path.starts_with("extensionsRequired") && !draco_accessor {
             errors.push(format!("{path}: {e}"))
         }
     });
@@ -721,17 +733,27 @@ fn tex_info(
 
 /// A primitive's vertex attributes and indices, read and checked: every
 /// attribute as long as POSITION, every index in range.
-struct Attributes {
-    positions: Vec<Vec3>,
-    normals: Option<Vec<Vec3>>,
-    tangents: Option<Vec<Vec4>>,
-    uv: [Option<Vec<Vec2>>; 2],
-    colors: Option<Vec<Vec4>>,
+pub(super) struct Attributes {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub tangents: Option<Vec<Vec4>>,
+    pub uv: [Option<Vec<Vec2>>; 2],
+    pub colors: Option<Vec<Vec4>>,
     /// Without an index accessor: 0..n.
-    indices: Vec<u32>,
+    pub indices: Vec<u32>,
 }
 
-fn read_attributes(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Attributes, String> {
+fn read_attributes(
+    prim: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    views: &[(usize, usize, usize)],
+) -> Result<Attributes, String> {
+    if let Some(ext) = prim
+        .extensions()
+        .and_then(|e| e.get("KHR_draco_mesh_compression"))
+    {
+        return super::draco::read(prim, ext, buffers, views);
+    }
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
     // KHR_mesh_quantization: integer positions, normals, tangents and
@@ -1038,6 +1060,8 @@ struct Builder {
     any_color: bool,
     any_tangent: bool,
     default_material: Option<usize>,
+    /// Every buffer view: (buffer, offset, length), for Draco streams.
+    views: Vec<(usize, usize, usize)>,
 }
 
 impl Builder {
@@ -1050,7 +1074,7 @@ impl Builder {
         world: Mat4,
         material: usize,
     ) -> Result<(), String> {
-        let a = read_attributes(prim, buffers)?;
+        let a = read_attributes(prim, buffers, &self.views)?;
         let base = self.mesh.positions.len() as u32;
         let m = &mut self.mesh;
         for (s, p) in a.positions.iter().enumerate() {
@@ -1111,7 +1135,7 @@ impl Builder {
             uv,
             colors,
             indices,
-        } = read_attributes(prim, buffers)?;
+        } = read_attributes(prim, buffers, &self.views)?;
         let n = positions.len();
         let Some(mut tris) = triangulate(mode, &indices) else {
             return Ok(());

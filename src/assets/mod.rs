@@ -2,6 +2,7 @@
 //! textures from images.
 
 pub mod accessor;
+pub mod draco;
 pub mod environment;
 pub mod gltf;
 pub mod mesh;
