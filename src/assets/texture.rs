@@ -191,12 +191,37 @@ impl Texture {
         let img = reader
             .decode()
             .map_err(|e| Error::asset(path, None, format!("cannot decode texture: {e}")))?;
-        let rgba = img.to_rgba8();
-        let (width, height) = rgba.dimensions();
+        let (width, height) = (img.width(), img.height());
         if width == 0 || height == 0 {
             return Err(Error::asset(path, None, "texture has no pixels"));
         }
-        let texels: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();
+        let texels: Vec<[u8; 4]> = if matches!(
+            img,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        ) {
+            // Linear float images (Radiance HDR, float TIFF): colour maps
+            // are stored sRGB-encoded like every 8-bit colour map, data
+            // maps linearly; values above 1 clip.
+            let encode = if srgb {
+                crate::color::encode_srgb
+            } else {
+                crate::color::encode_linear
+            };
+            img.to_rgba32f()
+                .pixels()
+                .map(|p| {
+                    let [r, g, b, a] = p.0;
+                    [
+                        encode(r),
+                        encode(g),
+                        encode(b),
+                        crate::color::encode_linear(a),
+                    ]
+                })
+                .collect()
+        } else {
+            img.to_rgba8().pixels().map(|p| p.0).collect()
+        };
         Ok(Texture::from_rgba8(width, height, texels, srgb))
     }
 
