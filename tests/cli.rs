@@ -363,14 +363,14 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
         &tri,
         "",
         &format!(
-            r#"{nodes}, "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"]"#
+            r#"{nodes}, "extensionsUsed": ["KHR_texture_basisu"], "extensionsRequired": ["KHR_texture_basisu"]"#
         ),
         None,
     );
-    write(&dir, "draco.gltf", &text);
-    let err = exit_2(&scene("draco.gltf"), &dir);
+    write(&dir, "basisu.gltf", &text);
+    let err = exit_2(&scene("basisu.gltf"), &dir);
     assert!(
-        err.contains("requires the glTF extension `KHR_draco_mesh_compression`"),
+        err.contains("requires the glTF extension `KHR_texture_basisu`"),
         "{err}"
     );
 

@@ -1,9 +1,11 @@
-//! glTF accessors of any component type as floats: what
+//! A glTF primitive's attributes as the loaders hand them on, and glTF
+//! accessors of any component type as floats: what
 //! KHR_mesh_quantization allows for positions, normals, tangents and
 //! texture coordinates (8- and 16-bit integers, normalized or not, signed
 //! or not), which the gltf crate's readers take as f32 only. Ranges were
 //! checked against the buffers (`check_accessors`) before this runs.
 
+use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 
 /// The elements of `a` as `N` floats each; normalized integers map to
@@ -84,4 +86,16 @@ pub fn read_floats<const N: usize>(
             Ok(out)
         })
         .collect()
+}
+
+/// A primitive's vertex attributes and indices, read and checked: every
+/// attribute as long as POSITION, every index in range.
+pub struct Attributes {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub tangents: Option<Vec<Vec4>>,
+    pub uv: [Option<Vec<Vec2>>; 2],
+    pub colors: Option<Vec<Vec4>>,
+    /// Without an index accessor: 0..n.
+    pub indices: Vec<u32>,
 }

@@ -7,7 +7,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use serde_json::Value;
 
-use super::gltf::Attributes;
+use super::accessor::Attributes;
 
 /// The primitive's attributes from its Draco stream.
 pub(super) fn read(

@@ -20,7 +20,7 @@ use glam::{Affine2, Mat2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use super::accessor::read_floats;
+use super::accessor::{Attributes, read_floats};
 use super::mesh::{Group, Mesh, Primitive};
 use super::texture::Wrap;
 use super::texture::{AddressMode, TextureFilter};
@@ -729,18 +729,6 @@ fn tex_info(
         min_limit,
         mag_nearest: sampler.mag_filter() == Some(MagFilter::Nearest),
     })
-}
-
-/// A primitive's vertex attributes and indices, read and checked: every
-/// attribute as long as POSITION, every index in range.
-pub(super) struct Attributes {
-    pub positions: Vec<Vec3>,
-    pub normals: Option<Vec<Vec3>>,
-    pub tangents: Option<Vec<Vec4>>,
-    pub uv: [Option<Vec<Vec2>>; 2],
-    pub colors: Option<Vec<Vec4>>,
-    /// Without an index accessor: 0..n.
-    pub indices: Vec<u32>,
 }
 
 fn read_attributes(
