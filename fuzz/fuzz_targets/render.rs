@@ -54,6 +54,11 @@ fuzz_target!(|data: &[u8]| {
         );
         obj += &format!("f {i} {j} {k}\n");
     }
+    // Some points and lines, drawn by their own pass.
+    for _ in 0..b.u8() % 4 {
+        let (i, j) = (1 + b.u8() as usize % n_verts, 1 + b.u8() as usize % n_verts);
+        obj += &format!("l {i} {j}\np {i}\n");
+    }
     let dir = common::dir();
     if std::fs::write(dir.join("render.obj"), obj).is_err() {
         return;
@@ -86,9 +91,12 @@ fuzz_target!(|data: &[u8]| {
         ),
     };
     let scale = toml_f32(b.f32());
+    let point_size = 0.5 + (b.u8() % 64) as f32;
+    let line_width = 0.25 + (b.u8() % 64) as f32 * 0.5;
     let scene = format!(
         "[output]\nwidth = 32\nheight = 32\n\
-         [render]\nshadows = {shadows}\ncull = \"{cull}\"\nmsaa = {msaa}\nssaa = {ssaa}\n{ao}\
+         [render]\nshadows = {shadows}\ncull = \"{cull}\"\nmsaa = {msaa}\nssaa = {ssaa}\n\
+         point_size = {point_size:?}\nline_width = {line_width:?}\n{ao}\
          [ground]\nshadow = {ground}\n\
          [[model]]\npath = \"render.obj\"\nscale = {scale}\n\
          [[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\ndirection = [{}, {}, {}]\nshadows = true\n{camera}",
