@@ -421,6 +421,22 @@ fn walk_nodes(
 fn validate(doc: &gltf::Document) -> Result<(), String> {
     use gltf::json::validation::Validate;
     let root = doc.as_json();
+    // gltf-json 1.4.1's own validation indexes the POSITION accessor
+    // without a bounds check: check it first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let pos = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(i) = prim.attributes.get(&pos)
+                && i.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "mesh {m} primitive {p}: POSITION names accessor {}, the file has {}",
+                    i.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
     let draco = doc
         .extensions_used()
         .any(|e| e == "KHR_draco_mesh_compression");
