@@ -782,6 +782,27 @@ fn read_attributes(
             ));
         }
     }
+    // The gltf crate's readers reach `unreachable!` on other types.
+    if let Some(a) = prim.indices()
+        && (a.dimensions() != Dimensions::Scalar
+            || !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32))
+    {
+        return Err(format!(
+            "its indices accessor is {:?} {:?}, not unsigned integer scalars",
+            a.data_type(),
+            a.dimensions()
+        ));
+    }
+    if let Some(a) = prim.get(&gltf::Semantic::Colors(0))
+        && (!matches!(a.dimensions(), Dimensions::Vec3 | Dimensions::Vec4)
+            || !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::F32))
+    {
+        return Err(format!(
+            "its COLOR_0 accessor is {:?} {:?}, not RGB or RGBA of unsigned bytes, shorts or floats",
+            a.data_type(),
+            a.dimensions()
+        ));
+    }
     let quantized = |s: gltf::Semantic| prim.get(&s).filter(|a| a.data_type() != DataType::F32);
     let positions: Vec<Vec3> = match quantized(gltf::Semantic::Positions) {
         Some(a) => read_floats::<3>(&a, buffers)?
