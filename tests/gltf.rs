@@ -556,6 +556,32 @@ fn khr_materials_unlit_ior_and_specular() {
     );
 }
 
+/// tex.png and plain.gltf (the textured cube) in `dir`; the cube.
+fn textured_cube_files(dir: &std::path::Path) -> Prim {
+    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
+    let p = common::cube();
+    let (plain, _) = gltf_text(
+        &p,
+        r#", "material": 0"#,
+        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+        "textures": [{"source": 0}], "images": [{"uri": "tex.png"}]"#,
+        None,
+    );
+    std::fs::write(dir.join("plain.gltf"), plain).unwrap();
+    p
+}
+
+/// An 80x80 scene of `model` under one light, textures nearest.
+fn cube_scene(model: &str) -> String {
+    format!(
+        "[output]\nwidth = 80\nheight = 80\n[render]\ntexture_filter = \"nearest\"\n\
+         [[model]]\npath = \"{model}\"\n\
+         [[light]]\nkind = \"directional\"\ndirection = [-0.4, -0.7, -0.5]\n\
+         [[camera]]\neye = [1.6, 1.2, 2.0]\ntarget = [0.0, 0.0, 0.0]\n"
+    )
+}
+
 /// The cube with KHR_mesh_quantization (i16 positions dequantized by the
 /// node's scale, i8 normalized normals, u16 normalized texture
 /// coordinates) in EXT_meshopt_compression views over a fallback buffer.
@@ -663,33 +689,15 @@ fn compressed_cube_gltf(p: &Prim, filter_normals: bool) -> String {
 #[test]
 fn meshopt_compressed_quantized_files_render_like_plain_ones() {
     let dir = common::scratch("gltf_meshopt");
-    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
-    let p = common::cube();
-    let (plain, _) = gltf_text(
-        &p,
-        r#", "material": 0"#,
-        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
-        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
-        "textures": [{"source": 0}], "images": [{"uri": "tex.png"}]"#,
-        None,
-    );
-    std::fs::write(dir.join("plain.gltf"), plain).unwrap();
+    let p = textured_cube_files(&dir);
     std::fs::write(dir.join("packed.gltf"), compressed_cube_gltf(&p, false)).unwrap();
     std::fs::write(dir.join("oct.gltf"), compressed_cube_gltf(&p, true)).unwrap();
-    let scene = |model: &str| {
-        format!(
-            "[output]\nwidth = 80\nheight = 80\n[render]\ntexture_filter = \"nearest\"\n\
-             [[model]]\npath = \"{model}\"\n\
-             [[light]]\nkind = \"directional\"\ndirection = [-0.4, -0.7, -0.5]\n\
-             [[camera]]\neye = [1.6, 1.2, 2.0]\ntarget = [0.0, 0.0, 0.0]\n"
-        )
-    };
-    let plain = common::scene_in(&dir, &scene("plain.gltf"), &[]);
+    let plain = common::scene_in(&dir, &cube_scene("plain.gltf"), &[]);
     let a = resolve(&render_frame(&plain, 0, 0), &plain.settings);
     let covered = a.data.chunks(3).filter(|c| c != &[0, 0, 0]).count();
     assert!(covered > 1500, "the cube covers {covered} pixels");
     for (model, tolerance) in [("packed.gltf", 0), ("oct.gltf", 2)] {
-        let s = common::scene_in(&dir, &scene(model), &[]);
+        let s = common::scene_in(&dir, &cube_scene(model), &[]);
         assert!(s.warnings.is_empty(), "{model}: {:?}", s.warnings);
         let b = resolve(&render_frame(&s, 0, 0), &s.settings);
         let worst = a
@@ -774,29 +782,11 @@ fn draco_cube_gltf(p: &Prim) -> String {
 #[test]
 fn draco_compressed_files_render_like_plain_ones() {
     let dir = common::scratch("gltf_draco");
-    std::fs::write(dir.join("tex.png"), quadrant_png()).unwrap();
-    let p = common::cube();
-    let (plain, _) = gltf_text(
-        &p,
-        r#", "material": 0"#,
-        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
-        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
-        "textures": [{"source": 0}], "images": [{"uri": "tex.png"}]"#,
-        None,
-    );
-    std::fs::write(dir.join("plain.gltf"), plain).unwrap();
+    let p = textured_cube_files(&dir);
     std::fs::write(dir.join("draco.gltf"), draco_cube_gltf(&p)).unwrap();
-    let scene = |model: &str| {
-        format!(
-            "[output]\nwidth = 80\nheight = 80\n[render]\ntexture_filter = \"nearest\"\n\
-             [[model]]\npath = \"{model}\"\n\
-             [[light]]\nkind = \"directional\"\ndirection = [-0.4, -0.7, -0.5]\n\
-             [[camera]]\neye = [1.6, 1.2, 2.0]\ntarget = [0.0, 0.0, 0.0]\n"
-        )
-    };
-    let plain = common::scene_in(&dir, &scene("plain.gltf"), &[]);
+    let plain = common::scene_in(&dir, &cube_scene("plain.gltf"), &[]);
     let a = resolve(&render_frame(&plain, 0, 0), &plain.settings);
-    let s = common::scene_in(&dir, &scene("draco.gltf"), &[]);
+    let s = common::scene_in(&dir, &cube_scene("draco.gltf"), &[]);
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
     assert_eq!(s.models[0].mesh.triangles.len(), 12);
     let b = resolve(&render_frame(&s, 0, 0), &s.settings);

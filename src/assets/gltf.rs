@@ -1091,7 +1091,25 @@ struct Builder {
     views: Vec<(usize, usize, usize)>,
 }
 
+/// Vertex `s`'s texture coordinates (both sets) and colour, defaults where
+/// the primitive has none.
+fn push_uv_color(m: &mut Mesh, uv: &[Option<Vec<Vec2>>; 2], colors: &Option<Vec<Vec4>>, s: usize) {
+    for (list, set) in [&mut m.uvs, &mut m.uvs1].into_iter().zip(uv) {
+        list.push(set.as_ref().map(|v| v[s]).unwrap_or(Vec2::ZERO));
+    }
+    m.colors
+        .push(colors.as_ref().map(|c| c[s]).unwrap_or(Vec4::ONE));
+}
+
 impl Builder {
+    /// Which optional sets some primitive had (the others are dropped at
+    /// the end).
+    fn note_sets(&mut self, uv: &[Option<Vec<Vec2>>; 2], colors: &Option<Vec<Vec4>>) {
+        self.any_uv[0] |= uv[0].is_some();
+        self.any_uv[1] |= uv[1].is_some();
+        self.any_color |= colors.is_some();
+    }
+
     /// Points, lines, line strips and loops: vertices as placed (normals
     /// +Y, unused: they are drawn unlit), then the primitives.
     fn add_points_or_lines(
@@ -1102,21 +1120,15 @@ impl Builder {
         material: usize,
     ) -> Result<(), String> {
         let a = read_attributes(prim, buffers, &self.views)?;
+        self.note_sets(&a.uv, &a.colors);
         let base = self.mesh.positions.len() as u32;
         let m = &mut self.mesh;
         for (s, p) in a.positions.iter().enumerate() {
             m.positions.push(world.transform_point3(*p));
             m.normals.push(Vec3::Y);
-            for (list, set) in [&mut m.uvs, &mut m.uvs1].into_iter().zip(&a.uv) {
-                list.push(set.as_ref().map(|v| v[s]).unwrap_or(Vec2::ZERO));
-            }
-            m.colors
-                .push(a.colors.as_ref().map(|c| c[s]).unwrap_or(Vec4::ONE));
+            push_uv_color(m, &a.uv, &a.colors, s);
             m.authored_tangents.push(Vec4::ZERO);
         }
-        self.any_uv[0] |= a.uv[0].is_some();
-        self.any_uv[1] |= a.uv[1].is_some();
-        self.any_color |= a.colors.is_some();
         let idx = &a.indices;
         let seg = |i: u32, j: u32| Primitive {
             vertices: [base + i, base + j],
@@ -1189,6 +1201,7 @@ impl Builder {
                 .collect();
             (order, Some(fn_))
         };
+        self.note_sets(&uv, &colors);
         let base = self.mesh.positions.len() as u32;
         let m = &mut self.mesh;
         for (k, &src) in order.iter().enumerate() {
@@ -1201,11 +1214,7 @@ impl Builder {
             };
             m.normals
                 .push((normal_m * nrm).try_normalize().unwrap_or(Vec3::Y));
-            for (list, set) in [&mut m.uvs, &mut m.uvs1].into_iter().zip(&uv) {
-                list.push(set.as_ref().map(|v| v[s]).unwrap_or(Vec2::ZERO));
-            }
-            m.colors
-                .push(colors.as_ref().map(|c| c[s]).unwrap_or(Vec4::ONE));
+            push_uv_color(m, &uv, &colors, s);
             let t = match (&tangents, &face_normals) {
                 (Some(t), None) => {
                     let t = t[s];
@@ -1222,9 +1231,6 @@ impl Builder {
             };
             m.authored_tangents.push(t);
         }
-        self.any_uv[0] |= uv[0].is_some();
-        self.any_uv[1] |= uv[1].is_some();
-        self.any_color |= colors.is_some();
         self.any_tangent |= tangents.is_some() && face_normals.is_none();
         let first = m.triangles.len() as u32;
         for t in tris {

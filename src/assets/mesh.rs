@@ -73,31 +73,34 @@ impl Mesh {
         if self.triangles.is_empty() {
             return false;
         }
-        let mut weld: HashMap<[u32; 3], u32> = HashMap::new();
-        let ids: Vec<u32> = self
-            .positions
-            .iter()
-            .map(|p| {
-                let n = weld.len() as u32;
-                *weld
-                    .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
-                    .or_insert(n)
-            })
-            .collect();
-        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+        // Weld by sorting positions (bitwise equal ones share an id).
+        let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let mut order: Vec<u32> = (0..self.positions.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| key(self.positions[i as usize]));
+        let mut ids = vec![0u32; self.positions.len()];
+        let mut id = 0;
+        for (k, w) in order.windows(2).enumerate() {
+            if key(self.positions[w[0] as usize]) != key(self.positions[w[1] as usize]) {
+                id += 1;
+            }
+            ids[order[k + 1] as usize] = id;
+        }
+        // Directed edges as sorted u64 keys: each used once, its reverse
+        // present.
+        let mut edges: Vec<u64> = Vec::with_capacity(self.triangles.len() * 3);
         for t in &self.triangles {
-            let [a, b, c] = t.map(|i| ids[i as usize]);
+            let [a, b, c] = t.map(|i| ids[i as usize] as u64);
             if a == b || b == c || a == c {
                 continue;
             }
-            for e in [(a, b), (b, c), (c, a)] {
-                *edges.entry(e).or_insert(0) += 1;
-            }
+            edges.extend([(a << 32) | b, (b << 32) | c, (c << 32) | a]);
         }
+        edges.sort_unstable();
         !edges.is_empty()
+            && edges.windows(2).all(|w| w[0] != w[1])
             && edges
                 .iter()
-                .all(|(&(u, v), &n)| n == 1 && edges.get(&(v, u)) == Some(&1))
+                .all(|&e| edges.binary_search(&e.rotate_right(32)).is_ok())
     }
 }
 

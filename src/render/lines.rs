@@ -13,7 +13,6 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use super::frame::Frame;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
-use crate::scene::material::{Material, Native};
 
 /// A projected end of a segment (or a point): screen position, 1/w and
 /// view depth / w (their ratio, interpolated linearly on screen, is the
@@ -43,7 +42,7 @@ pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, o
         }
         let color = |v: u32, material: usize| {
             let c = mesh.colors.get(v as usize).copied().unwrap_or(Vec4::ONE);
-            diffuse(&m.materials[material]) * c.truncate()
+            m.materials[material].diffuse_color() * c.truncate()
         };
         for l in &mesh.lines {
             let [a, b] = l.vertices.map(|v| v as usize);
@@ -85,14 +84,6 @@ pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, o
                 disc(e, radius, out);
             }
         }
-    }
-}
-
-/// A material's colour for unlit points and lines.
-fn diffuse(m: &Material) -> Vec3 {
-    match m.native {
-        Native::Pbr => m.pbr.base_color.truncate(),
-        Native::BlinnPhong => m.kd,
     }
 }
 

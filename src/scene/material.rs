@@ -154,6 +154,15 @@ pub struct Material {
 }
 
 impl Material {
+    /// The diffuse colour without textures or light (Kd, or glTF's base
+    /// colour factor): what unlit points and lines are drawn with.
+    pub fn diffuse_color(&self) -> glam::Vec3 {
+        match self.native {
+            Native::Pbr => self.pbr.base_color.truncate(),
+            Native::BlinnPhong => self.kd,
+        }
+    }
+
     pub fn default_named(name: &str) -> Material {
         Material {
             name: name.to_string(),

@@ -131,6 +131,33 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     )?;
     let mut warnings = settings::no_effect_warnings(d, ctx, &settings);
     let models = models::build(d, ctx, &settings, &scene_dir, &mut warnings)?;
+    // Point and line sizes without points or lines to draw.
+    for (key, v, has) in [
+        (
+            "render.point_size",
+            &d.render.point_size,
+            models.models.iter().any(|m| !m.mesh.points.is_empty()),
+        ),
+        (
+            "render.line_width",
+            &d.render.line_width,
+            models.models.iter().any(|m| !m.mesh.lines.is_empty()),
+        ),
+    ] {
+        if let Some(v) = v
+            && !has
+        {
+            warnings.push(format!(
+                "{}: {key} has no effect: no model has {}",
+                ctx.location(v.span()),
+                if key.ends_with("point_size") {
+                    "points"
+                } else {
+                    "lines"
+                }
+            ));
+        }
+    }
     let bounds = models::bounds(&models.models);
     let mut lights: Vec<_> = d
         .lights

@@ -118,7 +118,8 @@ pub(super) fn build(
                 .as_ref()
                 .map(|n| n.get_ref().clone())
                 .unwrap_or_else(|| format!("model{i}")),
-            closed: mesh.is_closed(),
+            // Only `cull = "auto"` asks (a sort over the edges).
+            closed: settings.cull == crate::scene::settings::CullMode::Auto && mesh.is_closed(),
             mesh: Arc::new(mesh),
             materials,
             world_from_object: world,
