@@ -706,3 +706,49 @@ fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
         }
     }
 }
+
+#[test]
+fn shadow_maps_reused_across_frames_match_maps_rendered_afresh() {
+    // One renderer for all frames keeps the last frame's maps while the
+    // lights and models stand still (a turntable that turns the camera):
+    // those frames must equal frames whose maps are rendered afresh, and a
+    // turntable that turns the models must never reuse a stale map.
+    let dir = common::scratch("shadow_map_reuse");
+    std::fs::write(
+        dir.join("box.obj"),
+        obj(procedural::cube([0.3, 0.5, 0.0], 0.5)),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        obj(procedural::ground(3.0, 0.0, 1.0)),
+    )
+    .unwrap();
+    for rotate in ["camera", "models"] {
+        let scene = load(
+            &dir,
+            &format!(
+                "[output]\nwidth = 96\nheight = 72\n[render]\nshadows = \"pcf\"\nshadow_map_size = 256\n\
+                 [[model]]\npath = \"box.obj\"\n[[model]]\npath = \"ground.obj\"\n\
+                 [[light]]\nkind = \"directional\"\ndirection = [-0.6, -1.0, -0.3]\nshadows = true\n\
+                 [[camera]]\neye = [0.0, 3.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                 [animation]\nframes = 4\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360.0, rotate = \"{rotate}\" }}\n"
+            ),
+        );
+        let shared = softraster::render::Renderer::new(&scene);
+        let mut frames = Vec::new();
+        for f in 0..4 {
+            let mut out = Frame::new(0, 0);
+            shared.render(&scene, 0, f, &mut out);
+            let fresh = render_frame(&scene, 0, f);
+            assert!(
+                out.color == fresh.color,
+                "rotate = {rotate}, frame {f}: the shared renderer's frame differs"
+            );
+            frames.push(out.color);
+        }
+        // The frames differ from each other (the turntable moves something,
+        // and the shadow is in view).
+        assert!(frames[0] != frames[2], "rotate = {rotate}");
+    }
+}

@@ -46,12 +46,13 @@ pub enum AddressMode {
     Border,
 }
 
-/// One image of a mip chain: RGBA8 in 4x4 blocks (see the module notes).
+/// One image of a mip chain: RGBA8 in 4x4 blocks of one cache line each
+/// (see the module notes).
 #[derive(Debug)]
 pub struct Level {
     pub width: u32,
     pub height: u32,
-    texels: Vec<[u8; 4]>,
+    blocks: Vec<Block>,
     /// Blocks per row of blocks.
     blocks_x: u32,
 }
@@ -76,7 +77,41 @@ pub struct Texture {
     pub binary_alpha: f32,
     /// Every texel has R = G = B (a height map rather than a normal map).
     pub grey: bool,
+    /// Stored byte -> linear value of R, G and B: the sRGB table for color
+    /// maps, `DATA_TABLE` for data.
+    lut: &'static [f32; 256],
+    /// Stored byte -> alpha.
+    alpha_lut: &'static [f32; 256],
 }
+
+/// Byte -> byte / 255 (data maps and alpha), the same floats as
+/// `b as f32 * (1.0 / 255.0)`.
+static DATA_TABLE: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = i as f32 * (1.0 / 255.0);
+        i += 1;
+    }
+    t
+};
+
+/// Byte -> byte / 255 as `b as f32 / 255.0` (the alpha of color maps).
+static ALPHA_TABLE: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = i as f32 / 255.0;
+        i += 1;
+    }
+    t
+};
+
+/// 4x4 texels, row-major, aligned to a 64-byte cache line (so a block is
+/// exactly one line).
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+struct Block([[u8; 4]; 16]);
 
 /// How a material refers to a texture: the texture plus the MTL options that
 /// change its lookup.
@@ -125,6 +160,16 @@ pub struct Gradients {
     pub dy: Vec2,
 }
 
+/// A filtered lookup's footprint in texels (`Texture::footprint`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Footprint {
+    /// One trilinear probe at this level of detail.
+    Lod(f32),
+    /// `n` trilinear probes at `lod`, spread over `axis` (texture
+    /// coordinates) centred on the lookup.
+    Probes { n: f32, lod: f32, axis: Vec2 },
+}
+
 /// Border color for `address = "border"` and NaN coordinates: transparent black.
 pub const BORDER: Vec4 = Vec4::ZERO;
 
@@ -135,7 +180,7 @@ impl Level {
         Level {
             width,
             height,
-            texels: vec![[0; 4]; (blocks_x * blocks_y * 16) as usize],
+            blocks: vec![Block([[0; 4]; 16]); (blocks_x * blocks_y) as usize],
             blocks_x,
         }
     }
@@ -146,7 +191,7 @@ impl Level {
         for (y, row) in rows.chunks_exact(width as usize).enumerate() {
             for (x, &texel) in row.iter().enumerate() {
                 let i = l.index(x as u32, y as u32);
-                l.texels[i] = texel;
+                l.blocks[i >> 4].0[i & 15] = texel;
             }
         }
         l
@@ -160,7 +205,28 @@ impl Level {
 
     #[inline]
     pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
-        self.texels[self.index(x, y)]
+        let i = self.index(x, y);
+        self.blocks[i >> 4].0[i & 15]
+    }
+
+    /// Texels (x, y), (x + 1, y), (x, y + 1) and (x + 1, y + 1), for
+    /// x + 1 < width and y + 1 < height: one address, then the steps to
+    /// the neighbours (within a block, or across to the next one).
+    #[inline(always)]
+    fn footprint(&self, x: u32, y: u32) -> [[u8; 4]; 4] {
+        let i = self.index(x, y);
+        // Along x: the next texel of the row, or the first of the block
+        // to the right (16 texels on, 3 back).
+        let dx = if x & 3 == 3 { 13 } else { 1 };
+        // Along y: the next row of the block, or the first row of the
+        // block below (a row of blocks on, 12 back).
+        let dy = if y & 3 == 3 {
+            (self.blocks_x as usize) * 16 - 12
+        } else {
+            4
+        };
+        let t = |i: usize| self.blocks[i >> 4].0[i & 15];
+        [t(i), t(i + dx), t(i + dy), t(i + dx + dy)]
     }
 }
 
@@ -245,6 +311,12 @@ impl Texture {
                 hard as f32 / partial as f32
             },
             grey,
+            lut: if srgb {
+                srgb_to_linear_table()
+            } else {
+                &DATA_TABLE
+            },
+            alpha_lut: if srgb { &ALPHA_TABLE } else { &DATA_TABLE },
         }
     }
 
@@ -289,8 +361,7 @@ impl Texture {
         if x >= 0.0 && y >= 0.0 && x < (l.width - 1) as f32 && y < (l.height - 1) as f32 {
             let (x0, y0) = (x as u32, y as u32);
             let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-            let (a, b) = (l.texel(x0, y0), l.texel(x0 + 1, y0));
-            let (c, d) = (l.texel(x0, y0 + 1), l.texel(x0 + 1, y0 + 1));
+            let [a, b, c, d] = l.footprint(x0, y0);
             let top = self.decode(a).lerp(self.decode(b), fx);
             let bottom = self.decode(c).lerp(self.decode(d), fx);
             return top.lerp(bottom, fy);
@@ -334,56 +405,77 @@ impl Texture {
             TextureFilter::Nearest => self.sample_nearest(uv, mode),
             TextureFilter::Bilinear => self.sample_bilinear(uv, mode),
             _ if f.mips.is_none() => self.sample_bilinear(uv, mode),
-            TextureFilter::Trilinear => {
-                let size = Vec2::new(self.width as f32, self.height as f32);
-                let (lx, ly) = ((g.dx * size).length(), (g.dy * size).length());
-                self.sample_lod(f.mips, uv, mode, lod_of(lx.max(ly)))
-            }
-            TextureFilter::Anisotropic => {
-                let size = Vec2::new(self.width as f32, self.height as f32);
-                let (ax, ay) = (g.dx * size, g.dy * size);
-                let (lx, ly) = (ax.length(), ay.length());
-                let (major, minor, axis) = if lx >= ly {
-                    (lx, ly, g.dx)
-                } else {
-                    (ly, lx, g.dy)
-                };
-                let ratio = if minor > 0.0 {
-                    major / minor
-                } else {
-                    f32::INFINITY
-                };
-                let n = ratio.min(f.max_anisotropy).ceil().max(1.0);
-                if !n.is_finite() || n <= 1.0 {
-                    return self.sample_lod(f.mips, uv, mode, lod_of(major));
-                }
-                // n probes cover the major axis; each filters major / n.
-                let lod = lod_of(major / n);
-                let count = n as u32;
+            _ => self.sample_footprint(uv, self.footprint(g, &f), mode, f.mips),
+        }
+    }
+
+    /// What trilinear or anisotropic filtering (`f.filter`) derives from
+    /// the derivatives `g` and this texture's size: the same for every
+    /// texture of that size looked up with those derivatives, so a
+    /// material's maps share it.
+    pub fn footprint(&self, g: Gradients, f: &Filtering) -> Footprint {
+        let size = Vec2::new(self.width as f32, self.height as f32);
+        let (ax, ay) = (g.dx * size, g.dy * size);
+        let (lx, ly) = (ax.length(), ay.length());
+        if f.filter != TextureFilter::Anisotropic {
+            return Footprint::Lod(lod_of(lx.max(ly)));
+        }
+        let (major, minor, axis) = if lx >= ly {
+            (lx, ly, g.dx)
+        } else {
+            (ly, lx, g.dy)
+        };
+        let ratio = if minor > 0.0 {
+            major / minor
+        } else {
+            f32::INFINITY
+        };
+        let n = ratio.min(f.max_anisotropy).ceil().max(1.0);
+        if !n.is_finite() || n <= 1.0 {
+            return Footprint::Lod(lod_of(major));
+        }
+        // n probes cover the major axis; each filters major / n.
+        Footprint::Probes {
+            n,
+            lod: lod_of(major / n),
+            axis,
+        }
+    }
+
+    /// A lookup at `uv` over `footprint` in the chain whose levels 1..
+    /// are `mips`.
+    #[inline]
+    pub fn sample_footprint(
+        &self,
+        uv: Vec2,
+        footprint: Footprint,
+        mode: Wrap,
+        mips: Option<&[Level]>,
+    ) -> Vec4 {
+        match footprint {
+            Footprint::Lod(lod) => self.sample_lod(mips, uv, mode, lod),
+            Footprint::Probes { n, lod, axis } => {
                 let mut sum = Vec4::ZERO;
-                for k in 0..count {
+                for k in 0..n as u32 {
                     let t = (k as f32 + 0.5) / n - 0.5;
-                    sum += self.sample_lod(f.mips, uv + axis * t, mode, lod);
+                    sum += self.sample_lod(mips, uv + axis * t, mode, lod);
                 }
                 sum / n
             }
         }
     }
 
-    /// A stored texel as linear RGBA (sRGB color decoded, data /255).
-    #[inline]
+    /// A stored texel as linear RGBA (sRGB color decoded, data /255), by
+    /// table.
+    #[inline(always)]
     pub(crate) fn decode(&self, t: [u8; 4]) -> Vec4 {
-        if self.srgb {
-            let lut = srgb_to_linear_table();
-            Vec4::new(
-                lut[t[0] as usize],
-                lut[t[1] as usize],
-                lut[t[2] as usize],
-                t[3] as f32 / 255.0,
-            )
-        } else {
-            Vec4::new(t[0] as f32, t[1] as f32, t[2] as f32, t[3] as f32) * (1.0 / 255.0)
-        }
+        let lut = self.lut;
+        Vec4::new(
+            lut[t[0] as usize],
+            lut[t[1] as usize],
+            lut[t[2] as usize],
+            self.alpha_lut[t[3] as usize],
+        )
     }
 
     /// The general case: any finite coordinate, through the address mode.
@@ -448,6 +540,13 @@ fn address(c: f64, size: u32, mode: AddressMode) -> Option<i64> {
 }
 
 impl TextureRef {
+    /// No transform and no sampler limits: a lookup is the texture's own
+    /// (`Texture::sample_grad`), and its footprint can be shared.
+    #[inline]
+    pub fn is_plain(&self) -> bool {
+        self.transform == Affine2::IDENTITY && self.min_limit.is_none() && !self.mag_nearest
+    }
+
     pub fn new(texture: std::sync::Arc<Texture>) -> TextureRef {
         TextureRef {
             texture,

@@ -130,10 +130,7 @@ impl<'a> FrameData<'a> {
                                 )
                             };
                             let (m, uv, color) = self.material_uv(t, f.lambda);
-                            let tc = TexCoords {
-                                uv,
-                                ..Default::default()
-                            };
+                            let tc = TexCoords::new(uv, Default::default());
                             self.ctx.opacity(m, &tc, color) >= cutoff
                         };
                         if self.reverse {
@@ -253,7 +250,7 @@ impl<'a> FrameData<'a> {
                 let frag = it.at_pixel(px, py);
                 let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
                 let (m, uv, vcolor) = self.material_uv(t, frag.lambda);
-                let tc = TexCoords { uv, grads: g };
+                let tc = TexCoords::new(uv, g);
                 let a = self.ctx.opacity(m, &tc, vcolor).clamp(0.0, 1.0);
                 if !c.is_finite() {
                     return;
@@ -293,7 +290,7 @@ impl<'a> FrameData<'a> {
             let frag = self.shading_point(&it, px, py, m);
             let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
             let (mat, uv, vcolor) = self.material_uv(t, frag.lambda);
-            let tc = TexCoords { uv, grads: g };
+            let tc = TexCoords::new(uv, g);
             let a = self.ctx.opacity(mat, &tc, vcolor).clamp(0.0, 1.0) * m.count_ones() as f32
                 / n as f32;
             if !c.is_finite() {
@@ -321,8 +318,32 @@ impl<'a> FrameData<'a> {
         let n = vis.samples();
         let inv_n = 1.0 / n as f32;
         let mut cache = InterpolatorCache::default();
+        // One background color for the band (none of the per-pixel kinds).
+        let flat_bg = (self.env_bg.is_none() && self.ground.is_none()).then_some(self.bg);
+        // Over a flat background: the empty pixels first, in one pass, and
+        // quads without a triangle skipped below.
+        let filled = flat_bg.is_some();
+        let empty_at = |i: usize| {
+            vis.id[i * n..(i + 1) * n]
+                .iter()
+                .all(|&id| id == NO_TRIANGLE)
+        };
+        if filled {
+            for (i, (c, d)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
+                if empty_at(i) {
+                    *c = self.bg;
+                    *d = f32::INFINITY;
+                }
+            }
+        }
         for qy in (0..th).step_by(2) {
             for qx in (0..tw).step_by(2) {
+                if filled {
+                    let at = |x: usize, y: usize| x >= tw || y >= th || empty_at(y * tw + x);
+                    if at(qx, qy) && at(qx + 1, qy) && at(qx, qy + 1) && at(qx + 1, qy + 1) {
+                        continue;
+                    }
+                }
                 let mut quad: smallvec::SmallVec<[(u32, [Gradients; 2]); 4]> =
                     smallvec::SmallVec::new();
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
@@ -333,15 +354,27 @@ impl<'a> FrameData<'a> {
                     let i = y * tw + x;
                     let ids = &vis.id[i * n..(i + 1) * n];
                     let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
-                    let bg = match &self.env_bg {
-                        Some(e) => e.at(px, py),
-                        None => self.bg,
+                    let empty = ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE);
+                    let bg = match flat_bg {
+                        Some(bg) => bg,
+                        // Only where the background shows (some sample is
+                        // uncovered) is its per-pixel color needed.
+                        None if empty || ids.contains(&NO_TRIANGLE) => {
+                            let bg = match &self.env_bg {
+                                Some(e) => e.at(px, py),
+                                None => self.bg,
+                            };
+                            match &self.ground {
+                                Some(g) => g.over(bg, px, py),
+                                None => bg,
+                            }
+                        }
+                        None => Vec4::ZERO,
                     };
-                    let bg = match &self.ground {
-                        Some(g) => g.over(bg, px, py),
-                        None => bg,
-                    };
-                    if ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE) {
+                    if empty {
+                        if filled {
+                            continue;
+                        }
                         color[i] = bg;
                         depth[i] = f32::INFINITY;
                         continue;
@@ -349,7 +382,12 @@ impl<'a> FrameData<'a> {
                     let occlusion = ao.map_or(1.0, |a| a[i]);
                     let mut acc = Vec4::ZERO;
                     let mut nearest = f32::INFINITY;
-                    for (id, mask) in fragments(ids) {
+                    let frags = if n == 1 {
+                        smallvec::smallvec![(ids[0], 1)]
+                    } else {
+                        fragments(ids)
+                    };
+                    for (id, mask) in frags {
                         let count = mask.count_ones() as f32;
                         if id == NO_TRIANGLE {
                             acc += bg * count;
@@ -501,7 +539,7 @@ impl<'a> FrameData<'a> {
             position,
             normal,
             raw_normal,
-            tc: TexCoords { uv, grads },
+            tc: TexCoords::new(uv, grads),
             color,
             tangent,
             normal_from_object: mv.normal_from_object,

@@ -82,6 +82,9 @@ pub struct Renderer {
     env: OnceLock<Option<EnvLight>>,
     /// `method = "sampled"`: the environment's sampling tables.
     env_sampler: OnceLock<Option<EnvSampler>>,
+    /// The last frame's shadow maps (reused while nothing they depend on
+    /// moves).
+    shadow_maps: shadow_pass::MapCache,
 }
 
 impl Renderer {
@@ -113,6 +116,7 @@ impl Renderer {
                 .map(|e| (e.intensity, e.rotation)),
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
+            shadow_maps: Default::default(),
         }
     }
 
@@ -242,7 +246,7 @@ impl Renderer {
         .then(|| self.tracer(fs));
 
         let mut verts = vertex::transform_all(fs);
-        let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref());
+        let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref(), &self.shadow_maps);
         let env = self.env_light(fs.scene);
         if s.shading == ShadingMode::Gouraud {
             let ctx = shade_context(fs, &[], &shadows, env);

@@ -10,6 +10,8 @@
 //! draw both faces of every triangle, with opaque depth (alpha-tested and
 //! blended materials cast full shadows).
 
+use std::sync::{Arc, Mutex};
+
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -20,7 +22,7 @@ use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
 use crate::raster::coverage::raster_triangle;
 use crate::raster::setup::{Tri, Viewport, setup};
 use crate::raytrace::Tracer;
-use crate::scene::light::LightKind;
+use crate::scene::light::{Light, LightKind};
 use crate::scene::settings::{CullMode, ShadowMethod};
 use crate::shade::shadow::{Filter, LightShadow, MapProjection, ShadowMap, Shadows};
 
@@ -32,12 +34,31 @@ struct Geo<'g> {
     triangles: &'g [[u32; 3]],
 }
 
+/// The shadow maps of the last frame rendered, with what they depend on:
+/// a frame whose lights and model placements are the same (a turntable
+/// that turns the camera, or a still scene) reuses them instead of
+/// rendering them again.
+#[derive(Default)]
+pub(super) struct MapCache {
+    last: Mutex<Option<(MapKey, Arc<[LightShadow]>)>>,
+}
+
+#[derive(PartialEq)]
+struct MapKey {
+    lights: Vec<Light>,
+    world_from_object: Vec<Mat4>,
+    method: ShadowMethod,
+    size: u32,
+}
+
 /// The frame's shadows. `tracer`: the frame's ray tracer, which
-/// `render.shadows = "raytraced"` tests against.
+/// `render.shadows = "raytraced"` tests against. `cache`: the maps of the
+/// renderer's last frame.
 pub(super) fn shadows<'a>(
     fs: &FrameSetup,
     mv: &[ModelVertices],
     tracer: Option<&'a Tracer<'a>>,
+    cache: &MapCache,
 ) -> Shadows<'a> {
     let s = &fs.scene.settings;
     if s.shadows == ShadowMethod::Off || !fs.lights.iter().any(|l| l.shadows) {
@@ -49,14 +70,45 @@ pub(super) fn shadows<'a>(
         Filter::Pcf
     };
     let mut out = Shadows {
-        lights: Vec::with_capacity(fs.lights.len()),
+        lights: Arc::new([]),
         filter,
         bias: s.shadow_bias,
         tracer: None,
     };
     if s.shadows == ShadowMethod::Raytraced {
         out.tracer = tracer;
+        out.lights = light_shadows(fs, mv).into();
+        return out;
     }
+    let key = MapKey {
+        lights: fs.lights.clone(),
+        world_from_object: fs.world_from_object.clone(),
+        method: s.shadows,
+        size: s.shadow_map_size,
+    };
+    // A poisoned lock only means another frame panicked: the cache holds
+    // whole values, so it is still consistent.
+    let cached = {
+        let last = cache.last.lock().unwrap_or_else(|e| e.into_inner());
+        last.as_ref()
+            .filter(|(k, _)| *k == key)
+            .map(|(_, maps)| maps.clone())
+    };
+    out.lights = match cached {
+        Some(maps) => maps,
+        None => {
+            let maps: Arc<[LightShadow]> = light_shadows(fs, mv).into();
+            *cache.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, maps.clone()));
+            maps
+        }
+    };
+    out
+}
+
+/// Each light's shadow: its map(s), rays, or none.
+fn light_shadows(fs: &FrameSetup, mv: &[ModelVertices]) -> Vec<LightShadow> {
+    let s = &fs.scene.settings;
+    let mut out = Vec::with_capacity(fs.lights.len());
     let size = s.shadow_map_size;
     let verts: Vec<Geo> = mv
         .iter()
@@ -91,7 +143,7 @@ pub(super) fn shadows<'a>(
                 LightKind::Point { position, .. } => point(verts, position, size),
             }
         };
-        out.lights.push(ls);
+        out.push(ls);
     }
     out
 }

@@ -10,9 +10,13 @@ pub mod light;
 pub mod pbr;
 pub mod shadow;
 
+use std::cell::Cell;
+
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
-use crate::assets::texture::{Filtering, Gradients, Level, TextureRef};
+use crate::assets::texture::{
+    Filtering, Footprint, Gradients, Level, TextureFilter as Filter, TextureRef,
+};
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
@@ -54,19 +58,31 @@ pub struct ShadeContext<'a> {
 
 /// Texture coordinates of a point in both sets (None where the mesh has
 /// none), with their screen-space derivatives.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct TexCoords {
     pub uv: [Option<Vec2>; 2],
     pub grads: [Gradients; 2],
+    /// Per set, the last filter footprint computed and the texture size it
+    /// is for: the maps of a material mostly share a size, and then one
+    /// footprint (level of detail, probes) serves them all.
+    footprint: [Cell<Option<SizedFootprint>>; 2],
 }
 
+/// A footprint and the texture size (width, height) it was computed for.
+type SizedFootprint = ((u32, u32), Footprint);
+
 impl TexCoords {
+    pub fn new(uv: [Option<Vec2>; 2], grads: [Gradients; 2]) -> TexCoords {
+        TexCoords {
+            uv,
+            grads,
+            footprint: Default::default(),
+        }
+    }
+
     /// Set 0 only.
     pub fn single(uv: Option<Vec2>, grads: Gradients) -> TexCoords {
-        TexCoords {
-            uv: [uv, None],
-            grads: [grads, Gradients::default()],
-        }
+        TexCoords::new([uv, None], [grads, Gradients::default()])
     }
 }
 
@@ -280,6 +296,23 @@ impl ShadeContext<'_> {
             max_anisotropy: self.max_anisotropy,
             mips: self.mips.get(t.texture.id).copied().flatten(),
         };
+        if f.mips.is_some()
+            && matches!(f.filter, Filter::Trilinear | Filter::Anisotropic)
+            && t.is_plain()
+        {
+            let tex = &t.texture;
+            let key = (tex.width, tex.height);
+            let fp = match tc.footprint[set].get() {
+                Some((k, fp)) if k == key => fp,
+                _ => {
+                    let fp = tex.footprint(tc.grads[set], &f);
+                    tc.footprint[set].set(Some((key, fp)));
+                    fp
+                }
+            };
+            let mode = t.address.unwrap_or(self.address.into());
+            return Some(tex.sample_footprint(uv, fp, mode, f.mips));
+        }
         Some(t.sample_grad(uv, tc.grads[set], self.address, f))
     }
 
@@ -398,7 +431,7 @@ impl ShadeContext<'_> {
                 let texels = (g.dx * size).length().max((g.dy * size).length());
                 let step = texels.max(1.0) / size;
                 let h = |d: Vec2| {
-                    let mut at = *tc;
+                    let mut at = tc.clone();
                     at.uv[set] = Some(uv + d);
                     self.sample(map, &at).map_or(0.0, |c| c.x)
                 };

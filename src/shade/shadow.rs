@@ -115,8 +115,9 @@ pub enum Filter {
 
 /// Every light's shadow for one frame.
 pub struct Shadows<'a> {
-    /// Per light of the frame, in the same order.
-    pub lights: Vec<LightShadow>,
+    /// Per light of the frame, in the same order (shared between frames
+    /// whose lights and shadow casters stand where they stood).
+    pub lights: std::sync::Arc<[LightShadow]>,
     pub filter: Filter,
     pub bias: ShadowBias,
     /// The frame's ray tracer (ray-traced shadows only).
@@ -129,7 +130,7 @@ impl Shadows<'_> {
     /// No shadows at all.
     pub fn none() -> Shadows<'static> {
         Shadows {
-            lights: Vec::new(),
+            lights: std::sync::Arc::new([]),
             filter: Filter::Pcf,
             bias: ShadowBias::default(),
             tracer: None,
@@ -326,7 +327,7 @@ mod tests {
 
     fn shadows(filter: Filter) -> Shadows<'static> {
         Shadows {
-            lights: vec![LightShadow::Map(map())],
+            lights: std::sync::Arc::new([LightShadow::Map(map())]),
             filter,
             bias: ShadowBias::default(),
             tracer: None,

@@ -24,9 +24,13 @@ pub struct BenchArgs {
     #[arg(long, default_value = "../shared/assets")]
     pub assets: PathBuf,
     /// Which workloads: diablo3, nefertiti, flighthelmet (glTF, pbr),
-    /// diablo3-4k, diablo3-4k-aniso, filters, shadows, ao, edges (time and
-    /// error of each method, CSV; edges at --size x 3/4 --size), or all
-    /// (the first three).
+    /// diablo3-4k, diablo3-4k-aniso; the llvmpipe harness's own set-ups
+    /// diablo3-matched, diablo3-matched-shadow (a floor and a 2048 shadow
+    /// map, like `--shadow 1 --floor 1`), diablo3-4k-matched and
+    /// nefertiti-matched (diablo3's maps on spherical UVs, like the
+    /// harness's nefertiti); filters, shadows, ao, edges (time and error
+    /// of each method, CSV; edges at --size x 3/4 --size), or all (the
+    /// first three).
     #[arg(long, default_value = "all")]
     pub case: String,
     #[arg(long, default_value_t = 72)]
@@ -48,6 +52,9 @@ pub struct BenchArgs {
     /// shadows.
     #[arg(long)]
     pub write_scene: Option<PathBuf>,
+    /// Append one JSON line per case (the table's numbers) to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone)]
@@ -123,12 +130,197 @@ fn scene_text(
                 p(dir.join("diablo3_pose_mtl.obj"))?
             )
         }
+        "diablo3-matched"
+        | "diablo3-matched-shadow"
+        | "diablo3-4k-matched"
+        | "nefertiti-matched" => matched_scene(case, assets, &d3, &common, &p)?,
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, filters, shadows, ao, edges or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, filters, shadows, ao, edges or all"
             )));
         }
     })
+}
+
+/// The llvmpipe harness's set-up (`turntable.py`): one material with
+/// kd 1, ks 0.5, Ns 32, the diffuse (sRGB), specular and tangent-space
+/// normal maps and no glow map; trilinear mip maps, back faces culled.
+/// `-shadow`: a grey floor under the model (a disc of the harness's
+/// quad's area: the floor turns with the model here, and a disc looks the
+/// same at every angle) and a 2048 PCF shadow map of the directional
+/// light (set in `anchor_lights`).
+fn matched_scene(
+    case: &str,
+    assets: &Path,
+    d3: &Path,
+    common: &str,
+    p: &dyn Fn(PathBuf) -> Result<String, Error>,
+) -> Result<String, Error> {
+    let (obj, maps) = match case {
+        "diablo3-4k-matched" => {
+            let dir = resampled_diablo3(d3)?;
+            (dir.join("diablo3_pose.obj"), dir)
+        }
+        "nefertiti-matched" => (
+            spherical_uv_model(&assets.join("common/nefertiti.obj"))?,
+            d3.to_path_buf(),
+        ),
+        _ => (d3.join("diablo3_pose.obj"), d3.to_path_buf()),
+    };
+    let map = |m: &str| p(maps.join(format!("diablo3_pose_{m}.tga")));
+    let mut render = "texture_filter = \"trilinear\"\ncull = \"back\"".to_string();
+    let mut floor = String::new();
+    if case.ends_with("-shadow") {
+        render.push_str("\nshadows = \"pcf\"\nshadow_map_size = 2048");
+        let (lo, hi) = obj_bounds(Path::new(&p(obj.clone())?))?;
+        let path = floor_disc(lo, hi)?;
+        // The harness's floor: sRGB 200 grey, ks 0.1, Ns 16.
+        let grey = crate::color::srgb_to_linear(200.0 / 255.0);
+        floor = format!(
+            "[[model]]\npath = \"{}\"\n[model.material]\nillum = 2\nkd = [{grey}, {grey}, {grey}]\n\
+             ks = [0.1, 0.1, 0.1]\nns = 16.0\n",
+            p(path)?
+        );
+    }
+    Ok(format!(
+        "{}[[model]]\npath = \"{}\"\n[model.material]\nillum = 2\nkd = [1.0, 1.0, 1.0]\n\
+         ks = [0.5, 0.5, 0.5]\nns = 32.0\nmap_kd = \"{}\"\nmap_ks = \"{}\"\nnorm = \"{}\"\n{floor}",
+        common.replace("texture_filter = \"bilinear\"", &render),
+        p(obj)?,
+        map("diffuse")?,
+        map("spec")?,
+        map("nm_tangent")?,
+    ))
+}
+
+/// The bounding box of an OBJ's `v` lines.
+fn obj_bounds(path: &Path) -> Result<(Vec3, Vec3), Error> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix("v ") {
+            let v: Vec<f32> = rest
+                .split_whitespace()
+                .filter_map(|t| t.parse().ok())
+                .collect();
+            if v.len() >= 3 {
+                let q = Vec3::new(v[0], v[1], v[2]);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+    }
+    if !lo.is_finite() {
+        return Err(Error::asset(path, None, "benchmark model has no vertices"));
+    }
+    Ok((lo, hi))
+}
+
+/// A horizontal disc, facing up, at the bottom of the box `lo`..`hi`,
+/// centred under it, of the area of the harness's floor quad (half side
+/// 1.6 x the box's half diagonal), in the benchmark cache.
+fn floor_disc(lo: Vec3, hi: Vec3) -> Result<PathBuf, Error> {
+    let c = (lo + hi) * 0.5;
+    let r = (hi - lo).length() * 0.5;
+    let radius = 1.6 * r * 2.0 / std::f32::consts::PI.sqrt();
+    const N: usize = 64;
+    let mut text = format!("v {} {} {}\n", c.x, lo.y, c.z);
+    for k in 0..N {
+        let a = k as f32 / N as f32 * std::f32::consts::TAU;
+        text.push_str(&format!(
+            "v {} {} {}\n",
+            c.x + radius * a.cos(),
+            lo.y,
+            c.z - radius * a.sin()
+        ));
+    }
+    text.push_str("vn 0 1 0\n");
+    for k in 0..N {
+        let (a, b) = (k + 2, (k + 1) % N + 2);
+        text.push_str(&format!("f 1//1 {a}//1 {b}//1\n"));
+    }
+    let dir = std::env::temp_dir().join("softraster-bench-cache");
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    // Named by its content: concurrent runs never write each other's file.
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    text.hash(&mut h);
+    let path = dir.join(format!("floor-{:016x}.obj", h.finish()));
+    if !path.is_file() {
+        let tmp = dir.join(format!(".floor.{}.obj", std::process::id()));
+        std::fs::write(&tmp, text).map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))?;
+    }
+    Ok(path)
+}
+
+/// `model` turned from Z-up to Y-up (x, z, -y) with the harness's
+/// spherical texture coordinates about its box center (u = 0.5 +
+/// atan2(x, z) / 2pi, v = 0.5 + asin(y) / pi of the unit direction), one
+/// per position, written once into the benchmark cache.
+fn spherical_uv_model(model: &Path) -> Result<PathBuf, Error> {
+    let dir = std::env::temp_dir().join("softraster-bench-cache/nefertiti_uv");
+    let out = dir.join("nefertiti_uv.obj");
+    if out.is_file() {
+        return Ok(out);
+    }
+    if !model.is_file() {
+        return Err(Error::asset(
+            model,
+            None,
+            "benchmark model not found (pass --assets)",
+        ));
+    }
+    let text = std::fs::read_to_string(model).map_err(|e| Error::io(model, e))?;
+    let mut pos = Vec::new();
+    let mut faces = Vec::new();
+    for line in text.lines() {
+        let mut t = line.split_whitespace();
+        match t.next() {
+            Some("v") => {
+                let v: Vec<f32> = t.filter_map(|x| x.parse().ok()).collect();
+                if v.len() >= 3 {
+                    pos.push(Vec3::new(v[0], v[2], -v[1]));
+                }
+            }
+            Some("f") => {
+                let n = pos.len() as i64;
+                let idx: Vec<i64> = t
+                    .filter_map(|c| c.split('/').next()?.parse::<i64>().ok())
+                    .map(|i| if i < 0 { n + i + 1 } else { i })
+                    .collect();
+                faces.push(idx);
+            }
+            _ => {}
+        }
+    }
+    let (lo, hi) = pos.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &q| (lo.min(q), hi.max(q)),
+    );
+    let c = (lo + hi) * 0.5;
+    let mut s = String::with_capacity(text.len() * 2);
+    for q in &pos {
+        s.push_str(&format!("v {} {} {}\n", q.x, q.y, q.z));
+    }
+    for q in &pos {
+        let d = (*q - c).normalize_or(Vec3::Y);
+        let u = 0.5 + d.x.atan2(d.z) / std::f32::consts::TAU;
+        let v = 0.5 + d.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI;
+        s.push_str(&format!("vt {u} {v}\n"));
+    }
+    for f in &faces {
+        s.push('f');
+        for i in f {
+            s.push_str(&format!(" {i}/{i}"));
+        }
+        s.push('\n');
+    }
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let tmp = dir.join(format!(".nefertiti_uv.{}.obj", std::process::id()));
+    std::fs::write(&tmp, s).map_err(|e| Error::io(&tmp, e))?;
+    std::fs::rename(&tmp, &out).map_err(|e| Error::io(&out, e))?;
+    Ok(out)
 }
 
 /// diablo3_pose_mtl with every map resampled to 4096x4096, generated once
@@ -136,11 +328,15 @@ fn scene_text(
 fn resampled_diablo3(src: &Path) -> Result<PathBuf, Error> {
     let dir = std::env::temp_dir().join("softraster-bench-cache/diablo3_4k");
     let done = dir.join(".complete");
-    if done.is_file() {
+    if done.is_file() && dir.join("diablo3_pose.obj").is_file() {
         return Ok(dir);
     }
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    for f in ["diablo3_pose_mtl.obj", "diablo3_pose.mtl"] {
+    for f in [
+        "diablo3_pose_mtl.obj",
+        "diablo3_pose.mtl",
+        "diablo3_pose.obj",
+    ] {
         std::fs::copy(src.join(f), dir.join(f)).map_err(|e| Error::io(src.join(f), e))?;
     }
     use rayon::prelude::*;
@@ -160,10 +356,26 @@ fn resampled_diablo3(src: &Path) -> Result<PathBuf, Error> {
     Ok(dir)
 }
 
+/// The bounding box center and half diagonal of model 0 as placed (the
+/// harness frames and lights the model alone, never its floor).
+fn subject_bounds(scene: &Scene) -> (Vec3, f32) {
+    let Some(m) = scene.models.first() else {
+        return (scene.bounds_center, scene.bounds_radius);
+    };
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for p in &m.mesh.positions {
+        let w = m.world_from_object.transform_point3(*p);
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
+}
+
 /// The llvmpipe harness's two lights, placed relative to the model's
-/// bounding sphere.
-fn anchor_lights(scene: &Scene) -> Vec<Light> {
-    let r = scene.bounds_radius;
+/// bounding sphere; the directional one casts shadows in the `-shadow`
+/// cases.
+fn anchor_lights(scene: &Scene, shadows: bool) -> Vec<Light> {
+    let (center, r) = subject_bounds(scene);
     let dir_l = Vec3::new(-0.5, 0.75, 0.45).normalize();
     let pt = Vec3::new(1.2, 0.6, 1.6) * r;
     let e = 0.6 * pt.length_squared();
@@ -174,12 +386,12 @@ fn anchor_lights(scene: &Scene) -> Vec<Light> {
                 irradiance: 1.0,
             },
             color: Vec3::new(0.9, 0.88, 0.85),
-            shadows: false,
+            shadows,
             range: None,
         },
         Light {
             kind: LightKind::Point {
-                position: scene.bounds_center + pt,
+                position: center + pt,
                 intensity: e,
             },
             color: Vec3::new(1.0, 0.95, 0.9),
@@ -208,13 +420,14 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         renderer.build_all_mips();
     }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    scene.lights = anchor_lights(&scene);
-    // The anchor's camera: the bounding sphere from +Z at fov 45 (the
-    // version 1 default; fitted cameras frame tighter).
+    scene.lights = anchor_lights(&scene, case.ends_with("-shadow"));
+    // The anchor's camera: the model's bounding sphere from +Z at fov 45
+    // (the version 1 default; fitted cameras frame tighter).
+    let (center, radius) = subject_bounds(&scene);
     scene.cameras = vec![crate::scene::Camera::framing(
         "camera".into(),
-        scene.bounds_center,
-        scene.bounds_radius,
+        center,
+        radius,
         45.0,
     )];
     let mut times = Vec::new();
@@ -302,7 +515,17 @@ fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
     } else {
         let text = scene_text(&args.case, &args.assets, args.size, args.frames, args.msaa)?;
         let scene = Scene::from_text(path, &text, &LoadOptions::default())?;
-        text + &lights_toml(&anchor_lights(&scene))
+        let (center, radius) = subject_bounds(&scene);
+        let cam = crate::scene::Camera::framing("camera".into(), center, radius, 45.0);
+        let v = |v: Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+        text + &lights_toml(&anchor_lights(&scene, args.case.ends_with("-shadow")))
+            + &format!(
+                "\n[[camera]]\neye = {}\ntarget = {}\nfov = 45.0\nnear = {}\nfar = {}\n",
+                v(cam.eye),
+                v(cam.target),
+                cam.near,
+                cam.far
+            )
     };
     crate::output::write_atomic(path, |w| {
         use std::io::Write;
@@ -362,6 +585,28 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
     println!("|---|---|---|---|---|---|---|");
     for c in cases {
         let r = pool.install(|| run_case(c, args))?;
+        if let Some(path) = &args.json {
+            let line = serde_json::json!({
+                "case": r.name,
+                "triangles": r.triangles,
+                "size": args.size,
+                "frames": args.frames,
+                "msaa": args.msaa,
+                "threads": pool.current_num_threads(),
+                "load_ms": r.load_ms,
+                "frame_median_ms": r.steady_ms,
+                "frame_min_ms": r.min_ms,
+                "render_total_ms": r.total_ms,
+                "png_ms_per_frame": r.png_ms,
+            });
+            use std::io::Write;
+            let mut f = std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(path)
+                .map_err(|e| Error::io(path, e))?;
+            writeln!(f, "{line}").map_err(|e| Error::io(path, e))?;
+        }
         println!(
             "| {} | {} | {:.1} | {:.2} | {:.2} | {:.0} | {:.2} |",
             r.name, r.triangles, r.load_ms, r.steady_ms, r.min_ms, r.total_ms, r.png_ms
