@@ -261,18 +261,23 @@ impl Shadows<'_> {
                 };
                 let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
                 let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
+                // `lit` over the 4x4 texels, its terms hoisted: the
+                // receiver's depth at texel (i, j) is z + tx[i] + ty[j]
+                // (the same sums, in the same order). A zero weight adds
+                // nothing, so every texel is read (clamped to the map).
+                let tx = [0, 1, 2, 3].map(|i| gx * ((bx + i) as f32 + 0.5 - fx));
+                let ty = [0, 1, 2, 3].map(|j| gy * ((by + j) as f32 + 0.5 - fy));
+                let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
                 let mut sum = 0.0;
-                for (j, wyj) in wy.iter().enumerate() {
-                    if *wyj == 0.0 {
-                        continue;
-                    }
+                for j in 0..4 {
+                    let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
                     let mut row = 0.0;
-                    for (i, wxi) in wx.iter().enumerate() {
-                        if *wxi > 0.0 {
-                            row += wxi * lit(bx + i as i32, by + j as i32);
-                        }
+                    for i in 0..4 {
+                        let stored = m.depth[base + cols[i]];
+                        let zr = z + tx[i] + ty[j];
+                        row += wx[i] * if stored <= zr { 1.0 } else { 0.0 };
                     }
-                    sum += wyj * row;
+                    sum += wy[j] * row;
                 }
                 sum
             }

@@ -28,7 +28,9 @@ pub struct BenchArgs {
     /// diablo3-matched, diablo3-matched-shadow (a floor and a 2048 shadow
     /// map, like `--shadow 1 --floor 1`), diablo3-4k-matched and
     /// nefertiti-matched (diablo3's maps on spherical UVs, like the
-    /// harness's nefertiti); filters, shadows, ao, edges (time and error
+    /// harness's nefertiti); tris-5k, tris-20k, tris-80k, tris-320k,
+    /// tris-1m (diablo3-matched subdivided 0 to 4 times: same pixels, more
+    /// triangles); filters, shadows, ao, edges (time and error
     /// of each method, CSV; edges at --size x 3/4 --size), or all (the
     /// first three).
     #[arg(long, default_value = "all")]
@@ -61,7 +63,11 @@ pub struct BenchArgs {
 pub struct BenchResult {
     pub name: String,
     pub triangles: usize,
+    /// Scene load (files read, meshes built, textures decoded, in
+    /// parallel) plus mip chains.
     pub load_ms: f64,
+    /// The mip chains' share of `load_ms`.
+    pub mips_ms: f64,
     /// Median of frames 1..n (frame 0 warms caches).
     pub steady_ms: f64,
     pub min_ms: f64,
@@ -133,10 +139,15 @@ fn scene_text(
         "diablo3-matched"
         | "diablo3-matched-shadow"
         | "diablo3-4k-matched"
-        | "nefertiti-matched" => matched_scene(case, assets, &d3, &common, &p)?,
+        | "nefertiti-matched"
+        | "tris-5k"
+        | "tris-20k"
+        | "tris-80k"
+        | "tris-320k"
+        | "tris-1m" => matched_scene(case, assets, &d3, &common, &p)?,
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, filters, shadows, ao, edges or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, tris-5k .. tris-1m, filters, shadows, ao, edges or all"
             )));
         }
     })
@@ -165,7 +176,19 @@ fn matched_scene(
             spherical_uv_model(&assets.join("common/nefertiti.obj"))?,
             d3.to_path_buf(),
         ),
-        _ => (d3.join("diablo3_pose.obj"), d3.to_path_buf()),
+        _ => match case.strip_prefix("tris-") {
+            Some(n) => {
+                let levels = ["5k", "20k", "80k", "320k", "1m"]
+                    .iter()
+                    .position(|k| *k == n)
+                    .unwrap_or(0);
+                (
+                    subdivided(&d3.join("diablo3_pose.obj"), levels)?,
+                    d3.to_path_buf(),
+                )
+            }
+            None => (d3.join("diablo3_pose.obj"), d3.to_path_buf()),
+        },
     };
     let map = |m: &str| p(maps.join(format!("diablo3_pose_{m}.tga")));
     let mut render = "texture_filter = \"trilinear\"\ncull = \"back\"".to_string();
@@ -191,6 +214,105 @@ fn matched_scene(
         map("spec")?,
         map("nm_tangent")?,
     ))
+}
+
+/// `model` (an OBJ of triangles) with every triangle split into four at
+/// its edge midpoints, `levels` times (5,022 triangles of diablo3 become
+/// 20k, 80k, 321k, 1.29M): positions, texture coordinates and normals
+/// are interpolated, so the surface, its texturing and the pixels it
+/// covers stay the same while the triangle count grows. Written once into
+/// the benchmark cache.
+fn subdivided(model: &Path, levels: usize) -> Result<PathBuf, Error> {
+    if levels == 0 {
+        return Ok(model.to_path_buf());
+    }
+    let dir = std::env::temp_dir().join("softraster-bench-cache");
+    let out = dir.join(format!("diablo3_sub{levels}.obj"));
+    if out.is_file() {
+        return Ok(out);
+    }
+    let text = std::fs::read_to_string(model).map_err(|e| Error::io(model, e))?;
+    // Attribute lists (positions, uvs, normals) and triangles of
+    // (position, uv, normal) indices, 0-based.
+    let mut attr: [Vec<Vec3>; 3] = Default::default();
+    let mut tris: Vec<[[usize; 3]; 3]> = Vec::new();
+    for line in text.lines() {
+        let mut t = line.split_whitespace();
+        let kind = match t.next() {
+            Some("v") => 0,
+            Some("vt") => 1,
+            Some("vn") => 2,
+            Some("f") => {
+                let corners: Vec<[usize; 3]> = t
+                    .map(|c| {
+                        let mut it = c.split('/').map(|x| x.parse::<usize>().unwrap_or(1) - 1);
+                        [0, 1, 2].map(|_| it.next().unwrap_or(0))
+                    })
+                    .collect();
+                for k in 1..corners.len().saturating_sub(1) {
+                    tris.push([corners[0], corners[k], corners[k + 1]]);
+                }
+                continue;
+            }
+            _ => continue,
+        };
+        let v: Vec<f32> = t.filter_map(|x| x.parse().ok()).collect();
+        attr[kind].push(Vec3::new(
+            v.first().copied().unwrap_or(0.0),
+            v.get(1).copied().unwrap_or(0.0),
+            v.get(2).copied().unwrap_or(0.0),
+        ));
+    }
+    if tris
+        .iter()
+        .flatten()
+        .any(|c| (0..3).any(|k| c[k] >= attr[k].len()))
+    {
+        return Err(Error::asset(
+            model,
+            None,
+            "benchmark model: index out of range",
+        ));
+    }
+    for _ in 0..levels {
+        // One midpoint per edge and attribute, shared by both triangles.
+        let mut mid: [std::collections::HashMap<(usize, usize), usize>; 3] = Default::default();
+        let mut next = Vec::with_capacity(tris.len() * 4);
+        for t in &tris {
+            let mut m = [[0usize; 3]; 3];
+            for (e, (a, b)) in [(0, 1), (1, 2), (2, 0)].into_iter().enumerate() {
+                for k in 0..3 {
+                    let (i, j) = (t[a][k], t[b][k]);
+                    let key = (i.min(j), i.max(j));
+                    m[e][k] = *mid[k].entry(key).or_insert_with(|| {
+                        attr[k].push((attr[k][i] + attr[k][j]) * 0.5);
+                        attr[k].len() - 1
+                    });
+                }
+            }
+            next.push([t[0], m[0], m[2]]);
+            next.push([m[0], t[1], m[1]]);
+            next.push([m[2], m[1], t[2]]);
+            next.push([m[0], m[1], m[2]]);
+        }
+        tris = next;
+    }
+    use std::fmt::Write;
+    let mut s = String::new();
+    for (k, tag) in ["v", "vt", "vn"].iter().enumerate() {
+        for a in &attr[k] {
+            let _ = writeln!(s, "{tag} {} {} {}", a.x, a.y, a.z);
+        }
+    }
+    for t in &tris {
+        let c = |c: [usize; 3]| format!("{}/{}/{}", c[0] + 1, c[1] + 1, c[2] + 1);
+        let _ = writeln!(s, "f {} {} {}", c(t[0]), c(t[1]), c(t[2]));
+    }
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let tmp = dir.join(format!(".sub.{}.obj", std::process::id()));
+    std::fs::write(&tmp, s).map_err(|e| Error::io(&tmp, e))?;
+    std::fs::rename(&tmp, &out).map_err(|e| Error::io(&out, e))?;
+    Ok(out)
 }
 
 /// The bounding box of an OBJ's `v` lines.
@@ -412,6 +534,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     // Mip chains are built when a frame first minifies a texture; the
     // benchmark builds them up front and counts them as loading.
     let renderer = Renderer::new(&scene);
+    let t_mips = Instant::now();
     if matches!(
         scene.settings.texture_filter,
         crate::scene::settings::TextureFilter::Trilinear
@@ -419,6 +542,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     ) {
         renderer.build_all_mips();
     }
+    let mips_ms = t_mips.elapsed().as_secs_f64() * 1e3;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     scene.lights = anchor_lights(&scene, case.ends_with("-shadow"));
     // The anchor's camera: the model's bounding sphere from +Z at fov 45
@@ -456,6 +580,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         name: case.to_string(),
         triangles: scene.triangle_count(),
         load_ms,
+        mips_ms,
         steady_ms: steady[steady.len() / 2],
         min_ms: steady[0],
         total_ms: times.iter().sum(),
@@ -580,7 +705,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         pool.current_num_threads()
     );
     println!(
-        "| case | triangles | load ms | steady ms/frame (median 1..n) | min ms | render total ms | png ms/frame |"
+        "| case | triangles | load ms (of which mip chains) | steady ms/frame (median 1..n) | min ms | render total ms | png ms/frame |"
     );
     println!("|---|---|---|---|---|---|---|");
     for c in cases {
@@ -594,6 +719,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
                 "msaa": args.msaa,
                 "threads": pool.current_num_threads(),
                 "load_ms": r.load_ms,
+                "mips_ms": r.mips_ms,
                 "frame_median_ms": r.steady_ms,
                 "frame_min_ms": r.min_ms,
                 "render_total_ms": r.total_ms,
@@ -608,8 +734,8 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
             writeln!(f, "{line}").map_err(|e| Error::io(path, e))?;
         }
         println!(
-            "| {} | {} | {:.1} | {:.2} | {:.2} | {:.0} | {:.2} |",
-            r.name, r.triangles, r.load_ms, r.steady_ms, r.min_ms, r.total_ms, r.png_ms
+            "| {} | {} | {:.1} ({:.1}) | {:.2} | {:.2} | {:.0} | {:.2} |",
+            r.name, r.triangles, r.load_ms, r.mips_ms, r.steady_ms, r.min_ms, r.total_ms, r.png_ms
         );
     }
     Ok(())
