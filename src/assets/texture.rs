@@ -77,24 +77,62 @@ pub struct Texture {
     pub binary_alpha: f32,
     /// Every texel has R = G = B (a height map rather than a normal map).
     pub grey: bool,
-    /// Stored byte -> linear value of R, G and B: the sRGB table for color
-    /// maps, `DATA_TABLE` for data.
-    lut: &'static [f32; 256],
-    /// Stored byte -> alpha.
-    alpha_lut: &'static [f32; 256],
 }
 
-/// Byte -> byte / 255 (data maps and alpha), the same floats as
-/// `b as f32 * (1.0 / 255.0)`.
-static DATA_TABLE: [f32; 256] = {
-    let mut t = [0.0f32; 256];
-    let mut i = 0;
-    while i < 256 {
-        t[i] = i as f32 * (1.0 / 255.0);
-        i += 1;
+/// A data texel as `[b as f32 * (1.0 / 255.0); 4]`: on x86-64 the four
+/// bytes are widened and converted together (SSE2, part of the base
+/// instruction set; the same IEEE operations, so the same floats).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn decode_data(t: [u8; 4]) -> Vec4 {
+    use std::arch::x86_64::*;
+    // SAFETY: these intrinsics need SSE2, which every x86-64 processor
+    // has (it is in the target's base features); they touch no memory.
+    unsafe {
+        let zero = _mm_setzero_si128();
+        let bytes = _mm_cvtsi32_si128(i32::from_le_bytes(t));
+        let ints = _mm_unpacklo_epi16(_mm_unpacklo_epi8(bytes, zero), zero);
+        Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(ints), _mm_set1_ps(1.0 / 255.0)))
     }
-    t
-};
+}
+
+/// Four data texels as `decode_data` gives them, widened together.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn decode_data4(t: [[u8; 4]; 4]) -> [Vec4; 4] {
+    use std::arch::x86_64::*;
+    // SAFETY: as in `decode_data` (SSE2 only, no memory access).
+    unsafe {
+        let zero = _mm_setzero_si128();
+        let v = _mm_set_epi32(
+            i32::from_le_bytes(t[3]),
+            i32::from_le_bytes(t[2]),
+            i32::from_le_bytes(t[1]),
+            i32::from_le_bytes(t[0]),
+        );
+        let (lo, hi) = (_mm_unpacklo_epi8(v, zero), _mm_unpackhi_epi8(v, zero));
+        let k = _mm_set1_ps(1.0 / 255.0);
+        let f = |w: __m128i| Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(w), k));
+        [
+            f(_mm_unpacklo_epi16(lo, zero)),
+            f(_mm_unpackhi_epi16(lo, zero)),
+            f(_mm_unpacklo_epi16(hi, zero)),
+            f(_mm_unpackhi_epi16(hi, zero)),
+        ]
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn decode_data4(t: [[u8; 4]; 4]) -> [Vec4; 4] {
+    t.map(decode_data)
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn decode_data(t: [u8; 4]) -> Vec4 {
+    Vec4::new(t[0] as f32, t[1] as f32, t[2] as f32, t[3] as f32) * (1.0 / 255.0)
+}
 
 /// Byte -> byte / 255 as `b as f32 / 255.0` (the alpha of color maps).
 static ALPHA_TABLE: [f32; 256] = {
@@ -311,12 +349,6 @@ impl Texture {
                 hard as f32 / partial as f32
             },
             grey,
-            lut: if srgb {
-                srgb_to_linear_table()
-            } else {
-                &DATA_TABLE
-            },
-            alpha_lut: if srgb { &ALPHA_TABLE } else { &DATA_TABLE },
         }
     }
 
@@ -361,9 +393,9 @@ impl Texture {
         if x >= 0.0 && y >= 0.0 && x < (l.width - 1) as f32 && y < (l.height - 1) as f32 {
             let (x0, y0) = (x as u32, y as u32);
             let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-            let [a, b, c, d] = l.footprint(x0, y0);
-            let top = self.decode(a).lerp(self.decode(b), fx);
-            let bottom = self.decode(c).lerp(self.decode(d), fx);
+            let [a, b, c, d] = self.decode4(l.footprint(x0, y0));
+            let top = a.lerp(b, fx);
+            let bottom = c.lerp(d, fx);
             return top.lerp(bottom, fy);
         }
         self.bilinear_wrapped(l, uv, mode)
@@ -384,7 +416,9 @@ impl Texture {
         };
         let top = mips.len() as f32;
         let lod = lod.min(top);
-        let i = lod.floor();
+        // lod is in (0, top] here: truncation is floor (and needs no
+        // library call).
+        let i = lod as u32 as f32;
         let f = lod - i;
         let i = i as usize;
         let level = |k: usize| if k == 0 { &self.base } else { &mips[k - 1] };
@@ -465,16 +499,34 @@ impl Texture {
         }
     }
 
-    /// A stored texel as linear RGBA (sRGB color decoded, data /255), by
-    /// table.
+    /// Four texels as `decode` gives them.
+    #[inline(always)]
+    fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
+        if self.srgb {
+            [
+                self.decode(t[0]),
+                self.decode(t[1]),
+                self.decode(t[2]),
+                self.decode(t[3]),
+            ]
+        } else {
+            decode_data4(t)
+        }
+    }
+
+    /// A stored texel as linear RGBA: sRGB color decoded by table, data
+    /// /255.
     #[inline(always)]
     pub(crate) fn decode(&self, t: [u8; 4]) -> Vec4 {
-        let lut = self.lut;
+        if !self.srgb {
+            return decode_data(t);
+        }
+        let lut = srgb_to_linear_table();
         Vec4::new(
             lut[t[0] as usize],
             lut[t[1] as usize],
             lut[t[2] as usize],
-            self.alpha_lut[t[3] as usize],
+            ALPHA_TABLE[t[3] as usize],
         )
     }
 

@@ -34,7 +34,7 @@ use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
-use crate::shade::{ShadeContext, Surface, TexCoords, background};
+use crate::shade::{ShadeContext, SizedFootprint, Surface, TexCoords, background};
 
 /// What every band of one frame reads.
 pub(super) struct FrameData<'a> {
@@ -344,8 +344,9 @@ impl<'a> FrameData<'a> {
                         continue;
                     }
                 }
-                let mut quad: smallvec::SmallVec<[(u32, [Gradients; 2]); 4]> =
-                    smallvec::SmallVec::new();
+                // Per triangle present in the quad: its texture-coordinate
+                // derivatives and the filter footprints computed from them.
+                let mut quad: smallvec::SmallVec<[QuadEntry; 4]> = smallvec::SmallVec::new();
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let (x, y) = (qx + dx, qy + dy);
                     if x >= tw || y >= th {
@@ -395,21 +396,29 @@ impl<'a> FrameData<'a> {
                         }
                         let t = &self.tris[id as usize];
                         let it = cache.get(id, t);
-                        let g = if self.grads {
-                            match quad.iter().find(|q| q.0 == id) {
-                                Some(q) => q.1,
-                                None => {
+                        let k = match quad.iter().position(|q| q.id == id) {
+                            Some(k) => k,
+                            None => {
+                                let grads = if self.grads {
                                     let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
-                                    let g = self.gradients(t, it, q0);
-                                    quad.push((id, g));
-                                    g
-                                }
+                                    self.gradients(t, it, q0)
+                                } else {
+                                    [Gradients::default(); 2]
+                                };
+                                quad.push(QuadEntry {
+                                    id,
+                                    grads,
+                                    footprints: [None; 2],
+                                });
+                                quad.len() - 1
                             }
-                        } else {
-                            [Gradients::default(); 2]
                         };
+                        let q = &mut quad[k];
                         let frag = self.shading_point(it, px, py, mask);
-                        let (c, d) = self.shade(t, it, frag, (px, py), g, occlusion);
+                        let (grads, fps) = (q.grads, q.footprints);
+                        let (c, d, fps) =
+                            self.shade_with(t, it, frag, (px, py), grads, fps, occlusion);
+                        quad[k].footprints = fps;
                         // A NaN from degenerate input must not poison the
                         // frame: such a fragment is black.
                         let c = if c.is_finite() { c } else { Vec3::ZERO };
@@ -490,10 +499,27 @@ impl<'a> FrameData<'a> {
         t: &Tri,
         it: &Interpolator,
         frag: Fragment,
-        (px, py): (i32, i32),
+        px: (i32, i32),
         grads: [Gradients; 2],
         ao: f32,
     ) -> (Vec3, f32) {
+        let (c, d, _) = self.shade_with(t, it, frag, px, grads, [None; 2], ao);
+        (c, d)
+    }
+
+    /// `shade`, given the filter footprints already known for `grads`;
+    /// also returns the footprints known afterwards.
+    #[allow(clippy::too_many_arguments)]
+    fn shade_with(
+        &self,
+        t: &Tri,
+        it: &Interpolator,
+        frag: Fragment,
+        (px, py): (i32, i32),
+        grads: [Gradients; 2],
+        footprints: [Option<SizedFootprint>; 2],
+        ao: f32,
+    ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
         let ctx = &self.ctx;
         let mode = ctx.mode;
         let d = self.draws[t.draw as usize];
@@ -539,7 +565,7 @@ impl<'a> FrameData<'a> {
             position,
             normal,
             raw_normal,
-            tc: TexCoords::new(uv, grads),
+            tc: TexCoords::with_footprints(uv, grads, footprints),
             color,
             tangent,
             normal_from_object: mv.normal_from_object,
@@ -549,7 +575,7 @@ impl<'a> FrameData<'a> {
             geo_normal,
             ao,
         };
-        (ctx.shade(&surface), view_depth)
+        (ctx.shade(&surface), view_depth, surface.tc.footprints())
     }
 
     /// Position, normals and view depth of triangle `t` at a fragment.
@@ -654,6 +680,15 @@ impl InterpolatorCache {
             .get_or_insert_with(|| (id, Interpolator::new(t)))
             .1
     }
+}
+
+/// A triangle present in a 2x2 quad: its texture-coordinate derivatives
+/// (one pair for the quad, as a GPU takes them) and the filter footprints
+/// derived from them, shared by the quad's pixels.
+struct QuadEntry {
+    id: u32,
+    grads: [Gradients; 2],
+    footprints: [Option<SizedFootprint>; 2],
 }
 
 /// A surface point as the rasterizer sees it.

@@ -69,7 +69,7 @@ pub struct TexCoords {
 }
 
 /// A footprint and the texture size (width, height) it was computed for.
-type SizedFootprint = ((u32, u32), Footprint);
+pub type SizedFootprint = ((u32, u32), Footprint);
 
 impl TexCoords {
     pub fn new(uv: [Option<Vec2>; 2], grads: [Gradients; 2]) -> TexCoords {
@@ -78,6 +78,25 @@ impl TexCoords {
             grads,
             footprint: Default::default(),
         }
+    }
+
+    /// With footprints already computed for these derivatives (by another
+    /// pixel of the same quad and triangle).
+    pub fn with_footprints(
+        uv: [Option<Vec2>; 2],
+        grads: [Gradients; 2],
+        footprints: [Option<SizedFootprint>; 2],
+    ) -> TexCoords {
+        TexCoords {
+            uv,
+            grads,
+            footprint: footprints.map(Cell::new),
+        }
+    }
+
+    /// The footprints computed so far (for the quad's other pixels).
+    pub fn footprints(&self) -> [Option<SizedFootprint>; 2] {
+        [self.footprint[0].get(), self.footprint[1].get()]
     }
 
     /// Set 0 only.
