@@ -630,10 +630,27 @@ fn image_sources(
     doc.images()
         .map(|img| {
             let i = img.index();
+            // The gltf crate's `source()` unwraps these (its validation
+            // lets both through): an image is a uri, or a bufferView with
+            // a mimeType (found by fuzzing).
+            let json = &doc.as_json().images[i];
+            match (&json.buffer_view, &json.uri, &json.mime_type) {
+                (Some(_), _, None) => {
+                    return Err(format!("image {i}: a bufferView image needs a mimeType"));
+                }
+                (None, None, _) => {
+                    return Err(format!("image {i}: has neither a uri nor a bufferView"));
+                }
+                _ => {}
+            }
             Ok(match img.source() {
                 gltf::image::Source::View { view, .. } => {
                     let b = &buffers[view.buffer().index()];
-                    let bytes = &b[view.offset()..view.offset() + view.length()];
+                    let bytes = b
+                        .get(view.offset()..view.offset().saturating_add(view.length()))
+                        .ok_or_else(|| {
+                            format!("image {i}: its bufferView reaches past its buffer")
+                        })?;
                     ImageSource::Memory {
                         name: name(i),
                         bytes: bytes.into(),
