@@ -103,6 +103,21 @@ fn walk(
     }
 }
 
+/// The pixel bounds of `t` within `rect` (x0, x1, y0, y1, inclusive) and
+/// the biased edge values at (x0, y0); None when they do not meet.
+#[inline]
+fn start(t: &Tri, e: &[Edge; 3], rect: TileRect) -> Option<(i32, i32, i32, i32, [i64; 3])> {
+    let x0 = t.min_x.max(rect.x0);
+    let x1 = t.max_x.min(rect.x1 - 1);
+    let y0 = t.min_y.max(rect.y0);
+    let y1 = t.max_y.min(rect.y1 - 1);
+    if x0 > x1 || y0 > y1 {
+        return None;
+    }
+    let row = [0, 1, 2].map(|k| e[k].at(x0 as i64, y0 as i64) + e[k].bias);
+    Some((x0, x1, y0, y1, row))
+}
+
 /// `walk` testing every pixel; a row ends at its first pixel past the run.
 #[inline]
 fn walk_tested(
@@ -112,15 +127,9 @@ fn walk_tested(
     reach: [i64; 3],
     mut visit: impl FnMut(i32, i32, [i64; 3]),
 ) {
-    let x0 = t.min_x.max(rect.x0);
-    let x1 = t.max_x.min(rect.x1 - 1);
-    let y0 = t.min_y.max(rect.y0);
-    let y1 = t.max_y.min(rect.y1 - 1);
-    if x0 > x1 || y0 > y1 {
+    let Some((x0, x1, y0, y1, mut row)) = start(t, e, rect) else {
         return;
-    }
-    let (x0l, y0l) = (x0 as i64, y0 as i64);
-    let mut row = [0, 1, 2].map(|k| e[k].at(x0l, y0l) + e[k].bias);
+    };
     for py in y0..=y1 {
         let mut w = row;
         let mut inside_seen = false;
@@ -152,15 +161,10 @@ fn walk_runs(
     reach: [i64; 3],
     mut visit: impl FnMut(i32, i32, [i64; 3]),
 ) {
-    let x0 = t.min_x.max(rect.x0);
-    let x1 = t.max_x.min(rect.x1 - 1);
-    let y0 = t.min_y.max(rect.y0);
-    let y1 = t.max_y.min(rect.y1 - 1);
-    if x0 > x1 || y0 > y1 {
+    let Some((x0, x1, y0, y1, mut row)) = start(t, e, rect) else {
         return;
-    }
-    let (x0l, y0l) = (x0 as i64, y0 as i64);
-    let mut row = [0, 1, 2].map(|k| e[k].at(x0l, y0l) + e[k].bias);
+    };
+    let x0l = x0 as i64;
     for py in y0..=y1 {
         if let Some((lo, hi)) = span(e, row, reach, x0l, x1 as i64) {
             let d = lo - x0l;
