@@ -45,6 +45,10 @@ pub struct JobSummary {
     pub gifs: Vec<PathBuf>,
     /// Why the scene's GIF was not written, if it was not.
     pub gif_skipped: Option<String>,
+    /// Videos written, one per camera.
+    pub videos: Vec<PathBuf>,
+    /// Why the scene's video was not written, if it was not.
+    pub video_skipped: Option<String>,
 }
 
 /// A worker pool of `threads` threads (all cores when None).
@@ -136,6 +140,7 @@ struct Naming {
     depth: bool,
     ao: bool,
     gif: Option<String>,
+    video: Option<String>,
 }
 
 /// The files of one frame of one camera (None: the scene does not ask).
@@ -176,6 +181,7 @@ impl FramePlan {
                 depth: scene.output.depth,
                 ao: scene.output.ao,
                 gif: scene.output.gif.clone(),
+                video: scene.output.video.clone(),
             },
         }
     }
@@ -234,8 +240,17 @@ impl FramePlan {
     /// camera when the scene has several (`{camera}` in the name, or
     /// `_<camera>` before the extension).
     pub fn gif_path(&self, cam: usize) -> Option<PathBuf> {
+        self.per_camera(self.naming.gif.as_ref()?, cam)
+    }
+
+    /// The video of camera `cam`: `output.video`, named per camera like
+    /// the GIF.
+    pub fn video_path(&self, cam: usize) -> Option<PathBuf> {
+        self.per_camera(self.naming.video.as_ref()?, cam)
+    }
+
+    fn per_camera(&self, name: &str, cam: usize) -> Option<PathBuf> {
         let n = &self.naming;
-        let name = n.gif.as_ref()?;
         let cam_name = &n.cameras[cam];
         let name = if name.contains("{camera}") {
             name.replace("{camera}", cam_name)
@@ -253,7 +268,7 @@ impl FramePlan {
                 .to_string_lossy()
                 .into_owned()
         } else {
-            name.clone()
+            name.to_string()
         };
         Some(n.dir.join(name))
     }
@@ -283,12 +298,19 @@ impl Output {
     }
 }
 
-/// A frame's files from its buffers, as the plan names them.
-fn outputs(frame: &Frame, files: FrameFiles, scene: &Scene) -> Vec<Output> {
+/// A frame's files from its buffers, as the plan names them, and (with
+/// `color`) its display image for a video.
+fn outputs(
+    frame: &Frame,
+    files: FrameFiles,
+    scene: &Scene,
+    color: bool,
+) -> (Vec<Output>, Option<Image8>) {
     let (width, height) = (frame.width, frame.height);
     let mut out = Vec::new();
-    if let Some(p) = files.color {
-        out.push(Output::Png(p, output::resolve(frame, &scene.settings)));
+    let image = (files.color.is_some() || color).then(|| output::resolve(frame, &scene.settings));
+    if let (Some(p), Some(img)) = (files.color, &image) {
+        out.push(Output::Png(p, img.clone()));
     }
     if let Some(p) = files.depth {
         out.push(Output::Exr(p, width, height, "Z", frame.depth.clone()));
@@ -301,7 +323,7 @@ fn outputs(frame: &Frame, files: FrameFiles, scene: &Scene) -> Vec<Output> {
         };
         out.push(Output::Exr(p, width, height, "AO", ao));
     }
-    out
+    (out, if color { image } else { None })
 }
 
 /// `scene` with `render.exposure = "auto"` resolved to stops.
@@ -323,23 +345,32 @@ impl RenderJob {
         }
     }
 
-    /// Renders and writes everything; calls `on_done` as frames land. Then
-    /// writes each camera's GIF when the scene asks for one and the job
-    /// covers every frame of the animation.
+    /// Renders and writes everything; calls `on_done` as frames land. The
+    /// videos are encoded as the frames land; then each camera's GIF is
+    /// written. Both need the job to cover every frame of the animation.
     pub fn run(&self, on_done: impl FnMut(&FrameDone)) -> Result<JobSummary, Error> {
-        self.render_frames(on_done)?;
         let mut summary = JobSummary::default();
+        let plan = &self.plan;
+        let total = plan.total_frames;
+        let partial = |what: &str, tool: &str| {
+            format!(
+                "{what} not written: this run has {} of the scene's {total} frames \
+                 (run `softraster {tool}` on the frames, or render again with --skip-existing)",
+                plan.frames.len()
+            )
+        };
+        let videos = if self.scene.output.video.is_some() && !plan.covers_animation() {
+            summary.video_skipped = Some(partial("output.video", "video"));
+            false
+        } else {
+            self.scene.output.video.is_some()
+        };
+        summary.videos = self.render_frames(videos, on_done)?;
         if self.scene.output.gif.is_none() {
             return Ok(summary);
         }
-        let plan = &self.plan;
-        let total = plan.total_frames;
         if !plan.covers_animation() {
-            summary.gif_skipped = Some(format!(
-                "output.gif not written: this run has {} of the scene's {total} frames \
-                 (run `softraster gif` on the frames, or render again with --skip-existing)",
-                plan.frames.len()
-            ));
+            summary.gif_skipped = Some(partial("output.gif", "gif"));
             return Ok(summary);
         }
         let opts = output::gif::GifOptions {
@@ -359,7 +390,14 @@ impl RenderJob {
         Ok(summary)
     }
 
-    fn render_frames(&self, mut on_done: impl FnMut(&FrameDone)) -> Result<(), Error> {
+    /// Renders the plan's frames and hands them to the writer thread; with
+    /// `videos`, the writer also encodes each camera's colour frames, in
+    /// order, into its video. Returns the videos written.
+    fn render_frames(
+        &self,
+        videos: bool,
+        mut on_done: impl FnMut(&FrameDone),
+    ) -> Result<Vec<PathBuf>, Error> {
         let auto;
         let scene = if self.scene.settings.auto_exposure {
             auto = with_auto_exposure(self.scene.clone());
@@ -367,16 +405,38 @@ impl RenderJob {
         } else {
             &self.scene
         };
-        let (to_writer, writer_rx) = mpsc::sync_channel::<(FrameDone, Vec<Output>)>(2);
+        let plan = &self.plan;
+        let video_paths: Vec<Option<PathBuf>> = (0..scene.cameras.len())
+            .map(|cam| if videos { plan.video_path(cam) } else { None })
+            .collect();
+        let video_opts = output::video::VideoOptions {
+            fps: scene.output.video_fps,
+            quality: scene.output.video_quality,
+        };
+        let (to_writer, writer_rx) = mpsc::sync_channel::<ToWriter>(2);
         let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
         let writer = std::thread::spawn(move || {
-            for (done, outputs) in writer_rx {
-                let r = outputs.iter().try_for_each(Output::write).map(|_| done);
+            let mut encoders = Videos::new(video_paths, video_opts);
+            for msg in writer_rx {
+                let (done, outputs, frame) = match msg {
+                    ToWriter::Frame(done, outputs, frame) => (done, outputs, frame),
+                    ToWriter::Finish => return encoders.finish(),
+                };
+                let r = outputs
+                    .iter()
+                    .try_for_each(Output::write)
+                    .and_then(|_| match frame {
+                        Some(f) => encoders.push(f),
+                        None => Ok(()),
+                    })
+                    .map(|_| done);
                 let failed = r.is_err();
                 if done_tx.send(r).is_err() || failed {
                     break;
                 }
             }
+            // Stopped early: the unfinished videos leave no file.
+            Ok(Vec::new())
         });
         let mut result = Ok(());
         let drain = |block: bool, on_done: &mut dyn FnMut(&FrameDone)| -> Result<(), Error> {
@@ -393,26 +453,38 @@ impl RenderJob {
                 }
             }
         };
-        let plan = &self.plan;
         let renderer = Renderer::new(scene);
         let mut buffer = Frame::new(0, 0);
         'frames: for &frame in &plan.frames {
             for &cam in &plan.cameras {
                 let camera = plan.camera_name(cam).to_string();
                 let files = plan.files(cam, frame);
-                if self.skip_existing && files.all().iter().all(|f| f.is_file()) {
-                    on_done(&FrameDone {
+                let in_video = videos && plan.video_path(cam).is_some();
+                // A skipped frame's video frame is read back from its PNG.
+                let can_skip = !in_video || files.color.is_some();
+                if self.skip_existing && can_skip && files.all().iter().all(|f| f.is_file()) {
+                    let done = FrameDone {
                         frame,
                         camera,
                         files: files.all(),
                         render_seconds: 0.0,
                         skipped: true,
-                    });
+                    };
+                    if in_video {
+                        let png = files.color.clone().unwrap_or_default();
+                        let msg =
+                            ToWriter::Frame(done, Vec::new(), Some(VideoFrame::File(cam, png)));
+                        if to_writer.send(msg).is_err() {
+                            break 'frames;
+                        }
+                    } else {
+                        on_done(&done);
+                    }
                     continue;
                 }
                 let t0 = Instant::now();
                 renderer.render(scene, cam, frame, &mut buffer);
-                let outputs = outputs(&buffer, files, scene);
+                let (outputs, color) = outputs(&buffer, files, scene, in_video);
                 let done = FrameDone {
                     frame,
                     camera,
@@ -420,7 +492,11 @@ impl RenderJob {
                     render_seconds: t0.elapsed().as_secs_f64(),
                     skipped: false,
                 };
-                if to_writer.send((done, outputs)).is_err() {
+                let video_frame = color.map(|img| VideoFrame::Image(cam, img));
+                if to_writer
+                    .send(ToWriter::Frame(done, outputs, video_frame))
+                    .is_err()
+                {
                     break 'frames;
                 }
                 if let Err(e) = drain(false, &mut on_done) {
@@ -429,12 +505,78 @@ impl RenderJob {
                 }
             }
         }
+        if result.is_ok() {
+            let _ = to_writer.send(ToWriter::Finish);
+        }
         drop(to_writer);
         if result.is_ok() {
             result = drain(true, &mut on_done);
         }
-        let _ = writer.join();
-        result
+        let written = writer
+            .join()
+            .map_err(|_| Error::Render("the file writer thread panicked".into()))?;
+        result?;
+        written
+    }
+}
+
+/// What the render loop sends the writer thread.
+enum ToWriter {
+    /// A frame's files, and its colour for the camera's video.
+    Frame(FrameDone, Vec<Output>, Option<VideoFrame>),
+    /// Every frame was sent: finish the videos.
+    Finish,
+}
+
+/// A camera's next video frame: rendered now, or read back from the PNG a
+/// previous run wrote (`--skip-existing`).
+enum VideoFrame {
+    Image(usize, Image8),
+    File(usize, PathBuf),
+}
+
+/// The videos of a job, one per camera, started at their first frame.
+struct Videos {
+    paths: Vec<Option<PathBuf>>,
+    opts: output::video::VideoOptions,
+    writers: Vec<Option<output::video::VideoWriter>>,
+}
+
+impl Videos {
+    fn new(paths: Vec<Option<PathBuf>>, opts: output::video::VideoOptions) -> Videos {
+        let writers = paths.iter().map(|_| None).collect();
+        Videos {
+            paths,
+            opts,
+            writers,
+        }
+    }
+
+    fn push(&mut self, frame: VideoFrame) -> Result<(), Error> {
+        let (cam, img) = match frame {
+            VideoFrame::Image(cam, img) => (cam, img),
+            VideoFrame::File(cam, png) => (cam, output::png::read(&png)?),
+        };
+        let Some(path) = self.paths.get(cam).cloned().flatten() else {
+            return Ok(());
+        };
+        let w = match &mut self.writers[cam] {
+            Some(w) => w,
+            slot => slot.insert(output::video::VideoWriter::create(
+                &path, img.width, img.height, self.opts,
+            )?),
+        };
+        w.push(&img)
+    }
+
+    fn finish(self) -> Result<Vec<PathBuf>, Error> {
+        let mut out = Vec::new();
+        for w in self.writers.into_iter().flatten() {
+            let path = w.path().to_path_buf();
+            w.finish()?;
+            out.push(path);
+        }
+        Ok(out)
     }
 }
 

@@ -34,6 +34,8 @@ enum Command {
     Render(RenderArgs),
     /// Assemble PNG frames into a looping GIF with one shared palette.
     Gif(GifArgs),
+    /// Assemble PNG frames into an H.264 MP4 video.
+    Video(VideoArgs),
     /// Compare two images, or two directories of images paired by name.
     /// Exit status: 0 pass, 1 fail (or a missing/extra file), 2 error.
     Compare(CompareArgs),
@@ -164,6 +166,22 @@ struct GifArgs {
     dither: String,
 }
 
+#[derive(clap::Args)]
+struct VideoArgs {
+    /// PNG frames, in order (all of one size).
+    #[arg(required = true)]
+    frames: Vec<PathBuf>,
+    /// The video to write (.mp4).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Frames per second.
+    #[arg(long, default_value_t = 24.0)]
+    fps: f64,
+    /// 1 (smallest) to 100 (best), or a bitrate such as 2500k or 4M.
+    #[arg(long, default_value = "75")]
+    quality: String,
+}
+
 pub fn main() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -175,6 +193,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Gif(args) => gif(args),
+        Command::Video(args) => video(args),
         Command::Chart(args) => chart(args),
         Command::Compare(args) => return compare(args),
         Command::Bench(args) => softraster::tools::bench::run(&args),
@@ -342,6 +361,52 @@ fn gif(args: GifArgs) -> Result<(), Error> {
         } else {
             ""
         }
+    );
+    Ok(())
+}
+
+fn video(args: VideoArgs) -> Result<(), Error> {
+    use softraster::output::video::{self, VideoOptions, VideoQuality};
+    let quality = match args.quality.parse::<u8>() {
+        Ok(q) if (1..=100).contains(&q) => VideoQuality::Quality(q),
+        _ => VideoQuality::parse_bitrate(&args.quality).ok_or_else(|| {
+            Error::Argument(format!(
+                "--quality {}: expected 1 to 100, or a bitrate from 10k to 200M such as 2500k",
+                args.quality
+            ))
+        })?,
+    };
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 240.0) {
+        return Err(Error::Argument(format!(
+            "--fps {}: expected more than 0 and at most 240",
+            args.fps
+        )));
+    }
+    match args.output.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("mp4") => {}
+        _ => {
+            return Err(Error::Argument(format!(
+                "--output {}: the video must be an .mp4 file",
+                args.output.display()
+            )));
+        }
+    }
+    let info = video::assemble(
+        &args.frames,
+        &args.output,
+        VideoOptions {
+            fps: args.fps,
+            quality,
+        },
+    )?;
+    eprintln!(
+        "{}: {} frames, {}x{}, {} fps, {} bytes",
+        args.output.display(),
+        info.frames,
+        info.width,
+        info.height,
+        info.fps,
+        info.bytes
     );
     Ok(())
 }
@@ -521,10 +586,20 @@ impl Reporter {
                 eprintln!("gif: {}", g.display());
             }
         }
-        if let Some(why) = &summary.gif_skipped
-            && !self.quiet
+        for v in &summary.videos {
+            if self.json {
+                println!("{}", serde_json::json!({ "event": "video", "file": v }));
+            } else if !self.quiet {
+                eprintln!("video: {}", v.display());
+            }
+        }
+        for why in [&summary.gif_skipped, &summary.video_skipped]
+            .into_iter()
+            .flatten()
         {
-            eprintln!("note: {why}");
+            if !self.quiet {
+                eprintln!("note: {why}");
+            }
         }
     }
 }

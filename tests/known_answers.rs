@@ -320,6 +320,7 @@ fn uvs_are_perspective_correct_on_a_tilted_plane() {
         projection: softraster::scene::camera::Projection::Perspective { fov_y: 70.0 },
         near: 0.1,
         far: 100.0,
+        path: None,
     };
     let clip_from_world: Mat4 =
         cam.clip_from_view(120.0 / 90.0, Default::default()) * cam.view_from_world();

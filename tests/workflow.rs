@@ -16,7 +16,8 @@ fn turntable(dir: &Path) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(root.join("scenes/showcase.toml"))
         .unwrap()
-        .replace("../assets/", &format!("{}/assets/", root.display()));
+        .replace("../assets/", &format!("{}/assets/", root.display()))
+        .replace("video = \"showcase.mp4\"", "");
     let text = format!(
         "{text}\n",
         text = text

@@ -7,6 +7,7 @@ pub mod exr;
 pub mod gif;
 pub mod png;
 pub mod tonemap;
+pub mod video;
 
 use std::io::Write;
 use std::path::Path;

@@ -21,7 +21,7 @@ pub struct FrameSetup<'a> {
 impl<'a> FrameSetup<'a> {
     pub fn new(scene: &'a Scene, camera: usize, frame: u32) -> FrameSetup<'a> {
         let turn = scene.animation.turn(frame);
-        let mut cam = scene.cameras[camera].clone();
+        let mut cam = scene.cameras[camera].at_frame(frame);
         if scene.animation.rotates_camera() {
             cam.eye = turn.transform_point3(cam.eye);
             cam.target = turn.transform_point3(cam.target);

@@ -19,11 +19,16 @@ pub struct Turntable {
     pub axis: Vec3,
     pub degrees: f32,
     pub rotate: TurntableTarget,
+    /// Degrees above the plane of the turn the cameras look from (their
+    /// orbit is a cone); None leaves them where they are.
+    pub elevation: Option<f32>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Animation {
     pub frames: u32,
+    /// Frame i is at time i / fps seconds.
+    pub fps: f32,
     pub turntable: Option<Turntable>,
     /// Bounding-box center of all models at rest (the turntable's pivot).
     pub pivot: Vec3,
@@ -41,6 +46,22 @@ impl Animation {
                     * Mat4::from_translation(-self.pivot)
             }
         }
+    }
+
+    /// `eye` moved on its sphere about the pivot to `degrees` above the
+    /// plane of the turn (keeping its distance and its direction about the
+    /// axis). An eye on the axis stays.
+    pub fn raise(&self, eye: Vec3, degrees: f32) -> Vec3 {
+        let Some(t) = &self.turntable else {
+            return eye;
+        };
+        let d = eye - self.pivot;
+        let radial = d - t.axis * d.dot(t.axis);
+        let Some(out) = radial.try_normalize() else {
+            return eye;
+        };
+        let e = degrees.to_radians();
+        self.pivot + (out * e.cos() + t.axis * e.sin()) * d.length()
     }
 
     pub fn rotates_models(&self) -> bool {
@@ -64,7 +85,9 @@ mod tests {
                 axis: Vec3::Y,
                 degrees: 360.0,
                 rotate: TurntableTarget::Models,
+                elevation: None,
             }),
+            fps: 24.0,
             pivot: Vec3::new(1.0, 0.0, 0.0),
         };
         let p = Vec3::new(2.0, 0.0, 0.0);
@@ -74,5 +97,12 @@ mod tests {
         let last = a.turn(71).transform_point3(p);
         assert!((last - p).length() > 1e-3);
         assert!(a.turn(0).abs_diff_eq(Mat4::IDENTITY, 1e-7));
+        // Raised 30 degrees: same distance, 30 degrees above the plane.
+        let eye = Vec3::new(1.0, 0.0, 4.0);
+        let up = a.raise(eye, 30.0);
+        let d = up - a.pivot;
+        assert!((d.length() - 4.0).abs() < 1e-5);
+        assert!((d.y / d.length() - 0.5).abs() < 1e-6, "{up}");
+        assert!(d.x.abs() < 1e-6 && d.z > 0.0);
     }
 }

@@ -26,9 +26,19 @@ pub struct Camera {
     pub projection: Projection,
     pub near: f32,
     pub far: f32,
+    /// Keys the camera follows over the animation (`[[camera.keys]]`).
+    pub path: Option<std::sync::Arc<crate::scene::camera_path::CameraPath>>,
 }
 
 impl Camera {
+    /// The camera at `frame`: itself, or where its path puts it.
+    pub fn at_frame(&self, frame: u32) -> Camera {
+        match &self.path {
+            Some(p) => p.at(self, frame),
+            None => self.clone(),
+        }
+    }
+
     /// The camera that frames a bounding sphere from +Z (the default camera).
     /// Distance so that the sphere fills the vertical field of view; near and
     /// far leave room for the sphere (and anything turning inside it).
@@ -45,6 +55,7 @@ impl Camera {
             projection: Projection::Perspective { fov_y },
             near,
             far,
+            path: None,
         }
     }
 
@@ -131,6 +142,7 @@ impl Camera {
             projection,
             near,
             far: far.max(near * 2.0),
+            path: None,
         }
     }
 
@@ -220,6 +232,7 @@ mod tests {
                 projection: proj,
                 near: 0.5,
                 far: 20.0,
+                path: None,
             };
             assert!((depth_of(&cam, DepthMode::Standard, -0.5) - 0.0).abs() < 1e-6);
             assert!((depth_of(&cam, DepthMode::Standard, -20.0) - 1.0).abs() < 1e-6);

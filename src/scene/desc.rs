@@ -11,10 +11,11 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use toml::Spanned;
 
 use super::animation::TurntableTarget;
+use super::camera_path::Interpolation;
 use super::material::NormalSpace;
 use super::settings::{
     AddressMode, AoMethod, Background, CullMode, DepthMode, GifDither, ShadingMode, ShadowMethod,
-    TextureFilter, Tonemap,
+    TextureFilter, Tonemap, VideoQuality,
 };
 use crate::error::{Error, Location};
 
@@ -106,6 +107,40 @@ pub struct OutputDesc {
     pub background: Option<S<Background>>,
     /// Version 2: how blurred `background = "blurred"` is, 0..1 (0.5).
     pub background_blur: Option<S<f32>>,
+    /// Version 2: an H.264 MP4 of each camera's colour frames.
+    pub video: Option<S<String>>,
+    pub video_fps: Option<S<f32>>,
+    /// 1 to 100, or a bitrate string such as "2500k".
+    pub video_quality: Option<S<VideoQualityDesc>>,
+}
+
+/// `output.video_quality` as written: a number or a string.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VideoQualityDesc {
+    Number(i64),
+    Text(String),
+}
+
+impl<'de> Deserialize<'de> for VideoQualityDesc {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = VideoQualityDesc;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a quality from 1 to 100, or a bitrate like \"2500k\"")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<VideoQualityDesc, E> {
+                Ok(VideoQualityDesc::Number(v))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<VideoQualityDesc, E> {
+                Ok(VideoQualityDesc::Number(v.min(i64::MAX as u64) as i64))
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<VideoQualityDesc, E> {
+                Ok(VideoQualityDesc::Text(s.to_string()))
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 /// `[render]`. The defaults are `scene::build::settings`'s (and the
@@ -338,6 +373,22 @@ pub struct CameraDesc {
     pub elevation: Option<S<f32>>,
     /// Version 2, fitted cameras: degrees about +Y, 0 = from +Z.
     pub azimuth: Option<S<f32>>,
+    /// Version 2: a camera path's keys (`[[camera.keys]]`).
+    #[serde(default)]
+    pub keys: Vec<S<CameraKeyDesc>>,
+    /// Version 2: "smooth" (Catmull-Rom, the default) or "linear".
+    pub interpolation: Option<S<Interpolation>>,
+}
+
+/// `[[camera.keys]]`: where the camera is at a frame.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraKeyDesc {
+    pub frame: S<i64>,
+    pub eye: S<[f32; 3]>,
+    pub target: S<[f32; 3]>,
+    pub up: Option<S<[f32; 3]>>,
+    pub fov: Option<S<f32>>,
 }
 
 /// `[animation]`. Default: one frame, no turntable.
@@ -345,6 +396,8 @@ pub struct CameraDesc {
 #[serde(deny_unknown_fields)]
 pub struct AnimationDesc {
     pub frames: Option<S<i64>>,
+    /// Version 2: frame i is at time i / fps (24).
+    pub fps: Option<S<f32>>,
     pub turntable: Option<S<TurntableDesc>>,
 }
 
@@ -355,6 +408,8 @@ pub struct TurntableDesc {
     pub axis: Option<S<[f32; 3]>>,
     pub degrees: Option<S<f32>>,
     pub rotate: Option<S<TurntableTarget>>,
+    /// Version 2: degrees above the plane of the turn (`rotate = "camera"`).
+    pub elevation: Option<S<f32>>,
 }
 
 // ---------------------------------------------------------------------------
@@ -513,6 +568,11 @@ fn read_vec3<'de, A: SeqAccess<'de>>(
     Ok(out)
 }
 
+file_names!(Interpolation {
+    "smooth" => Smooth,
+    "linear" => Linear,
+});
+
 // ---------------------------------------------------------------------------
 // Parsing and validation.
 
@@ -560,6 +620,7 @@ impl SceneDesc {
                 "output.background shows the environment: the scene needs an [environment]",
             ));
         }
+        validate_video(c, o)?;
         if let Some(n) = &o.name
             && n.get_ref().trim().is_empty()
         {
@@ -636,13 +697,53 @@ impl SceneDesc {
         }
         let a = &self.animation;
         c.int_range(&a.frames, "animation.frames", 1, 1_000_000)?;
+        c.float_range(&a.fps, "animation.fps", 0.001, 1000.0)?;
         if let Some(t) = &a.turntable {
             let t = t.get_ref();
             c.finite(&t.degrees, "animation.turntable.degrees")?;
             c.direction(&t.axis, "animation.turntable.axis")?;
+            c.float_range(&t.elevation, "animation.turntable.elevation", -89.0, 89.0)?;
         }
         Ok(())
     }
+}
+
+/// `output.video`: an `.mp4` name, a frame rate and a quality in range.
+fn validate_video(c: &Ctx, o: &OutputDesc) -> Result<(), Error> {
+    if let Some(v) = &o.video {
+        let name = v.get_ref();
+        let ext = Path::new(name)
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        if ext.as_deref() != Some("mp4") {
+            return Err(c.err(
+                v.span(),
+                format!(
+                    "output.video = \"{name}\": expected a file name ending in .mp4 (H.264 in MP4)"
+                ),
+            ));
+        }
+    }
+    c.float_range(&o.video_fps, "output.video_fps", 0.1, 240.0)?;
+    if let Some(q) = &o.video_quality {
+        match q.get_ref() {
+            VideoQualityDesc::Number(n) if !(1..=100).contains(n) => {
+                return Err(c.err(
+                    q.span(),
+                    format!("output.video_quality = {n}: expected a quality from 1 to 100, or a bitrate like \"2500k\""),
+                ));
+            }
+            VideoQualityDesc::Text(t) if VideoQuality::parse_bitrate(t).is_none() => {
+                return Err(c.err(
+                    q.span(),
+                    format!("output.video_quality = \"{t}\": expected a bitrate from 10k to 200M such as \"2500k\" or \"4M\", or a quality from 1 to 100"),
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn get_i64(v: &Option<S<i64>>, default: i64) -> i64 {
@@ -741,7 +842,83 @@ fn validate_light(c: &Ctx, l: &LightDesc) -> Result<(), Error> {
     Ok(())
 }
 
+fn validate_camera_keys(c: &Ctx, cam: &CameraDesc) -> Result<(), Error> {
+    if cam.keys.is_empty() {
+        if let Some(i) = &cam.interpolation {
+            return Err(c.err(i.span(), "camera.interpolation needs [[camera.keys]]"));
+        }
+        return Ok(());
+    }
+    for (what, span) in [
+        ("eye", cam.eye.as_ref().map(|v| v.span())),
+        ("target", cam.target.as_ref().map(|v| v.span())),
+    ] {
+        if let Some(span) = span {
+            return Err(c.err(
+                span,
+                format!(
+                    "camera.{what}: a camera with [[camera.keys]] takes its {what} from the keys"
+                ),
+            ));
+        }
+    }
+    let orthographic = matches!(
+        cam.projection.as_ref().map(|p| *p.get_ref()),
+        Some(Projection::Orthographic)
+    );
+    let mut last: Option<i64> = None;
+    for k in &cam.keys {
+        let k = k.get_ref();
+        let f = *k.frame.get_ref();
+        if !(0..=1_000_000).contains(&f) {
+            return Err(c.err(
+                k.frame.span(),
+                format!("camera.keys.frame = {f}: expected a frame from 0 to 1000000"),
+            ));
+        }
+        if let Some(prev) = last
+            && f <= prev
+        {
+            return Err(c.err(
+                k.frame.span(),
+                format!(
+                    "camera.keys: frame {f} comes after frame {prev}: keys must be in increasing frame order"
+                ),
+            ));
+        }
+        last = Some(f);
+        c.vec3(&Some(k.eye.clone()), "camera.keys.eye")?;
+        c.vec3(&Some(k.target.clone()), "camera.keys.target")?;
+        c.direction(&k.up, "camera.keys.up")?;
+        c.float_range(&k.fov, "camera.keys.fov", 0.01, 179.0)?;
+        if let (Some(fov), true) = (&k.fov, orthographic) {
+            return Err(c.err(fov.span(), "camera.keys.fov: the camera is orthographic"));
+        }
+        if k.eye.get_ref() == k.target.get_ref() {
+            return Err(c.err(
+                k.target.span(),
+                "camera.keys.target must differ from its eye",
+            ));
+        }
+        let up = glam::Vec3::from(
+            k.up.as_ref()
+                .map(|u| *u.get_ref())
+                .or(cam.up.as_ref().map(|u| *u.get_ref()))
+                .unwrap_or([0.0, 1.0, 0.0]),
+        );
+        let view = glam::Vec3::from(*k.target.get_ref()) - glam::Vec3::from(*k.eye.get_ref());
+        if view.normalize().cross(up.normalize()).length() < 1e-6 {
+            return Err(c.err(
+                k.eye.span(),
+                "camera.keys: this key looks along its `up` vector: give another `up`",
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn validate_camera(c: &Ctx, cam: &CameraDesc) -> Result<(), Error> {
+    validate_camera_keys(c, cam)?;
     c.vec3(&cam.eye, "camera.eye")?;
     c.vec3(&cam.target, "camera.target")?;
     c.direction(&cam.up, "camera.up")?;

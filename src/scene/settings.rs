@@ -184,6 +184,59 @@ pub struct AoSettings {
     pub samples: u32,
 }
 
+/// `output.video_quality`: a quality (1 to 100, the default 75) that maps
+/// to a constant quantizer, or a target bitrate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VideoQuality {
+    /// 1 (smallest file) to 100 (best picture).
+    Quality(u8),
+    /// Bits per second.
+    Bitrate(u32),
+}
+
+impl Default for VideoQuality {
+    fn default() -> Self {
+        VideoQuality::Quality(75)
+    }
+}
+
+impl VideoQuality {
+    /// H.264 quantizer of a quality: 100 -> 10, 75 -> 20, 1 -> 51.
+    pub fn qp(q: u8) -> u8 {
+        let q = q.clamp(1, 100) as f32;
+        (51.0 - (q - 1.0) * 41.0 / 99.0).round() as u8
+    }
+
+    /// Parses `video_quality`'s string form: a bitrate such as "2500k",
+    /// "4M" or "800000" (bits per second).
+    pub fn parse_bitrate(s: &str) -> Option<VideoQuality> {
+        let s = s.trim();
+        let (num, scale) = match s.as_bytes().last()? {
+            b'k' | b'K' => (&s[..s.len() - 1], 1e3),
+            b'm' | b'M' => (&s[..s.len() - 1], 1e6),
+            _ => (s, 1.0),
+        };
+        let v = num.trim().parse::<f64>().ok()? * scale;
+        (v.is_finite() && (10_000.0..=200e6).contains(&v))
+            .then_some(VideoQuality::Bitrate(v as u32))
+    }
+}
+
+/// Largest frame OpenH264 encodes (level 5.2).
+const MAX_LONG_SIDE: u32 = 3840;
+const MAX_SHORT_SIDE: u32 = 2160;
+
+/// Checks that frames of this size can be encoded (before any rendering).
+pub fn check_video_size(width: u32, height: u32) -> Result<(), String> {
+    let (w, h) = (width.next_multiple_of(2), height.next_multiple_of(2));
+    if w.max(h) > MAX_LONG_SIDE || w.min(h) > MAX_SHORT_SIDE {
+        return Err(format!(
+            "a video frame may be at most 3840x2160 (or 2160x3840); these frames are {width}x{height}"
+        ));
+    }
+    Ok(())
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSettings {
     pub dir: PathBuf,
@@ -200,4 +253,8 @@ pub struct OutputSettings {
     pub gif: Option<String>,
     pub gif_delay_ms: u32,
     pub gif_dither: GifDither,
+    /// The video's file name (in `dir`; per camera like the GIF).
+    pub video: Option<String>,
+    pub video_fps: f64,
+    pub video_quality: VideoQuality,
 }

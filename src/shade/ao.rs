@@ -414,6 +414,7 @@ mod tests {
             projection: Projection::Perspective { fov_y: 50.0 },
             near: 0.1,
             far: 50.0,
+            path: None,
         };
         let view = AoView::new(&cam, w, h);
         let world_from_view = view.view_from_world.inverse();

@@ -11,6 +11,8 @@
 //! (under a tenth of its largest extent) is seen along that axis, tilted by
 //! the elevation, never edge-on.
 
+use std::sync::Arc;
+
 use glam::{Mat4, Vec3};
 
 use super::get;
@@ -19,6 +21,7 @@ use crate::error::Error;
 use crate::scene::Model;
 use crate::scene::animation::Animation;
 use crate::scene::camera::{Camera, Projection, fitted_planes};
+use crate::scene::camera_path::{CameraKey, CameraPath};
 use crate::scene::desc::{self, Ctx, S, SceneDesc};
 
 /// The default elevation of fitted cameras, degrees above the horizon.
@@ -125,13 +128,19 @@ pub(super) fn build(
     bounds: Bounds,
     subject: &Subject,
     imported: &[(GltfCamera, Mat4)],
+    animation: &Animation,
 ) -> Result<Vec<Camera>, Error> {
+    // `animation.turntable.elevation`: fitted cameras look from it, cameras
+    // with an eye are raised to it (about the pivot); keyed cameras follow
+    // their keys.
+    let raise = animation.turntable.as_ref().and_then(|t| t.elevation);
+    let elevation = raise.unwrap_or(ELEVATION);
     if d.cameras.is_empty() && imported.is_empty() {
         let projection = Projection::Perspective { fov_y: 45.0 };
         return Ok(vec![subject.camera(
             "camera".into(),
             projection,
-            ELEVATION,
+            elevation,
             0.0,
         )]);
     }
@@ -153,7 +162,15 @@ pub(super) fn build(
         if cams.iter().any(|c| c.name == name) {
             return Err(ctx.err(c.span(), format!("two cameras are named `{name}`")));
         }
-        cams.push(from_desc(c, name, ctx, bounds, subject)?);
+        let mut cam = from_desc(c, name, ctx, bounds, subject, elevation)?;
+        let cd = c.get_ref();
+        if let Some(e) = raise
+            && cd.keys.is_empty()
+            && (cd.eye.is_some() || cd.target.is_some())
+        {
+            cam.eye = animation.raise(cam.eye, e);
+        }
+        cams.push(cam);
     }
     for (g, world) in imported {
         let mut name = g.name.clone();
@@ -177,6 +194,7 @@ fn from_desc(
     ctx: &Ctx,
     b: Bounds,
     subject: &Subject,
+    default_elevation: f32,
 ) -> Result<Camera, Error> {
     let cd = c.get_ref();
     let fov = get(&cd.fov, 45.0);
@@ -191,9 +209,12 @@ fn from_desc(
         } else {
             Projection::Perspective { fov_y: fov }
         };
-        let (e, a) = (get(&cd.elevation, ELEVATION), get(&cd.azimuth, 0.0));
+        let (e, a) = (get(&cd.elevation, default_elevation), get(&cd.azimuth, 0.0));
         subject.camera(name.clone(), projection, e, a)
     };
+    if !cd.keys.is_empty() {
+        return Ok(keyed(cd, name, up, fov, b));
+    }
     if cd.eye.is_none() && cd.target.is_none() {
         let mut f = fitted();
         if let Some(h) = &cd.height {
@@ -262,7 +283,69 @@ fn from_desc(
         projection,
         near,
         far,
+        path: None,
     })
+}
+
+/// A camera on a path of `[[camera.keys]]` (validated: at least one key,
+/// frames increasing). It is the first key's camera; each frame places it
+/// along the path (`CameraPath::at`), with near and far fitted to the
+/// models from where the eye is unless the camera gives them.
+fn keyed(cd: &desc::CameraDesc, name: String, up: Vec3, fov: f32, b: Bounds) -> Camera {
+    let keys: Vec<CameraKey> = cd
+        .keys
+        .iter()
+        .map(|k| {
+            let k = k.get_ref();
+            CameraKey {
+                frame: *k.frame.get_ref() as u32,
+                eye: Vec3::from(*k.eye.get_ref()),
+                target: Vec3::from(*k.target.get_ref()),
+                up: k
+                    .up
+                    .as_ref()
+                    .map(|u| Vec3::from(*u.get_ref()).normalize())
+                    .unwrap_or(up),
+                fov: k.fov.as_ref().map(|f| *f.get_ref()),
+            }
+        })
+        .collect();
+    let projection = match cd.projection.as_ref().map(|p| *p.get_ref()) {
+        None | Some(desc::Projection::Perspective) => Projection::Perspective { fov_y: fov },
+        Some(desc::Projection::Orthographic) => Projection::Orthographic {
+            height: get(&cd.height, b.radius * 2.0),
+        },
+    };
+    let user_planes = cd.near.is_some() || cd.far.is_some();
+    let first = keys[0].clone();
+    let (fit_near, fit_far) = fitted_planes((b.center - first.eye).length(), b.radius);
+    let near = get(&cd.near, fit_near);
+    let far = get(&cd.far, fit_far.max(near * 2.0));
+    let path = CameraPath {
+        interpolation: cd
+            .interpolation
+            .as_ref()
+            .map(|i| *i.get_ref())
+            .unwrap_or_default(),
+        fit_planes: (!user_planes).then_some((b.center, b.radius)),
+        projection,
+        keys,
+    };
+    let base = Camera {
+        name,
+        eye: first.eye,
+        target: first.target,
+        up: first.up,
+        projection,
+        near,
+        far,
+        path: None,
+    };
+    let placed = path.at(&base, first.frame);
+    Camera {
+        path: Some(Arc::new(path)),
+        ..placed
+    }
 }
 
 /// A glTF camera placed with its model; it looks at a point straight ahead
@@ -301,5 +384,6 @@ fn from_gltf(g: &GltfCamera, world: Mat4, name: String, b: Bounds) -> Camera {
         },
         near,
         far,
+        path: None,
     }
 }

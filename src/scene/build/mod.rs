@@ -168,7 +168,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let animation = animation(&d.animation, bounds.center);
     let aspect = settings.width as f32 / settings.height as f32;
     let subject = cameras::Subject::new(&models.models, &animation, aspect);
-    let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras)?;
+    let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras, &animation)?;
     let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
     let environment = match &d.environment {
         Some(e) => {
@@ -307,10 +307,12 @@ fn animation(a: &desc::AnimationDesc, pivot: Vec3) -> Animation {
             axis: Vec3::from(get(&t.axis, [0.0, 1.0, 0.0])).normalize(),
             degrees: get(&t.degrees, 360.0),
             rotate: get(&t.rotate, TurntableTarget::Models),
+            elevation: t.elevation.as_ref().map(|e| *e.get_ref()),
         }
     });
     Animation {
         frames: get(&a.frames, 1) as u32,
+        fps: get(&a.fps, 24.0),
         turntable,
         pivot,
     }

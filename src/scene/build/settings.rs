@@ -13,7 +13,7 @@ use crate::scene::check_pattern;
 use crate::scene::desc::{self, Ctx, SceneDesc};
 use crate::scene::settings::{
     AoMethod, AoSettings, Background, OutputSettings, RenderSettings, ShadowBias, ShadowMethod,
-    TextureFilter, Tonemap,
+    TextureFilter, Tonemap, VideoQuality, check_video_size,
 };
 
 /// An optional key's value, or the renderer's default for it.
@@ -125,6 +125,29 @@ pub(super) fn output(
             "output.gif is assembled from the color frames: it needs output.color = true",
         ));
     }
+    if let Some(v) = &o.video {
+        if settings.background == Background::Transparent {
+            return Err(ctx.err(
+                v.span(),
+                "output.video cannot hold a transparent background (H.264 has no alpha): \
+                 give output.background a colour, or drop output.video",
+            ));
+        }
+        if let Err(m) = check_video_size(settings.width, settings.height) {
+            return Err(ctx.err(v.span(), format!("output.video: {m}")));
+        }
+    }
+    let video_quality = match o.video_quality.as_ref().map(|q| q.get_ref()) {
+        None => VideoQuality::default(),
+        Some(desc::VideoQualityDesc::Number(n)) => VideoQuality::Quality((*n).clamp(1, 100) as u8),
+        Some(desc::VideoQualityDesc::Text(t)) => VideoQuality::parse_bitrate(t).unwrap_or_default(),
+    };
+    // The video's rate: `output.video_fps`, else the animation's, else
+    // the GIF's delay.
+    let video_fps = match (&o.video_fps, &d.animation.fps) {
+        (Some(f), _) | (None, Some(f)) => *f.get_ref() as f64,
+        (None, None) => 1000.0 / get(&o.gif_delay_ms, 40) as f64,
+    };
     let dir = match (out_dir, &o.dir) {
         (Some(out), _) => out.to_path_buf(),
         (None, Some(dir)) => scene_dir.join(dir.get_ref()),
@@ -139,6 +162,9 @@ pub(super) fn output(
         gif: o.gif.as_ref().map(|g| g.get_ref().clone()),
         gif_delay_ms: get(&o.gif_delay_ms, 40) as u32,
         gif_dither: pick(&o.gif_dither),
+        video: o.video.as_ref().map(|v| v.get_ref().clone()),
+        video_fps,
+        video_quality,
     })
 }
 
@@ -259,6 +285,17 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
                 &format!("camera.azimuth {why}"),
             );
         }
+    }
+    if o.video.is_none() {
+        let why = "has no effect without output.video";
+        warn(
+            o.video_fps.as_ref().map(|v| v.span()),
+            &format!("output.video_fps {why}"),
+        );
+        warn(
+            o.video_quality.as_ref().map(|v| v.span()),
+            &format!("output.video_quality {why}"),
+        );
     }
     if o.gif.is_none() {
         let why = "has no effect without output.gif";
