@@ -9,13 +9,14 @@
 //! rerun finish what an interrupted one left (files land atomically, so an
 //! existing file is a complete one).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Instant;
 
 use crate::error::Error;
 use crate::output::{self, Image8};
-use crate::render::{Frame, Renderer};
+use crate::render::{AovPixel, Frame, Renderer};
 use crate::scene::{Scene, expand_pattern};
 
 pub struct RenderJob {
@@ -139,6 +140,10 @@ struct Naming {
     color: bool,
     depth: bool,
     ao: bool,
+    normal: bool,
+    albedo: bool,
+    position: bool,
+    id: bool,
     gif: Option<String>,
     video: Option<String>,
 }
@@ -152,16 +157,32 @@ pub struct FrameFiles {
     pub depth: Option<PathBuf>,
     /// `<name>_ao.exr`, channel `AO`.
     pub ao: Option<PathBuf>,
+    /// `<name>_normal.exr`, channels `N.X N.Y N.Z`.
+    pub normal: Option<PathBuf>,
+    /// `<name>_albedo.exr`, channels `albedo.R albedo.G albedo.B`.
+    pub albedo: Option<PathBuf>,
+    /// `<name>_position.exr`, channels `P.X P.Y P.Z`.
+    pub position: Option<PathBuf>,
+    /// `<name>_id.exr`, UINT channels `object_id` and `material_id`.
+    pub id: Option<PathBuf>,
 }
 
 impl FrameFiles {
     /// The files, color first.
     pub fn all(&self) -> Vec<PathBuf> {
-        [&self.color, &self.depth, &self.ao]
-            .into_iter()
-            .flatten()
-            .cloned()
-            .collect()
+        [
+            &self.color,
+            &self.depth,
+            &self.ao,
+            &self.normal,
+            &self.albedo,
+            &self.position,
+            &self.id,
+        ]
+        .into_iter()
+        .flatten()
+        .cloned()
+        .collect()
     }
 }
 
@@ -180,6 +201,10 @@ impl FramePlan {
                 color: scene.output.color,
                 depth: scene.output.depth,
                 ao: scene.output.ao,
+                normal: scene.output.normal,
+                albedo: scene.output.albedo,
+                position: scene.output.position,
+                id: scene.output.id,
                 gif: scene.output.gif.clone(),
                 video: scene.output.video.clone(),
             },
@@ -233,6 +258,10 @@ impl FramePlan {
             color: file(n.color, ".png"),
             depth: file(n.depth, "_depth.exr"),
             ao: file(n.ao, "_ao.exr"),
+            normal: file(n.normal, "_normal.exr"),
+            albedo: file(n.albedo, "_albedo.exr"),
+            position: file(n.position, "_position.exr"),
+            id: file(n.id, "_id.exr"),
         }
     }
 
@@ -279,12 +308,14 @@ enum Output {
     Png(PathBuf, Image8),
     /// Path, width, height, channel name, values.
     Exr(PathBuf, u32, u32, &'static str, Vec<f32>),
+    /// Path, width, height, channels.
+    ExrChannels(PathBuf, u32, u32, Vec<(&'static str, output::exr::Samples)>),
 }
 
 impl Output {
     fn path(&self) -> &std::path::Path {
         match self {
-            Output::Png(p, _) | Output::Exr(p, ..) => p,
+            Output::Png(p, _) | Output::Exr(p, ..) | Output::ExrChannels(p, ..) => p,
         }
     }
 
@@ -293,6 +324,19 @@ impl Output {
             Output::Png(p, img) => output::png::write(p, img),
             Output::Exr(p, w, h, channel, values) => {
                 output::exr::write_channel(p, *w, *h, channel, values)
+            }
+            Output::ExrChannels(p, w, h, channels) => {
+                let channels = channels
+                    .iter()
+                    .map(|(name, s)| {
+                        let s = match s {
+                            output::exr::Samples::F32(v) => output::exr::Samples::F32(v.clone()),
+                            output::exr::Samples::U32(v) => output::exr::Samples::U32(v.clone()),
+                        };
+                        (*name, s)
+                    })
+                    .collect();
+                output::exr::write_channels(p, *w, *h, channels)
             }
         }
     }
@@ -322,6 +366,39 @@ fn outputs(
             frame.ao.clone()
         };
         out.push(Output::Exr(p, width, height, "AO", ao));
+    }
+    let aov = &frame.aov;
+    let vec3 = |names: [&'static str; 3], get: fn(&AovPixel) -> glam::Vec3| {
+        (0..3)
+            .map(|k| {
+                let v = aov.iter().map(|a| get(a)[k]).collect();
+                (names[k], output::exr::Samples::F32(v))
+            })
+            .collect::<Vec<_>>()
+    };
+    if !aov.is_empty() {
+        if let Some(p) = files.normal {
+            let c = vec3(["N.X", "N.Y", "N.Z"], |a| a.normal);
+            out.push(Output::ExrChannels(p, width, height, c));
+        }
+        if let Some(p) = files.albedo {
+            let c = vec3(["albedo.R", "albedo.G", "albedo.B"], |a| a.albedo);
+            out.push(Output::ExrChannels(p, width, height, c));
+        }
+        if let Some(p) = files.position {
+            let c = vec3(["P.X", "P.Y", "P.Z"], |a| a.position);
+            out.push(Output::ExrChannels(p, width, height, c));
+        }
+        if let Some(p) = files.id {
+            let ids = |get: fn(&AovPixel) -> u32| {
+                output::exr::Samples::U32(aov.iter().map(get).collect())
+            };
+            let c = vec![
+                ("object_id", ids(|a| a.object)),
+                ("material_id", ids(|a| a.material)),
+            ];
+            out.push(Output::ExrChannels(p, width, height, c));
+        }
     }
     (out, if color { image } else { None })
 }
@@ -365,6 +442,9 @@ impl RenderJob {
         } else {
             self.scene.output.video.is_some()
         };
+        if self.scene.output.id {
+            write_ids(&self.scene)?;
+        }
         summary.videos = self.render_frames(videos, on_done)?;
         if self.scene.output.gif.is_none() {
             return Ok(summary);
@@ -518,6 +598,37 @@ impl RenderJob {
         result?;
         written
     }
+}
+
+/// `{scene}_ids.json` in the output directory: what the id pass's numbers
+/// stand for (`object_id` 1 + the model's index, `material_id` 1 + the
+/// material's index over the models' materials in order; 0 = nothing).
+fn write_ids(scene: &Scene) -> Result<(), Error> {
+    let mut objects = Vec::new();
+    let mut materials = Vec::new();
+    for (i, m) in scene.models.iter().enumerate() {
+        objects.push(serde_json::json!({ "id": i + 1, "name": m.name }));
+        for mat in &m.materials {
+            materials.push(serde_json::json!({
+                "id": materials.len() + 1,
+                "name": mat.name,
+                "object_id": i + 1,
+            }));
+        }
+    }
+    let doc = serde_json::json!({
+        "background": 0,
+        "objects": objects,
+        "materials": materials,
+    });
+    let path = scene.output.dir.join(format!("{}_ids.json", scene.stem));
+    output::write_atomic(&path, |w| {
+        serde_json::to_writer_pretty(&mut *w, &doc).map_err(|e| Error::Encode {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        w.write_all(b"\n").map_err(|e| Error::io(&path, e))
+    })
 }
 
 /// What the render loop sends the writer thread.

@@ -51,6 +51,80 @@ pub fn write_channel(
     })
 }
 
+/// One channel's samples for `write_channels`.
+pub enum Samples {
+    F32(Vec<f32>),
+    U32(Vec<u32>),
+}
+
+/// Writes several channels (name, samples; each `width * height` values,
+/// row-major from the top) into one layer.
+pub fn write_channels(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Vec<(&str, Samples)>,
+) -> Result<(), Error> {
+    let encode = |message: String| Error::Encode {
+        path: path.to_path_buf(),
+        message,
+    };
+    let n = width as usize * height as usize;
+    let mut list = smallvec::SmallVec::new();
+    for (name, samples) in channels {
+        let text = Text::new_or_none(name).ok_or_else(|| encode(format!("channel {name}")))?;
+        let (len, flat) = match samples {
+            Samples::F32(v) => (v.len(), FlatSamples::F32(v)),
+            Samples::U32(v) => (v.len(), FlatSamples::U32(v)),
+        };
+        if len != n {
+            return Err(encode(format!(
+                "{len} values in {name} for a {width}x{height} image"
+            )));
+        }
+        list.push(AnyChannel::new(text, flat));
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let image = Image::from_layer(layer);
+    write_atomic(path, |w| {
+        image
+            .write()
+            .to_buffered(w)
+            .map_err(|e| encode(e.to_string()))
+    })
+}
+
+/// Reads channel `channel` of the first layer as unsigned integers (a
+/// UINT channel exactly; float channels rounded).
+pub fn read_channel_u32(path: &Path, channel: &str) -> Result<(u32, u32, Vec<u32>), Error> {
+    let bad = |message: String| Error::asset(path, None, message);
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| bad(e.to_string()))?;
+    let layer = &image.layer_data;
+    let ch = layer
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == channel)
+        .ok_or_else(|| bad(format!("no channel `{channel}`")))?;
+    let values = match &ch.sample_data {
+        FlatSamples::U32(v) => v.clone(),
+        other => other.values_as_f32().map(|x| x.round() as u32).collect(),
+    };
+    Ok((layer.size.0 as u32, layer.size.1 as u32, values))
+}
+
 /// Reads channel `channel` of the first layer as float32: (width, height,
 /// values row-major from the top).
 pub fn read_channel(path: &Path, channel: &str) -> Result<(u32, u32, Vec<f32>), Error> {

@@ -16,6 +16,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use super::frame::AovPixel;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
 use super::rays::CameraRays;
@@ -202,6 +203,66 @@ impl<'a> FrameData<'a> {
                 position: p.position,
                 normal: p.normal,
                 geo_normal: p.geo_normal,
+            };
+        }
+    }
+
+    /// The data passes of a band: per pixel, of its nearest fragment (the
+    /// one the depth comes from), at that fragment's shading point; the
+    /// background and the ground shadow catcher are `AovPixel::EMPTY`.
+    pub fn aovs(&self, vis: &Visibility, out: &mut [AovPixel]) {
+        let rect = vis.rect;
+        let tw = rect.width();
+        let n = vis.samples();
+        let mut cache = InterpolatorCache::default();
+        let models = &self.fs.scene.models;
+        let material_base: Vec<u32> = models
+            .iter()
+            .scan(0u32, |acc, m| {
+                let base = *acc;
+                *acc += m.materials.len() as u32;
+                Some(base)
+            })
+            .collect();
+        for (i, a) in out.iter_mut().enumerate() {
+            let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
+            let frags = if n == 1 {
+                smallvec::smallvec![(vis.id[i], 1)]
+            } else {
+                fragments(&vis.id[i * n..(i + 1) * n])
+            };
+            let mut best: Option<(f32, u32, Fragment)> = None;
+            for (id, mask) in frags {
+                if id == NO_TRIANGLE {
+                    continue;
+                }
+                let it = cache.get(id, &self.tris[id as usize]);
+                let frag = self.shading_point(it, px, py, mask);
+                let d = self.point(&self.tris[id as usize], frag).view_depth;
+                if best.is_none_or(|b| d < b.0) {
+                    best = Some((d, id, frag));
+                }
+            }
+            let Some((_, id, frag)) = best else {
+                *a = AovPixel::EMPTY;
+                continue;
+            };
+            let t = &self.tris[id as usize];
+            let it = cache.get(id, t);
+            let grads = if self.grads {
+                self.gradients(t, it, (px & !1, py & !1))
+            } else {
+                [Gradients::default(); 2]
+            };
+            let s = self.surface(t, it, frag, (px, py), grads, [None; 2], 1.0);
+            let (normal, albedo) = self.ctx.aov(&s);
+            let d = self.draws[t.draw as usize];
+            *a = AovPixel {
+                normal,
+                albedo,
+                position: s.position,
+                object: d.model as u32 + 1,
+                material: material_base[d.model] + d.material as u32 + 1,
             };
         }
     }
@@ -520,6 +581,26 @@ impl<'a> FrameData<'a> {
         footprints: [Option<SizedFootprint>; 2],
         ao: f32,
     ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
+        let surface = self.surface(t, it, frag, (px, py), grads, footprints, ao);
+        (
+            self.ctx.shade(&surface),
+            surface.view_depth,
+            surface.tc.footprints(),
+        )
+    }
+
+    /// The surface of triangle `t` at a fragment, as shading sees it.
+    #[allow(clippy::too_many_arguments)]
+    fn surface(
+        &self,
+        t: &Tri,
+        it: &Interpolator,
+        frag: Fragment,
+        (px, py): (i32, i32),
+        grads: [Gradients; 2],
+        footprints: [Option<SizedFootprint>; 2],
+        ao: f32,
+    ) -> Surface<'_> {
         let ctx = &self.ctx;
         let mode = ctx.mode;
         let d = self.draws[t.draw as usize];
@@ -560,7 +641,7 @@ impl<'a> FrameData<'a> {
         } else {
             f32::INFINITY
         };
-        let surface = Surface {
+        Surface {
             material: &model.materials[d.material],
             position,
             normal,
@@ -574,8 +655,7 @@ impl<'a> FrameData<'a> {
             edge_distance,
             geo_normal,
             ao,
-        };
-        (ctx.shade(&surface), view_depth, surface.tc.footprints())
+        }
     }
 
     /// Position, normals and view depth of triangle `t` at a fragment.

@@ -1,7 +1,7 @@
 //! The frame buffers a render fills, and the supersampling resolve that
 //! turns a frame rendered `k` times larger per axis into the output size.
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 /// A rendered frame in linear space, before tone mapping.
@@ -19,6 +19,38 @@ pub struct Frame {
     /// Ambient occlusion at the pixel center (1: unoccluded, and where
     /// nothing was drawn); empty unless the scene selects an AO method.
     pub ao: Vec<f32>,
+    /// The surface data passes (normal, albedo, position, ids) of the
+    /// nearest fragment per pixel; empty unless the scene writes one.
+    pub aov: Vec<AovPixel>,
+}
+
+/// What the data passes record of a pixel's nearest fragment: the one its
+/// depth comes from. Background (and the ground shadow catcher): zeros.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AovPixel {
+    /// World-space unit shading normal (normal maps applied), facing the
+    /// camera.
+    pub normal: Vec3,
+    /// The material's base colour after textures, linear (Kd, or glTF's
+    /// base colour, times vertex colours).
+    pub albedo: Vec3,
+    /// World-space position.
+    pub position: Vec3,
+    /// 1 + the model's index; 0: none.
+    pub object: u32,
+    /// 1 + the material's index in the scene (models' materials in order);
+    /// 0: none.
+    pub material: u32,
+}
+
+impl AovPixel {
+    pub const EMPTY: AovPixel = AovPixel {
+        normal: Vec3::ZERO,
+        albedo: Vec3::ZERO,
+        position: Vec3::ZERO,
+        object: 0,
+        material: 0,
+    };
 }
 
 impl Frame {
@@ -30,6 +62,7 @@ impl Frame {
             color: vec![Vec4::ZERO; n],
             depth: vec![f32::INFINITY; n],
             ao: Vec::new(),
+            aov: Vec::new(),
         }
     }
 
@@ -76,6 +109,26 @@ pub(super) fn downsample(big: &Frame, k: u32, out: &mut Frame) {
                 depth[x] = d;
             }
         });
+    if big.aov.is_empty() {
+        out.aov.clear();
+    } else {
+        // The data of the block's nearest pixel (no blending).
+        out.aov.resize(w * h as usize, AovPixel::EMPTY);
+        out.aov.par_chunks_mut(w).enumerate().for_each(|(y, aov)| {
+            for (x, a) in aov.iter_mut().enumerate() {
+                let mut best = (f32::INFINITY, AovPixel::EMPTY);
+                for sy in 0..k {
+                    let row = (y * k + sy) * bw + x * k;
+                    for sx in 0..k {
+                        if big.depth[row + sx] < best.0 {
+                            best = (big.depth[row + sx], big.aov[row + sx]);
+                        }
+                    }
+                }
+                *a = best.1;
+            }
+        });
+    }
     if has_ao {
         out.ao.par_chunks_mut(w).enumerate().for_each(|(y, ao)| {
             for (x, a) in ao.iter_mut().enumerate() {

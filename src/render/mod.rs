@@ -39,7 +39,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 pub use exposure::auto_exposure;
-pub use frame::Frame;
+pub use frame::{AovPixel, Frame};
 pub use setup::FrameSetup;
 
 use crate::assets::environment::EnvImage;
@@ -283,14 +283,28 @@ impl Renderer {
         let bins = geo.bins();
         let grid = &geo.grid;
         let band = (grid.tile_w * grid.tile_h) as usize;
+        // The data passes: a buffer the bands fill beside their colour, or
+        // an empty chunk per band.
+        let aovs = data.fs.scene.output.writes_aovs();
+        if aovs {
+            out.aov.resize(out.color.len(), AovPixel::EMPTY);
+        } else {
+            out.aov.clear();
+        }
+        let bands = out.color.len().div_ceil(band);
         if data.fs.scene.settings.ao.method == AoMethod::Off {
             out.ao.clear();
+            let chunks = aov_chunks(&mut out.aov, band, bands);
             out.color
                 .par_chunks_mut(band)
                 .zip(out.depth.par_chunks_mut(band))
+                .zip(chunks)
                 .enumerate()
-                .for_each(|(ti, (color, depth))| {
+                .for_each(|(ti, ((color, depth), aov))| {
                     let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
+                    if !aov.is_empty() {
+                        data.aovs(&vis, aov);
+                    }
                     data.shade_band(&vis, blended, None, color, depth);
                 });
             return;
@@ -308,12 +322,17 @@ impl Renderer {
             })
             .collect();
         out.ao = ao_pass::occlusion(data.fs, &gbuf, out.width, out.height, tracer);
+        let chunks = aov_chunks(&mut out.aov, band, bands);
         out.color
             .par_chunks_mut(band)
             .zip(out.depth.par_chunks_mut(band))
             .zip(out.ao.par_chunks(band))
             .zip(visible)
-            .for_each(|(((color, depth), ao), (vis, blended))| {
+            .zip(chunks)
+            .for_each(|((((color, depth), ao), (vis, blended)), aov)| {
+                if !aov.is_empty() {
+                    data.aovs(&vis, aov);
+                }
                 data.shade_band(&vis, blended, Some(ao), color, depth);
             });
     }
@@ -344,6 +363,16 @@ impl Renderer {
             .zip(&needed)
             .map(|((t, m), &need)| need.then(|| m.get_or_init(|| mip::build_chain(t)).as_slice()))
             .collect()
+    }
+}
+
+/// The data-pass buffer in band-sized chunks, or an empty chunk per band
+/// when the frame has none.
+fn aov_chunks(aov: &mut [AovPixel], band: usize, bands: usize) -> Vec<&mut [AovPixel]> {
+    if aov.is_empty() {
+        (0..bands).map(|_| Default::default()).collect()
+    } else {
+        aov.chunks_mut(band).collect()
     }
 }
 

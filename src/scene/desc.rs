@@ -112,6 +112,11 @@ pub struct OutputDesc {
     pub video_fps: Option<S<f32>>,
     /// 1 to 100, or a bitrate string such as "2500k".
     pub video_quality: Option<S<VideoQualityDesc>>,
+    /// Version 2: the data passes as EXR.
+    pub normal: Option<S<bool>>,
+    pub albedo: Option<S<bool>>,
+    pub position: Option<S<bool>>,
+    pub id: Option<S<bool>>,
 }
 
 /// `output.video_quality` as written: a number or a string.

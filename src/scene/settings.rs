@@ -257,4 +257,20 @@ pub struct OutputSettings {
     pub video: Option<String>,
     pub video_fps: f64,
     pub video_quality: VideoQuality,
+    /// `{stem}_normal.exr`, channels `N.X N.Y N.Z` (world, unit).
+    pub normal: bool,
+    /// `{stem}_albedo.exr`, channels `albedo.R albedo.G albedo.B` (linear).
+    pub albedo: bool,
+    /// `{stem}_position.exr`, channels `P.X P.Y P.Z` (world).
+    pub position: bool,
+    /// `{stem}_id.exr`, UINT channels `object_id` and `material_id`, and
+    /// `{scene}_ids.json` naming them.
+    pub id: bool,
+}
+
+impl OutputSettings {
+    /// Whether frames need the data passes (`Frame::aov`).
+    pub fn writes_aovs(&self) -> bool {
+        self.normal || self.albedo || self.position || self.id
+    }
 }

@@ -207,6 +207,29 @@ impl ShadeContext<'_> {
         }
     }
 
+    /// The data passes' values of a surface point: its shading normal
+    /// (normal and bump maps applied; the triangle's in flat mode), world
+    /// space, unit, facing the camera; and its base colour after textures,
+    /// linear (glTF's base colour, or Kd), times the vertex colour.
+    pub fn aov(&self, s: &Surface) -> (Vec3, Vec3) {
+        let normal = if self.mode == ShadingMode::Flat {
+            s.normal
+        } else {
+            self.mapped_normal(s)
+        };
+        let pbr = match self.mode {
+            ShadingMode::Pbr => true,
+            ShadingMode::BlinnPhong | ShadingMode::Flat | ShadingMode::Gouraud => false,
+            _ => s.material.native == Native::Pbr,
+        };
+        let albedo = if pbr {
+            self.pbr_color(s).base
+        } else {
+            self.surface_color(s.material, &s.tc, s.color).kd
+        };
+        (normal.normalize_or(Vec3::Z), albedo)
+    }
+
     /// Metallic-roughness shading of a point.
     fn shade_pbr(&self, s: &Surface) -> Vec3 {
         let c = self.pbr_color(s);

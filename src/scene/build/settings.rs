@@ -165,6 +165,10 @@ pub(super) fn output(
         video: o.video.as_ref().map(|v| v.get_ref().clone()),
         video_fps,
         video_quality,
+        normal: get(&o.normal, false),
+        albedo: get(&o.albedo, false),
+        position: get(&o.position, false),
+        id: get(&o.id, false),
     })
 }
 
