@@ -148,6 +148,14 @@ struct CompareArgs {
     /// One JSON report on stdout instead of text.
     #[arg(long)]
     json: bool,
+    /// Write a self-contained HTML review page (images embedded, failures
+    /// first).
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Bless the test images: copy each failing one over its reference
+    /// (and add the ones the references lack), printing what changed.
+    #[arg(long)]
+    update: bool,
 }
 
 #[derive(clap::Args)]
@@ -239,6 +247,26 @@ fn compare(args: CompareArgs) -> i32 {
                 println!("{}", report.to_json());
             } else {
                 print!("{}", report.to_text());
+            }
+            if let Some(page) = &args.report {
+                if let Err(e) = softraster::tools::report::write_html(&report, page) {
+                    eprintln!("error: {e}");
+                    return e.exit_code();
+                }
+                eprintln!("report: {}", page.display());
+            }
+            if args.update && report.exit_code() == 1 {
+                return match softraster::tools::report::update_references(&report, &args.reference)
+                {
+                    Ok(files) => {
+                        eprintln!("updated {} reference(s)", files.len());
+                        0
+                    }
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        e.exit_code()
+                    }
+                };
             }
             report.exit_code()
         }

@@ -379,3 +379,63 @@ fn gifs_per_camera_and_their_keys_are_checked() {
     );
     assert_eq!(code, 2, "{err}");
 }
+
+#[test]
+fn review_report_lists_failures_first_and_update_blesses_them() {
+    let dir = common::scratch("compare_report");
+    let (refs, tests) = (dir.join("ref"), dir.join("test"));
+    std::fs::create_dir_all(&refs).unwrap();
+    std::fs::create_dir_all(&tests).unwrap();
+    let base = |x: u32, y: u32| [(x * 2) as u8, (y * 3) as u8, 120];
+    // a_same passes, b_changed fails, c_new is in the test set only.
+    png(&refs.join("a_same.png"), base);
+    png(&tests.join("a_same.png"), base);
+    png(&refs.join("b_changed.png"), base);
+    png(&tests.join("b_changed.png"), |x, y| {
+        [255 - (x * 2) as u8, 30, (y * 3) as u8]
+    });
+    png(&tests.join("c_new.png"), base);
+    let page = dir.join("report.html");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "compare",
+            refs.to_str().unwrap(),
+            tests.to_str().unwrap(),
+            "--report",
+            page.to_str().unwrap(),
+        ];
+        a.extend(extra);
+        run(&a)
+    };
+    let (code, _, err) = args(&[]);
+    assert_eq!(code, 1, "{err}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("2 of 3 failed"), "{html:.300}");
+    // Failures first: the failing file's row comes before the passing one.
+    let (fail, new, pass) = (
+        html.find("b_changed.png").unwrap(),
+        html.find("c_new.png").unwrap(),
+        html.find("a_same.png").unwrap(),
+    );
+    assert!(fail < new && new < pass, "{fail} {new} {pass}");
+    // Self-contained: reference, test and error map of both pairs and the
+    // new file's test image, embedded; no other file referenced.
+    assert_eq!(html.matches("data:image/png;base64,").count(), 7);
+    assert!(!html.contains("src=\"/") && !html.contains("src=\"ref"));
+    // --update copies the failing and the new test images into the
+    // references and prints what changed; then everything passes.
+    let (code, _, err) = args(&["--update"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("b_changed.png") && err.contains("c_new.png"),
+        "{err}"
+    );
+    for name in ["b_changed.png", "c_new.png"] {
+        assert_eq!(
+            std::fs::read(refs.join(name)).unwrap(),
+            std::fs::read(tests.join(name)).unwrap()
+        );
+    }
+    let (code, out, err) = args(&[]);
+    assert_eq!(code, 0, "{out}{err}");
+}

@@ -299,6 +299,9 @@ pub struct FileResult {
     /// side a file is missing from.
     pub message: Option<String>,
     pub diff: Option<PathBuf>,
+    /// The pair's files (where each exists).
+    pub reference: Option<PathBuf>,
+    pub test: Option<PathBuf>,
 }
 
 impl FileResult {
@@ -434,6 +437,8 @@ fn compare_pair(
         value,
         message,
         diff,
+        reference: reference.exists().then(|| reference.to_path_buf()),
+        test: test.exists().then(|| test.to_path_buf()),
     };
     for (path, side) in [(reference, "reference"), (test, "test")] {
         if !path.exists() {
@@ -505,6 +510,8 @@ pub fn compare_paths(
                     value: None,
                     message: Some(message.to_string()),
                     diff: None,
+                    reference: r.contains(*name).then(|| reference.join(name.as_str())),
+                    test: t.contains(*name).then(|| test.join(name.as_str())),
                 };
                 if !t.contains(*name) {
                     return only(Status::Missing, "not in the test set");

@@ -8,3 +8,4 @@ pub mod accuracy;
 pub mod bench;
 pub mod chart;
 pub mod compare;
+pub mod report;
