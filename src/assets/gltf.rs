@@ -340,6 +340,14 @@ fn extensions(doc: &gltf::Document, path: &Path) -> Result<Vec<String>, String> 
         .collect())
 }
 
+/// Where a mesh's primitives go: the node's world transform, its morph
+/// weights, and its skin with every node's world transform (for joints).
+struct Pose<'a> {
+    world: Mat4,
+    weights: &'a [f32],
+    skin: Option<(&'a gltf::Skin<'a>, &'a [Mat4])>,
+}
+
 /// The lights and cameras the node hierarchy places.
 #[derive(Default)]
 struct Placed {
@@ -372,6 +380,12 @@ fn walk_nodes(
         }
     };
     let mut seen = vec![false; doc.nodes().count()];
+    // Every node's default world transform, for skins' joints.
+    let worlds = if doc.skins().next().is_some() {
+        super::gltf_pose::node_worlds(doc)?
+    } else {
+        Vec::new()
+    };
     let mut stack: Vec<(gltf::Node, Mat4)> = roots
         .into_iter()
         .rev()
@@ -392,6 +406,8 @@ fn walk_nodes(
             ));
         }
         if let Some(mesh) = node.mesh() {
+            let weights = node.weights().or(mesh.weights()).unwrap_or(&[]);
+            let skin = node.skin();
             for prim in mesh.primitives() {
                 let mat = match prim.material().index() {
                     Some(i) => i,
@@ -400,7 +416,12 @@ fn walk_nodes(
                         materials.len() - 1
                     }),
                 };
-                b.add_primitive(&prim, buffers, world, mat).map_err(|m| {
+                let pose = Pose {
+                    world,
+                    weights,
+                    skin: skin.as_ref().map(|s| (s, worlds.as_slice())),
+                };
+                b.add_primitive(&prim, buffers, &pose, mat).map_err(|m| {
                     format!("mesh {} primitive {}: {m}", mesh.index(), prim.index())
                 })?;
             }
@@ -1174,9 +1195,10 @@ impl Builder {
         &mut self,
         prim: &gltf::Primitive,
         buffers: &[Vec<u8>],
-        world: Mat4,
+        pose: &Pose,
         material: usize,
     ) -> Result<(), String> {
+        let world = pose.world;
         let mode = prim.mode();
         if matches!(
             mode,
@@ -1184,6 +1206,8 @@ impl Builder {
         ) {
             return self.add_points_or_lines(prim, buffers, world, material);
         }
+        let mut attributes = read_attributes(prim, buffers, &self.views)?;
+        super::gltf_pose::apply_morph(prim, pose.weights, buffers, &mut attributes)?;
         let Attributes {
             positions,
             normals,
@@ -1191,8 +1215,17 @@ impl Builder {
             uv,
             colors,
             indices,
-        } = read_attributes(prim, buffers, &self.views)?;
+        } = attributes;
         let n = positions.len();
+        // A skinned primitive: each vertex placed by its joints (the node's
+        // own transform does not apply).
+        let skinned = match pose.skin {
+            Some((skin, worlds)) => Some(super::gltf_pose::skin_matrices(
+                prim, skin, worlds, buffers, n,
+            )?),
+            None => None,
+        };
+        let place = |s: usize| skinned.as_ref().map_or(world, |k| k[s]);
         let Some(mut tris) = triangulate(mode, &indices) else {
             return Ok(());
         };
@@ -1223,7 +1256,16 @@ impl Builder {
         let m = &mut self.mesh;
         for (k, &src) in order.iter().enumerate() {
             let s = src as usize;
-            m.positions.push(world.transform_point3(positions[s]));
+            let (xf, m3, normal_m) = match &skinned {
+                None => (world, m3, normal_m),
+                Some(_) => {
+                    let xf = place(s);
+                    let m3 = Mat3::from_mat4(xf);
+                    (xf, m3, m3.inverse().transpose())
+                }
+            };
+            let mirrored = m3.determinant() < 0.0;
+            m.positions.push(xf.transform_point3(positions[s]));
             let nrm = match (&normals, &face_normals) {
                 (Some(nv), _) => nv[s],
                 (None, Some(f)) => f[k / 3],
@@ -1251,6 +1293,13 @@ impl Builder {
         self.any_tangent |= tangents.is_some() && face_normals.is_none();
         let first = m.triangles.len() as u32;
         for t in tris {
+            // Skinned: mirrored where the first corner's joints mirror.
+            let mirrored = match &skinned {
+                None => mirrored,
+                Some(_) => {
+                    Mat3::from_mat4(place(order[t[0] as usize] as usize)).determinant() < 0.0
+                }
+            };
             let [a, b, c] = t.map(|i| i + base);
             m.triangles
                 .push(if mirrored { [a, c, b] } else { [a, b, c] });

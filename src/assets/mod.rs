@@ -5,6 +5,7 @@ pub mod accessor;
 pub mod draco;
 pub mod environment;
 pub mod gltf;
+pub mod gltf_pose;
 pub mod mesh;
 pub mod meshopt;
 pub mod mip;
