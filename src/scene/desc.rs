@@ -11,7 +11,7 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use toml::Spanned;
 
 use super::animation::TurntableTarget;
-use super::camera_path::Interpolation;
+use super::camera::Interpolation;
 use super::material::NormalSpace;
 use super::settings::{
     AddressMode, AoMethod, Background, CullMode, DepthMode, GifDither, ShadingMode, ShadowMethod,

@@ -9,7 +9,6 @@
 pub mod animation;
 pub mod build;
 pub mod camera;
-pub mod camera_path;
 pub mod desc;
 pub mod environment;
 pub mod light;

@@ -20,8 +20,7 @@ use crate::assets::gltf::{GltfCamera, GltfProjection};
 use crate::error::Error;
 use crate::scene::Model;
 use crate::scene::animation::Animation;
-use crate::scene::camera::{Camera, Projection, fitted_planes};
-use crate::scene::camera_path::{CameraKey, CameraPath};
+use crate::scene::camera::{Camera, CameraKey, CameraPath, Projection, fitted_planes};
 use crate::scene::desc::{self, Ctx, S, SceneDesc};
 
 /// The default elevation of fitted cameras, degrees above the horizon.
