@@ -99,9 +99,8 @@ pub fn write_channels(
     })
 }
 
-/// Reads channel `channel` of the first layer as unsigned integers (a
-/// UINT channel exactly; float channels rounded).
-pub fn read_channel_u32(path: &Path, channel: &str) -> Result<(u32, u32, Vec<u32>), Error> {
+/// Channel `channel` of the first layer: (width, height, samples).
+fn read_samples(path: &Path, channel: &str) -> Result<(u32, u32, FlatSamples), Error> {
     let bad = |message: String| Error::asset(path, None, message);
     let image = read()
         .no_deep_data()
@@ -111,42 +110,33 @@ pub fn read_channel_u32(path: &Path, channel: &str) -> Result<(u32, u32, Vec<u32
         .all_attributes()
         .from_file(path)
         .map_err(|e| bad(e.to_string()))?;
-    let layer = &image.layer_data;
+    let layer = image.layer_data;
+    let size = layer.size;
     let ch = layer
         .channel_data
         .list
-        .iter()
+        .into_iter()
         .find(|c| c.name.to_string() == channel)
         .ok_or_else(|| bad(format!("no channel `{channel}`")))?;
-    let values = match &ch.sample_data {
-        FlatSamples::U32(v) => v.clone(),
+    Ok((size.0 as u32, size.1 as u32, ch.sample_data))
+}
+
+/// Reads channel `channel` of the first layer as unsigned integers (a
+/// UINT channel exactly; float channels rounded).
+pub fn read_channel_u32(path: &Path, channel: &str) -> Result<(u32, u32, Vec<u32>), Error> {
+    let (w, h, samples) = read_samples(path, channel)?;
+    let values = match samples {
+        FlatSamples::U32(v) => v,
         other => other.values_as_f32().map(|x| x.round() as u32).collect(),
     };
-    Ok((layer.size.0 as u32, layer.size.1 as u32, values))
+    Ok((w, h, values))
 }
 
 /// Reads channel `channel` of the first layer as float32: (width, height,
 /// values row-major from the top).
 pub fn read_channel(path: &Path, channel: &str) -> Result<(u32, u32, Vec<f32>), Error> {
-    let bad = |message: String| Error::asset(path, None, message);
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| bad(e.to_string()))?;
-    let layer = &image.layer_data;
-    let size = layer.size;
-    let ch = layer
-        .channel_data
-        .list
-        .iter()
-        .find(|c| c.name.to_string() == channel)
-        .ok_or_else(|| bad(format!("no channel `{channel}`")))?;
-    let values: Vec<f32> = ch.sample_data.values_as_f32().collect();
-    Ok((size.0 as u32, size.1 as u32, values))
+    let (w, h, samples) = read_samples(path, channel)?;
+    Ok((w, h, samples.values_as_f32().collect()))
 }
 
 #[cfg(test)]

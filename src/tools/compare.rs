@@ -408,7 +408,8 @@ fn is_image(p: &Path) -> bool {
         .is_some_and(|e| matches!(e.as_str(), "png" | "jpg" | "jpeg" | "tga"))
 }
 
-fn read_image(p: &Path) -> Result<Image8, String> {
+/// A PNG as it is, another image format as RGBA.
+pub fn read_image(p: &Path) -> Result<Image8, String> {
     if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         return png::read(p).map_err(|e| e.to_string());
     }

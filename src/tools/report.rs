@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use base64::Engine as _;
 use rayon::prelude::*;
 
-use super::compare::{FileResult, Report, Status, score};
+use super::compare::{FileResult, Report, Status, read_image, score};
 use crate::error::Error;
-use crate::output::{Image8, png, write_atomic};
+use crate::output::{Image8, write_atomic};
 
 /// Longest side of a passing pair's images in the page.
 const THUMBNAIL: u32 = 256;
@@ -92,7 +92,7 @@ fn row(report: &Report, f: &FileResult) -> Result<String, Error> {
         .map(|m| format!("<br>{}", escape(m)))
         .unwrap_or_default();
     let full = f.status != Status::Pass;
-    let read = |p: &Option<PathBuf>| p.as_ref().and_then(|p| png_or_image(p).ok());
+    let read = |p: &Option<PathBuf>| p.as_ref().and_then(|p| read_image(p).ok());
     let (a, b) = (read(&f.reference), read(&f.test));
     let diff = match (&a, &b) {
         (Some(a), Some(b)) => score(a, b, report.metric).ok().map(|s| s.diff_image()),
@@ -118,20 +118,6 @@ fn row(report: &Report, f: &FileResult) -> Result<String, Error> {
         cell(&diff, &None)?,
         name = escape(&f.name),
     ))
-}
-
-fn png_or_image(p: &Path) -> Result<Image8, Error> {
-    if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-        return png::read(p);
-    }
-    let img = image::open(p).map_err(|e| Error::asset(p, None, e.to_string()))?;
-    let rgba = img.to_rgba8();
-    Ok(Image8 {
-        width: rgba.width(),
-        height: rgba.height(),
-        channels: 4,
-        data: rgba.into_raw(),
-    })
 }
 
 /// Base64 PNG of `img`, shrunk to a thumbnail unless `full`.
