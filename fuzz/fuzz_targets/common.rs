@@ -47,6 +47,11 @@ pub fn toml_f32(v: f32) -> String {
 /// Loads and, when it loads, renders every camera's first frame of the
 /// scene text (written to `name` in the scratch dir): the whole pipeline.
 pub fn load_and_render(name: &str, text: &str, render: bool) {
+    load_and_render_frames(name, text, render, &[0]);
+}
+
+/// As `load_and_render`, for the given frames.
+pub fn load_and_render_frames(name: &str, text: &str, render: bool, frames: &[u32]) {
     use softraster::render::{Frame, Renderer};
     use softraster::scene::{LoadOptions, Scene};
     let path = dir().join(name);
@@ -59,7 +64,9 @@ pub fn load_and_render(name: &str, text: &str, render: bool) {
     let renderer = Renderer::new(&scene);
     let mut frame = Frame::new(0, 0);
     for cam in 0..scene.cameras.len().min(2) {
-        renderer.render(&scene, cam, 0, &mut frame);
-        let _ = softraster::output::resolve(&frame, &scene.settings);
+        for &f in frames {
+            renderer.render(&scene, cam, f, &mut frame);
+            let _ = softraster::output::resolve(&frame, &scene.settings);
+        }
     }
 }

@@ -1,6 +1,7 @@
 //! glTF and GLB: the input as a model file (`.glb` when it starts with the
 //! binary magic, `.gltf` otherwise), loaded with its lights and cameras and
-//! rendered at 16x16.
+//! rendered at 16x16; a file that mentions animations plays its first clip
+//! (frames 0 and 1 at 3 fps), and then its second.
 
 #![no_main]
 #[path = "common.rs"]
@@ -23,4 +24,12 @@ fuzz_target!(|data: &[u8]| {
          [[light]]\nkind = \"point\"\nposition = [2.0, 3.0, 4.0]\n"
     );
     common::load_and_render("gltf.toml", &scene, true);
+    if data.windows(10).any(|w| w == b"animations") {
+        for clip in ["0", "1"] {
+            let animated = format!(
+                "{scene}[animation]\nfps = 3.0\nframes = 2\n[[model]]\npath = \"{name}\"\nanimation = {clip}\nlights = true\n"
+            );
+            common::load_and_render_frames("gltf_anim.toml", &animated, true, &[0, 1]);
+        }
+    }
 });

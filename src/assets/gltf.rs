@@ -22,6 +22,7 @@ use gltf::mesh::Mode;
 
 use super::accessor::{Attributes, read_floats};
 use super::mesh::{Group, Mesh, Primitive};
+use super::rig::{Rig, RigNode, RigSkin, Segment, SegmentNormals};
 use super::texture::Wrap;
 use super::texture::{AddressMode, TextureFilter};
 use crate::error::Error;
@@ -226,6 +227,24 @@ pub struct GltfModel {
     /// Things ignored on the way (optional extensions, point and line
     /// primitives), for the user to see.
     pub warnings: Vec<String>,
+    /// Files with animations: what posing the mesh at other times takes,
+    /// or why it cannot be done.
+    pub rig: Option<Result<Arc<Rig>, String>>,
+}
+
+impl GltfLight {
+    /// The light at a node whose world transform is `world`: at its
+    /// origin, shining down its -Z.
+    pub fn placed(&self, world: Mat4) -> GltfLight {
+        GltfLight {
+            position: world.transform_point3(Vec3::ZERO),
+            direction: world
+                .transform_vector3(Vec3::NEG_Z)
+                .try_normalize()
+                .unwrap_or(Vec3::NEG_Z),
+            ..self.clone()
+        }
+    }
 }
 
 /// The version of a glTF 1.x file (`asset.version` "1.0", or a binary
@@ -301,17 +320,94 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
             .views()
             .map(|v| (v.buffer().index(), v.offset(), v.length()))
             .collect(),
+        // Only files with animations keep their source vertices.
+        segments: doc.animations().next().is_some().then(Vec::new),
+        rig_error: None,
     };
     let mut placed = Placed::default();
     walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
+    let segments = b.segments.take();
+    let rig_error = b.rig_error.take();
     let mut mesh = b.finish();
     mesh.groups.retain(|g| !g.triangles.is_empty());
+    let rig = segments.map(|segments| match rig_error {
+        Some(e) => Err(e),
+        None => rig(doc, &buffers, segments, placed.light_nodes.clone()).map(Arc::new),
+    });
     Ok(GltfModel {
         mesh,
         materials,
         lights: placed.lights,
         cameras: placed.cameras,
         warnings,
+        rig,
+    })
+}
+
+/// The rig of a file with animations: its nodes (parents first), skins,
+/// the segments the loader recorded and its clips.
+fn rig(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    segments: Vec<Segment>,
+    light_nodes: Vec<usize>,
+) -> Result<Rig, String> {
+    let n = doc.nodes().count();
+    let mut parent = vec![None; n];
+    for node in doc.nodes() {
+        for c in node.children() {
+            parent[c.index()] = Some(node.index());
+        }
+    }
+    // Parents before children: roots, then each level's children.
+    let mut order: Vec<usize> = (0..n).filter(|&i| parent[i].is_none()).collect();
+    let mut k = 0;
+    while k < order.len() {
+        let i = order[k];
+        if let Some(node) = doc.nodes().nth(i) {
+            order.extend(node.children().map(|c| c.index()));
+        }
+        k += 1;
+        if order.len() > n {
+            return Err("the node hierarchy has a cycle or a node with two parents".into());
+        }
+    }
+    if order.len() != n {
+        return Err("the node hierarchy has a cycle".into());
+    }
+    let nodes = doc
+        .nodes()
+        .map(|node| {
+            let (t, r, s) = node.transform().decomposed();
+            RigNode {
+                parent: parent[node.index()],
+                matrix: Mat4::from_cols_array_2d(&node.transform().matrix()),
+                trs: (Vec3::from(t), glam::Quat::from_array(r), Vec3::from(s)),
+                weights: node
+                    .weights()
+                    .or(node.mesh().and_then(|m| m.weights()))
+                    .unwrap_or(&[])
+                    .to_vec(),
+            }
+        })
+        .collect();
+    let skins = doc
+        .skins()
+        .map(|s| {
+            let (joints, inverse_bind) = super::gltf_pose::read_skin(&s, buffers)?;
+            Ok(RigSkin {
+                joints,
+                inverse_bind,
+            })
+        })
+        .collect::<Result<_, String>>()?;
+    Ok(Rig {
+        nodes,
+        order,
+        skins,
+        segments,
+        light_nodes,
+        clips: super::gltf_pose::read_clips(doc, buffers),
     })
 }
 
@@ -343,6 +439,7 @@ fn extensions(doc: &gltf::Document, path: &Path) -> Result<Vec<String>, String> 
 /// Where a mesh's primitives go: the node's world transform, its morph
 /// weights, and its skin with every node's world transform (for joints).
 struct Pose<'a> {
+    node: usize,
     world: Mat4,
     weights: &'a [f32],
     skin: Option<(&'a gltf::Skin<'a>, &'a [Mat4])>,
@@ -352,6 +449,8 @@ struct Pose<'a> {
 #[derive(Default)]
 struct Placed {
     lights: Vec<GltfLight>,
+    /// Per light: its node.
+    light_nodes: Vec<usize>,
     cameras: Vec<GltfCamera>,
 }
 
@@ -417,6 +516,7 @@ fn walk_nodes(
                     }),
                 };
                 let pose = Pose {
+                    node: node.index(),
                     world,
                     weights,
                     skin: skin.as_ref().map(|s| (s, worlds.as_slice())),
@@ -428,6 +528,7 @@ fn walk_nodes(
         }
         if let Some(l) = node.light() {
             lights.push(light(&l, &node, world));
+            placed.light_nodes.push(node.index());
         }
         if let Some(c) = node.camera() {
             cameras.push(camera(&c, &node, world, cameras.len()));
@@ -1046,12 +1147,10 @@ fn light(l: &gltf::khr_lights_punctual::Light, node: &gltf::Node, world: Mat4) -
         color: Vec3::from(l.color()),
         intensity: l.intensity(),
         range: l.range(),
-        position: world.transform_point3(Vec3::ZERO),
-        direction: world
-            .transform_vector3(Vec3::NEG_Z)
-            .try_normalize()
-            .unwrap_or(Vec3::NEG_Z),
+        position: Vec3::ZERO,
+        direction: Vec3::NEG_Z,
     }
+    .placed(world)
 }
 
 fn camera(c: &gltf::Camera, node: &gltf::Node, world: Mat4, n: usize) -> GltfCamera {
@@ -1127,6 +1226,12 @@ struct Builder {
     default_material: Option<usize>,
     /// Every buffer view: (buffer, offset, length), for Draco streams.
     views: Vec<(usize, usize, usize)>,
+    /// Files with animations: each primitive instance's source vertices,
+    /// for posing at other times.
+    segments: Option<Vec<Segment>>,
+    /// Why the segments cannot pose the mesh (then the file still loads
+    /// in its default pose).
+    rig_error: Option<String>,
 }
 
 /// Vertex `s`'s texture coordinates (both sets) and colour, defaults where
@@ -1154,12 +1259,25 @@ impl Builder {
         &mut self,
         prim: &gltf::Primitive,
         buffers: &[Vec<u8>],
-        world: Mat4,
+        pose: &Pose,
         material: usize,
     ) -> Result<(), String> {
+        let world = pose.world;
         let a = read_attributes(prim, buffers, &self.views)?;
         self.note_sets(&a.uv, &a.colors);
         let base = self.mesh.positions.len() as u32;
+        if let Some(segments) = &mut self.segments {
+            segments.push(Segment {
+                first: base,
+                order: None,
+                node: pose.node,
+                skin: None,
+                positions: a.positions.clone(),
+                normals: SegmentNormals::Fixed,
+                targets: Vec::new(),
+                influences: Vec::new(),
+            });
+        }
         let m = &mut self.mesh;
         for (s, p) in a.positions.iter().enumerate() {
             m.positions.push(world.transform_point3(*p));
@@ -1204,9 +1322,14 @@ impl Builder {
             mode,
             Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
         ) {
-            return self.add_points_or_lines(prim, buffers, world, material);
+            return self.add_points_or_lines(prim, buffers, pose, material);
         }
         let mut attributes = read_attributes(prim, buffers, &self.views)?;
+        // Animated files: the source vertices, before morphing.
+        let source = self
+            .segments
+            .is_some()
+            .then(|| (attributes.positions.clone(), attributes.normals.clone()));
         super::gltf_pose::apply_morph(prim, pose.weights, buffers, &mut attributes)?;
         let Attributes {
             positions,
@@ -1253,6 +1376,16 @@ impl Builder {
         };
         self.note_sets(&uv, &colors);
         let base = self.mesh.positions.len() as u32;
+        if let Some((positions, normals)) = source {
+            let segment = self.segment(prim, buffers, pose, base, positions, normals, &order);
+            match (segment, &mut self.segments) {
+                (Ok(seg), Some(list)) => list.push(seg),
+                (Err(e), _) => {
+                    self.rig_error.get_or_insert(e);
+                }
+                _ => {}
+            }
+        }
         let m = &mut self.mesh;
         for (k, &src) in order.iter().enumerate() {
             let s = src as usize;
@@ -1310,6 +1443,55 @@ impl Builder {
             material,
         });
         Ok(())
+    }
+
+    /// The segment of a triangle primitive placed at `base` in the mesh,
+    /// its vertices taken from the source in `order`.
+    #[allow(clippy::too_many_arguments)]
+    fn segment(
+        &self,
+        prim: &gltf::Primitive,
+        buffers: &[Vec<u8>],
+        pose: &Pose,
+        base: u32,
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        order: &[u32],
+    ) -> Result<Segment, String> {
+        let n = positions.len();
+        let context = |e: String| {
+            format!(
+                "animating primitive {} of node {}: {e}",
+                prim.index(),
+                pose.node
+            )
+        };
+        let targets = super::gltf_pose::read_targets(prim, buffers, n).map_err(context)?;
+        let (skin, influences) = match pose.skin {
+            Some((skin, _)) => {
+                let count = skin.joints().count();
+                let inf =
+                    super::gltf_pose::read_influences(prim, buffers, n, count).map_err(context)?;
+                (Some(skin.index()), inf)
+            }
+            None => (None, Vec::new()),
+        };
+        let flat = normals.is_none();
+        Ok(Segment {
+            first: base,
+            order: flat.then(|| order.to_vec()),
+            node: pose.node,
+            skin,
+            positions,
+            normals: match normals {
+                Some(v) => SegmentNormals::Vertex(v),
+                None => SegmentNormals::Faces {
+                    first_triangle: self.mesh.triangles.len() as u32,
+                },
+            },
+            targets,
+            influences,
+        })
     }
 
     fn finish(self) -> Mesh {

@@ -2,6 +2,7 @@
 //! textures from images.
 
 pub mod accessor;
+pub mod clip;
 pub mod draco;
 pub mod environment;
 pub mod gltf;
@@ -11,6 +12,7 @@ pub mod meshopt;
 pub mod mip;
 pub mod obj;
 pub mod ply;
+pub mod rig;
 pub mod stl;
 pub mod text;
 pub mod texture;

@@ -117,6 +117,59 @@ impl Bvh {
         self.nodes.is_empty()
     }
 
+    /// The same tree over the same triangles with their vertices moved to
+    /// `positions` (a posed mesh of unchanged topology): triangles
+    /// re-read, every node's box recomputed from its children. Linear in
+    /// the triangles, against a full build's n log n sorting; the tree
+    /// keeps the split of the pose it was built for, so rays visit more
+    /// nodes the further the pose has moved, but every answer is exact.
+    /// Triangles left out of the build (degenerate there) stay out.
+    pub fn refit(&self, positions: &[Vec3], triangles: &[[u32; 3]]) -> Bvh {
+        let vertex = |k: u32| Vec3A::from(positions.get(k as usize).copied().unwrap_or(Vec3::ZERO));
+        let tris: Vec<Triangle> = self
+            .prim
+            .iter()
+            .map(|&i| {
+                let p = triangles
+                    .get(i as usize)
+                    .map_or([Vec3A::ZERO; 3], |t| t.map(vertex));
+                Triangle {
+                    v0: p[0],
+                    e1: p[1] - p[0],
+                    e2: p[2] - p[0],
+                }
+            })
+            .collect();
+        let mut nodes = self.nodes.clone();
+        // Depth-first order: children follow their parent, so a reverse
+        // pass sees both children before the parent.
+        for i in (0..nodes.len()).rev() {
+            let n = nodes[i];
+            let mut b = Aabb::EMPTY;
+            if n.count > 0 {
+                for t in &tris[n.index as usize..(n.index + n.count) as usize] {
+                    b.grow_point(t.v0);
+                    b.grow_point(t.v0 + t.e1);
+                    b.grow_point(t.v0 + t.e2);
+                }
+            } else {
+                for c in [i + 1, n.index as usize] {
+                    b.grow(&Aabb {
+                        lo: nodes[c].lo,
+                        hi: nodes[c].hi,
+                    });
+                }
+            }
+            nodes[i].lo = b.lo;
+            nodes[i].hi = b.hi;
+        }
+        Bvh {
+            nodes,
+            tris,
+            prim: self.prim.clone(),
+        }
+    }
+
     /// Appends the node for `refs` (and its subtree); returns its index.
     fn build_node(&mut self, refs: &mut [(u32, Aabb, Vec3A)], depth: u32) -> usize {
         let mut bounds = Aabb::EMPTY;

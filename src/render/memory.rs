@@ -88,6 +88,21 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
             + mesh.triangles.len() as u64 * 12;
     }
     parts.push(("meshes", mesh_bytes * 2));
+    // Models playing glTF clips: the rig's source vertices, and per frame
+    // in flight the posed vertices (position, normal, placement matrix
+    // while posing) and tangents, and a BVH of the pose.
+    let posed: u64 = scene
+        .models
+        .iter()
+        .filter(|m| m.playback.is_some())
+        .map(|m| {
+            let (v, t) = (m.mesh.positions.len() as u64, m.mesh.triangles.len() as u64);
+            v * (24 + 72) + 3 * t * 16 + t * BVH_PER_TRIANGLE + v * 64
+        })
+        .sum();
+    if posed > 0 {
+        parts.push(("posed models", posed * FRAMES_IN_FLIGHT.min(2)));
+    }
 
     // Textures (4 bytes a texel), their mip chains when filtered with
     // them, and the decoding of the largest ones at once while loading.

@@ -206,24 +206,57 @@ impl Renderer {
         Some((sampler, samples))
     }
 
-    /// The frame's meshes as placed, for rays.
-    fn tracer(&self, fs: &FrameSetup) -> Tracer<'_> {
-        let placed =
-            self.model_mesh
-                .iter()
-                .zip(&fs.world_from_object)
-                .map(|(&k, &world_from_object)| {
-                    let (bvh, bounds) = self.bvhs[k].get_or_init(|| {
+    /// The frame's meshes as placed, for rays. `posed`: the BVHs of this
+    /// frame's posed models (`posed_bvhs`).
+    fn tracer<'a>(
+        &'a self,
+        fs: &FrameSetup,
+        posed: &'a [Option<(Bvh, (Vec3, Vec3))>],
+    ) -> Tracer<'a> {
+        let placed = self
+            .model_mesh
+            .iter()
+            .zip(&fs.world_from_object)
+            .zip(posed)
+            .map(|((&k, &world_from_object), posed)| {
+                let (bvh, bounds) = match posed {
+                    Some(b) => b,
+                    None => self.bvhs[k].get_or_init(|| {
                         let m = &self.meshes[k];
                         (Bvh::build(&m.positions, &m.triangles), m.bounds())
-                    });
-                    Placed {
-                        bvh,
-                        bounds: *bounds,
-                        world_from_object,
-                    }
-                });
+                    }),
+                };
+                Placed {
+                    bvh,
+                    bounds: *bounds,
+                    world_from_object,
+                }
+            });
         Tracer::new(placed, fs.scene.bounds_radius)
+    }
+
+    /// Per model: the BVH of its vertices as this frame poses them, the
+    /// kept BVH of its rest pose refitted (None for models at rest, whose
+    /// BVH the renderer keeps).
+    fn posed_bvhs(&self, fs: &FrameSetup) -> Vec<Option<(Bvh, (Vec3, Vec3))>> {
+        fs.scene
+            .models
+            .par_iter()
+            .zip(&self.model_mesh)
+            .zip(&fs.posed)
+            .map(|((m, &k), p)| {
+                let (p, _) = p.as_ref()?;
+                let bounds = p.positions.iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), q| (lo.min(*q), hi.max(*q)),
+                );
+                let (rest, _) = self.bvhs[k].get_or_init(|| {
+                    let m = &self.meshes[k];
+                    (Bvh::build(&m.positions, &m.triangles), m.bounds())
+                });
+                Some((rest.refit(&p.positions, &m.mesh.triangles), bounds))
+            })
+            .collect()
     }
 
     /// Renders the frame at `width` x `height` pixels: the passes in order.
@@ -239,11 +272,16 @@ impl Renderer {
         let shadow_rays =
             s.shadows == ShadowMethod::Raytraced && fs.lights.iter().any(|l| l.shadows);
         let sampled = self.env_sampler(fs.scene);
-        let tracer = (shadow_rays
+        let traced = shadow_rays
             || s.ao.method == AoMethod::Raytraced
             || sampled.is_some()
-            || fs.scene.ground.is_some())
-        .then(|| self.tracer(fs));
+            || fs.scene.ground.is_some();
+        let posed_bvhs = if traced {
+            self.posed_bvhs(fs)
+        } else {
+            Vec::new()
+        };
+        let tracer = traced.then(|| self.tracer(fs, &posed_bvhs));
 
         let mut verts = vertex::transform_all(fs);
         let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref(), &self.shadow_maps);

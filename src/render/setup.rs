@@ -1,9 +1,13 @@
 //! The draw list of one frame: the camera and the models where the
-//! animation puts them at this frame, the lights in world space (a
-//! headlight when the scene has none), and clip-from-world.
+//! animation puts them at this frame (turned, and posed by their glTF
+//! clips), the lights in world space (a headlight when the scene has none;
+//! lights of animated glTF nodes where their node is), and
+//! clip-from-world.
 
 use glam::{Mat4, Vec3};
+use rayon::prelude::*;
 
+use crate::assets::rig::{Parts, Posed};
 use crate::scene::Scene;
 use crate::scene::camera::Camera;
 use crate::scene::light::{Light, LightKind};
@@ -14,6 +18,9 @@ pub struct FrameSetup<'a> {
     pub camera: Camera,
     /// Per model, this frame's placement.
     pub world_from_object: Vec<Mat4>,
+    /// Per model that plays a clip: its vertices posed for this frame, and
+    /// the clip time they are posed at.
+    pub posed: Vec<Option<(Posed, f32)>>,
     pub lights: Vec<Light>,
     pub clip_from_world: Mat4,
 }
@@ -38,6 +45,23 @@ impl<'a> FrameSetup<'a> {
                 }
             })
             .collect();
+        let time = scene.animation.time(frame);
+        let nodes: Vec<_> = scene
+            .models
+            .par_iter()
+            .map(|m| m.playback.as_ref().map(|p| p.nodes_at(time)))
+            .collect();
+        let posed = scene
+            .models
+            .iter()
+            .zip(&nodes)
+            .map(|(m, n)| {
+                let (p, n) = (m.playback.as_ref()?, n.as_ref()?);
+                let mut posed = p.rig.place(n, &m.mesh, &p.tangents, Parts::All);
+                keep_in_range(&mut posed, &m.mesh.positions, &m.mesh.normals);
+                Some((posed, p.clip.local_time(time)))
+            })
+            .collect();
         let lights = if scene.lights.is_empty() && scene.environment.is_none() {
             // Headlight: a directional light travelling along the view.
             vec![Light {
@@ -50,7 +74,19 @@ impl<'a> FrameSetup<'a> {
                 range: None,
             }]
         } else {
-            scene.lights.clone()
+            let mut lights = scene.lights.clone();
+            for nl in &scene.node_lights {
+                if let (Some(Some(n)), Some(l)) = (nodes.get(nl.model), lights.get_mut(nl.light)) {
+                    let node = n.worlds.get(nl.node).copied().unwrap_or(Mat4::IDENTITY);
+                    let placed = nl
+                        .local
+                        .transformed(scene.models[nl.model].world_from_object * node);
+                    if placed_ok(&placed) {
+                        *l = placed;
+                    }
+                }
+            }
+            lights
         };
         let s = &scene.settings;
         let aspect = s.width as f32 / s.height as f32;
@@ -59,8 +95,38 @@ impl<'a> FrameSetup<'a> {
             scene,
             camera: cam,
             world_from_object,
+            posed,
             lights,
             clip_from_world,
         }
+    }
+}
+
+/// Largest coordinate a pose may give (as the loader's bound).
+const MAX_COORDINATE: f32 = 1e18;
+
+/// Vertices a pose throws out of range (non-finite, or beyond the
+/// loader's bound) stay where the mesh has them at rest.
+fn keep_in_range(posed: &mut Posed, rest: &[Vec3], rest_normals: &[Vec3]) {
+    for (i, p) in posed.positions.iter_mut().enumerate() {
+        if !(p.is_finite() && p.abs().max_element() <= MAX_COORDINATE) {
+            *p = rest[i];
+            if let (Some(n), Some(r)) = (posed.normals.get_mut(i), rest_normals.get(i)) {
+                *n = *r;
+            }
+        }
+    }
+}
+
+/// Whether a light a node places is usable (finite position and direction).
+fn placed_ok(l: &Light) -> bool {
+    match l.kind {
+        LightKind::Point { position, .. } => position.is_finite(),
+        LightKind::Directional { direction, .. } => direction.is_finite(),
+        LightKind::Spot {
+            position,
+            direction,
+            ..
+        } => position.is_finite() && direction.is_finite(),
     }
 }

@@ -47,6 +47,8 @@ pub(super) struct MapCache {
 struct MapKey {
     lights: Vec<Light>,
     world_from_object: Vec<Mat4>,
+    /// The clip time of each posed model.
+    poses: Vec<Option<f32>>,
     method: ShadowMethod,
     size: u32,
 }
@@ -83,6 +85,7 @@ pub(super) fn shadows<'a>(
     let key = MapKey {
         lights: fs.lights.clone(),
         world_from_object: fs.world_from_object.clone(),
+        poses: fs.posed.iter().map(|p| p.as_ref().map(|p| p.1)).collect(),
         method: s.shadows,
         size: s.shadow_map_size,
     };

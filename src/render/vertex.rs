@@ -6,7 +6,6 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::setup::FrameSetup;
-use crate::scene::Model;
 
 /// Vertices of one model after the vertex pass.
 pub(super) struct ModelVertices {
@@ -27,14 +26,27 @@ pub(super) fn transform_all(fs: &FrameSetup) -> Vec<ModelVertices> {
         .models
         .iter()
         .zip(&fs.world_from_object)
-        .map(|(m, world)| transform(fs.clip_from_world, m, *world))
+        .zip(&fs.posed)
+        .map(|((m, world), posed)| {
+            let (positions, normals, tangents) = match posed {
+                Some((p, _)) => (&p.positions, &p.normals, &p.tangents),
+                None => (&m.mesh.positions, &m.mesh.normals, &m.mesh.tangents),
+            };
+            transform(fs.clip_from_world, positions, normals, tangents, *world)
+        })
         .collect()
 }
 
-fn transform(clip_from_world: Mat4, m: &Model, world_from_object: Mat4) -> ModelVertices {
-    let mesh = &m.mesh;
+/// A model's vertices (at rest or posed) placed by `world_from_object`.
+fn transform(
+    clip_from_world: Mat4,
+    positions: &[Vec3],
+    normals: &[Vec3],
+    tangents: &[Vec4],
+    world_from_object: Mat4,
+) -> ModelVertices {
     let normal_from_object = Mat3::from_mat4(world_from_object).inverse().transpose();
-    let n = mesh.positions.len();
+    let n = positions.len();
     let mut world = vec![Vec3::ZERO; n];
     let mut normal = vec![Vec3::ZERO; n];
     let mut clip = vec![Vec4::ZERO; n];
@@ -47,9 +59,9 @@ fn transform(clip_from_world: Mat4, m: &Model, world_from_object: Mat4) -> Model
         .for_each(|(c, ((w, nn), cl))| {
             let base = c * V_CHUNK;
             for i in 0..w.len() {
-                let p = world_from_object.transform_point3(mesh.positions[base + i]);
+                let p = world_from_object.transform_point3(positions[base + i]);
                 w[i] = p;
-                nn[i] = (normal_from_object * mesh.normals[base + i]).normalize_or(Vec3::Y);
+                nn[i] = (normal_from_object * normals[base + i]).normalize_or(Vec3::Y);
                 cl[i] = clip_from_world * p.extend(1.0);
             }
         });
@@ -57,8 +69,7 @@ fn transform(clip_from_world: Mat4, m: &Model, world_from_object: Mat4) -> Model
     // transform flips the bitangent.
     let m3 = Mat3::from_mat4(world_from_object);
     let flip = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let tangent = mesh
-        .tangents
+    let tangent = tangents
         .par_iter()
         .map(|t| (m3 * t.truncate()).normalize_or(Vec3::X).extend(t.w * flip))
         .collect();

@@ -1,8 +1,53 @@
 //! The turntable: frame i turns by i * degrees / frames about an axis through
 //! the models' bounding-box center, so the last frame is one step short of the
-//! first and the loop is seamless.
+//! first and the loop is seamless. And glTF clips played on a model
+//! (`Playback`): frame i poses it at time i / fps of the clip, which loops.
 
-use glam::{Mat4, Quat, Vec3};
+use std::sync::Arc;
+
+use glam::{Mat4, Quat, Vec3, Vec4};
+
+use crate::assets::clip::Clip;
+use crate::assets::mesh::Mesh;
+use crate::assets::rig::{NodePose, Parts, Posed, Rig};
+use crate::scene::light::Light;
+
+/// A glTF clip played on one model.
+#[derive(Debug)]
+pub struct Playback {
+    pub rig: Arc<Rig>,
+    pub clip: Clip,
+    /// The clip's index in the file.
+    pub index: usize,
+    /// The model's per-corner tangents in source space (`Rig::source_tangents`).
+    pub tangents: Vec<Vec4>,
+}
+
+impl Playback {
+    /// The file's nodes at animation time `t` seconds.
+    pub fn nodes_at(&self, t: f64) -> NodePose {
+        self.rig
+            .node_pose(Some((&self.clip, self.clip.local_time(t))))
+    }
+
+    /// The model's mesh as the clip poses it at animation time `t`.
+    pub fn pose(&self, mesh: &Mesh, t: f64, parts: Parts) -> Posed {
+        self.rig
+            .place(&self.nodes_at(t), mesh, &self.tangents, parts)
+    }
+}
+
+/// A light of a glTF file (`model.lights = true`) whose model plays a
+/// clip: it follows its node.
+#[derive(Debug, Clone)]
+pub struct NodeLight {
+    /// Index in `Scene::lights`.
+    pub light: usize,
+    pub model: usize,
+    pub node: usize,
+    /// The light in its node's space (at the origin, shining down -Z).
+    pub local: Light,
+}
 
 /// What a turntable turns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -62,6 +107,11 @@ impl Animation {
         };
         let e = degrees.to_radians();
         self.pivot + (out * e.cos() + t.axis * e.sin()) * d.length()
+    }
+
+    /// Frame `frame`'s time in seconds.
+    pub fn time(&self, frame: u32) -> f64 {
+        frame as f64 / self.fps as f64
     }
 
     pub fn rotates_models(&self) -> bool {

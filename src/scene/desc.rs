@@ -220,10 +220,43 @@ pub struct ModelDesc {
     pub material: Option<S<MaterialOverride>>,
     #[serde(default)]
     pub materials: std::collections::BTreeMap<String, S<MaterialOverride>>,
+    /// Version 2: a glTF animation to play, by name or index.
+    pub animation: Option<S<ClipRef>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scale(pub [f32; 3]);
+
+/// `model.animation`: a clip's name, or its index in the file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ClipRef {
+    Name(String),
+    Index(u64),
+}
+
+impl<'de> Deserialize<'de> for ClipRef {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = ClipRef;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an animation's name (a string) or index (an integer from 0)")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<ClipRef, E> {
+                Ok(ClipRef::Name(s.to_string()))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<ClipRef, E> {
+                u64::try_from(v)
+                    .map(ClipRef::Index)
+                    .map_err(|_| E::invalid_value(de::Unexpected::Signed(v), &self))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<ClipRef, E> {
+                Ok(ClipRef::Index(v))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
 
 /// A memory size in bytes, written `"512M"`, `"1.5G"` or as a number of
 /// bytes.

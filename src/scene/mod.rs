@@ -39,6 +39,20 @@ pub struct Model {
     /// Every edge shared by exactly two faces in opposite directions
     /// (`Mesh::is_closed`): `render.cull = "auto"` culls its back faces.
     pub closed: bool,
+    /// `model.animation`: the glTF clip it plays.
+    pub playback: Option<Arc<animation::Playback>>,
+    /// With a clip: a sample of the (object-space) points its vertices
+    /// reach over the frames, the extremes along each axis included, for
+    /// bounds and framing.
+    pub motion_points: Vec<Vec3>,
+}
+
+impl Model {
+    /// Every point the model's vertices take (object space): at rest, and
+    /// over its clip.
+    pub fn reach(&self) -> impl Iterator<Item = &Vec3> {
+        self.mesh.positions.iter().chain(&self.motion_points)
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -53,6 +67,8 @@ pub struct Scene {
     /// for): every camera gets a headlight (a directional light along its
     /// view). A scene that names no light gets the studio environment.
     pub lights: Vec<Light>,
+    /// Lights that follow the animated nodes of their glTF file.
+    pub node_lights: Vec<animation::NodeLight>,
     /// Image-based lighting (`[environment]`).
     pub environment: Option<environment::Environment>,
     /// The shadow catcher under the models (`[ground] shadow = true`).

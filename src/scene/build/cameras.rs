@@ -45,14 +45,12 @@ impl Subject {
     /// frame of the turntable places them relative to the camera (at most
     /// `FIT_ANGLES` frames, evenly spread).
     pub(super) fn new(models: &[Model], animation: &Animation, aspect: f32) -> Subject {
-        let total: usize = models.iter().map(|m| m.mesh.positions.len()).sum();
+        let total: usize = models.iter().map(|m| m.reach().count()).sum();
         let stride = total.div_ceil(FIT_POINTS).max(1);
         let rest: Vec<Vec3> = models
             .iter()
             .flat_map(|m| {
-                m.mesh
-                    .positions
-                    .iter()
+                m.reach()
                     .map(move |p| m.world_from_object.transform_point3(*p))
             })
             .step_by(stride)

@@ -130,7 +130,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         opts.out_dir.as_deref(),
     )?;
     let mut warnings = settings::no_effect_warnings(d, ctx, &settings);
-    let models = models::build(d, ctx, &settings, &scene_dir, &mut warnings)?;
+    let mut models = models::build(d, ctx, &settings, &scene_dir, &mut warnings)?;
     // Point and line sizes without points or lines to draw.
     for (key, v, has) in [
         (
@@ -158,14 +158,25 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             ));
         }
     }
+    // The clips' frames first: their motion counts in the bounds.
+    let mut animation = animation(&d.animation, Vec3::ZERO, &models.models);
+    models::sweep(&mut models.models, &animation);
     let bounds = models::bounds(&models.models);
+    animation.pivot = bounds.center;
     let mut lights: Vec<_> = d
         .lights
         .iter()
         .map(|l| lights::from_desc(l.get_ref()))
         .collect();
+    let node_lights = models
+        .node_lights
+        .iter()
+        .map(|n| super::animation::NodeLight {
+            light: n.light + lights.len(),
+            ..n.clone()
+        })
+        .collect();
     lights.extend(models.lights);
-    let animation = animation(&d.animation, bounds.center);
     let aspect = settings.width as f32 / settings.height as f32;
     let subject = cameras::Subject::new(&models.models, &animation, aspect);
     let cameras = cameras::build(d, ctx, bounds, &subject, &models.cameras, &animation)?;
@@ -200,6 +211,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         output,
         models: models.models,
         lights,
+        node_lights,
         environment,
         ground,
         cameras,
@@ -211,14 +223,13 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     })
 }
 
-/// The catcher's plane: at the models' lowest point at rest.
+/// The catcher's plane: at the models' lowest point at rest (and over
+/// their clips).
 fn ground_plane(models: &[super::Model], bounds: cameras::Bounds) -> super::GroundPlane {
     let lowest = models
         .iter()
         .flat_map(|m| {
-            m.mesh
-                .positions
-                .iter()
+            m.reach()
                 .map(|p| m.world_from_object.transform_point3(*p).y)
         })
         .fold(f32::INFINITY, f32::min);
@@ -299,8 +310,20 @@ fn environment(
 
 /// `[animation]`: one frame and no turntable by default; a turntable turns
 /// about +Y by 360 degrees over the frames, turning the models, about the
-/// models' center.
-fn animation(a: &desc::AnimationDesc, pivot: Vec3) -> Animation {
+/// models' center. Models that play clips make the default frame count the
+/// longest clip's length times fps (at least 1).
+fn animation(a: &desc::AnimationDesc, pivot: Vec3, models: &[super::Model]) -> Animation {
+    let fps = get(&a.fps, 24.0);
+    let clip_frames = models
+        .iter()
+        .filter_map(|m| m.playback.as_ref())
+        .map(|p| {
+            (p.clip.duration as f64 * fps as f64)
+                .round()
+                .clamp(1.0, 1e6) as i64
+        })
+        .max()
+        .unwrap_or(1);
     let turntable = a.turntable.as_ref().map(|t| {
         let t = t.get_ref();
         Turntable {
@@ -311,8 +334,8 @@ fn animation(a: &desc::AnimationDesc, pivot: Vec3) -> Animation {
         }
     });
     Animation {
-        frames: get(&a.frames, 1) as u32,
-        fps: get(&a.fps, 24.0),
+        frames: get(&a.frames, clip_frames) as u32,
+        fps,
         turntable,
         pivot,
     }

@@ -17,8 +17,10 @@ use super::{get, lights};
 use crate::assets::gltf::{GltfCamera, GltfModel, ImageSource};
 use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
+use crate::assets::rig::Parts;
 use crate::assets::texture::{AddressMode, Texture};
 use crate::error::Error;
+use crate::scene::animation::{NodeLight, Playback};
 use crate::scene::desc::{self, Ctx, SceneDesc};
 use crate::scene::light::Light;
 use crate::scene::material::{Material, NormalMap};
@@ -31,6 +33,9 @@ pub(super) struct Models {
     pub models: Vec<Model>,
     pub textures: Vec<Arc<Texture>>,
     pub lights: Vec<Light>,
+    /// The imported lights that follow animated nodes (`light` indexes
+    /// `lights`).
+    pub node_lights: Vec<NodeLight>,
     pub cameras: Vec<(GltfCamera, Mat4)>,
 }
 
@@ -84,6 +89,7 @@ pub(super) fn build(
         models: Vec::new(),
         textures,
         lights: Vec::new(),
+        node_lights: Vec::new(),
         cameras: Vec::new(),
     };
     for (i, (m, mats)) in d.models.iter().zip(&model_mats).enumerate() {
@@ -111,7 +117,22 @@ pub(super) fn build(
         if textured && let Some(set) = tangent_set(&materials) {
             mesh.compute_tangents(set);
         }
+        let playback = playback(md, ctx, src, &mesh)?;
+        let first_light = out.lights.len();
         import_lights_and_cameras(md, ctx, src, world, &mut out, warnings)?;
+        if let (Some(p), Some(g)) = (&playback, &src.gltf) {
+            // Imported lights follow their nodes.
+            for (k, (gl, &node)) in g.lights.iter().zip(&p.rig.light_nodes).enumerate() {
+                if first_light + k < out.lights.len() {
+                    out.node_lights.push(NodeLight {
+                        light: first_light + k,
+                        model: i,
+                        node,
+                        local: lights::from_gltf(&gl.placed(Mat4::IDENTITY), Mat4::IDENTITY),
+                    });
+                }
+            }
+        }
         out.models.push(Model {
             name: md
                 .name
@@ -123,9 +144,110 @@ pub(super) fn build(
             mesh: Arc::new(mesh),
             materials,
             world_from_object: world,
+            playback,
+            motion_points: Vec::new(),
         });
     }
     Ok(out)
+}
+
+/// `model.animation`: the clip it names in the model's glTF file, ready to
+/// play (an error lists the clips the file has).
+fn playback(
+    md: &desc::ModelDesc,
+    ctx: &Ctx,
+    src: &SourceModel,
+    mesh: &Mesh,
+) -> Result<Option<Arc<Playback>>, Error> {
+    let Some(want) = &md.animation else {
+        return Ok(None);
+    };
+    let err = |m: String| Err(ctx.err(want.span(), m));
+    let Some(g) = &src.gltf else {
+        return err(
+            "model.animation: only glTF models carry animations; this one is not glTF".into(),
+        );
+    };
+    let rig = match &g.rig {
+        None => {
+            return err(format!(
+                "model.animation: {} has no animations",
+                md.path.get_ref()
+            ));
+        }
+        Some(Err(e)) => {
+            return err(format!(
+                "model.animation: {} cannot be animated: {e}",
+                md.path.get_ref()
+            ));
+        }
+        Some(Ok(r)) => r.clone(),
+    };
+    let found = match want.get_ref() {
+        desc::ClipRef::Name(n) => rig.clips.iter().position(|(name, _)| name == n),
+        desc::ClipRef::Index(i) => usize::try_from(*i).ok().filter(|&i| i < rig.clips.len()),
+    };
+    let Some(index) = found else {
+        let what = match want.get_ref() {
+            desc::ClipRef::Name(n) => format!("no animation named \"{n}\""),
+            desc::ClipRef::Index(i) => format!("no animation {i}"),
+        };
+        return err(format!(
+            "model.animation: {} has {what}; it has: {}",
+            md.path.get_ref(),
+            rig.clip_names()
+        ));
+    };
+    let clip = match &rig.clips[index].1 {
+        Ok(c) => c.clone(),
+        Err(e) => {
+            return err(format!(
+                "model.animation: animation {index} of {} cannot be played: {e}",
+                md.path.get_ref()
+            ));
+        }
+    };
+    let tangents = rig.source_tangents(mesh);
+    Ok(Some(Arc::new(Playback {
+        rig,
+        clip,
+        index,
+        tangents,
+    })))
+}
+
+/// Frames sampled for a clip's motion points at most.
+const MOTION_FRAMES: u32 = 48;
+/// Vertices kept per sampled frame at most (besides each axis' extremes).
+const MOTION_SAMPLE: usize = 2_000;
+
+/// Fills each playing model's `motion_points`: its vertices at up to
+/// `MOTION_FRAMES` of the animation's frames (evenly spread), a sample of
+/// them and each frame's extremes along every axis.
+pub(super) fn sweep(models: &mut [Model], animation: &crate::scene::Animation) {
+    for m in models.iter_mut() {
+        let Some(p) = &m.playback else { continue };
+        let frames = animation.frames.max(1);
+        let n = frames.min(MOTION_FRAMES);
+        let stride = m.mesh.positions.len().div_ceil(MOTION_SAMPLE).max(1);
+        let points: Vec<Vec3> = (0..n)
+            .into_par_iter()
+            .flat_map_iter(|k| {
+                let frame = (k as u64 * frames as u64 / n as u64) as u32;
+                let posed = p.pose(&m.mesh, animation.time(frame), Parts::Positions);
+                let mut pts: Vec<Vec3> = posed.positions.iter().step_by(stride).copied().collect();
+                for axis in 0..3 {
+                    let key = |p: &&Vec3| p[axis];
+                    let by = |a: &&Vec3, b: &&Vec3| key(a).total_cmp(&key(b));
+                    pts.extend(posed.positions.iter().min_by(by).copied());
+                    pts.extend(posed.positions.iter().max_by(by).copied());
+                }
+                pts
+            })
+            .filter(|p| p.is_finite())
+            .collect();
+        m.motion_points = points;
+    }
 }
 
 /// Reads every model file once, in parallel; a missing file is an error
@@ -327,7 +449,7 @@ fn import_lights_and_cameras(
 pub(super) fn bounds(models: &[Model]) -> Bounds {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for m in models {
-        for p in &m.mesh.positions {
+        for p in m.reach() {
             let w = m.world_from_object.transform_point3(*p);
             lo = lo.min(w);
             hi = hi.max(w);

@@ -1,7 +1,10 @@
 //! Procedural meshes and textures: the showcase scene's assets, made by code
-//! so the repository holds no third-party model. `softraster generate-assets
+//! so the repository holds no third-party model, and a walking figure
+//! (`walker`, a skinned and animated glTF). `softraster generate-assets
 //! assets/showcase` writes them; a test checks the committed files are what
 //! this code produces.
+
+pub mod walker;
 
 use std::f32::consts::{PI, TAU};
 use std::fmt::Write as _;
@@ -278,6 +281,12 @@ pub fn write_showcase_assets(dir: &Path) -> Result<(), Error> {
             w.write_all(text.as_bytes()).map_err(|e| Error::io(&p, e))
         })?;
     }
+    let glb = dir.join("walker.glb");
+    crate::output::write_atomic(&glb, |w| {
+        use std::io::Write;
+        w.write_all(&walker::walker_glb())
+            .map_err(|e| Error::io(&glb, e))
+    })?;
     png::write(
         &dir.join("checker.png"),
         &checker(256, 8, [230, 226, 214], [62, 66, 78]),
