@@ -78,7 +78,8 @@ pub struct Renderer {
     /// on the first frame).
     env_image: Option<Arc<EnvImage>>,
     /// The environment's intensity and rotation its lighting is built with.
-    env_params: Option<(f32, f32)>,
+    /// The environment's intensity, rotation and prefilter size.
+    env_params: Option<(f32, f32, u32)>,
     env: OnceLock<Option<EnvLight>>,
     /// `method = "sampled"`: the environment's sampling tables.
     env_sampler: OnceLock<Option<EnvSampler>>,
@@ -113,7 +114,7 @@ impl Renderer {
             env_params: scene
                 .environment
                 .as_ref()
-                .map(|e| (e.intensity, e.rotation)),
+                .map(|e| (e.intensity, e.rotation, e.prefilter_size)),
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
@@ -158,7 +159,8 @@ impl Renderer {
     }
 
     /// Whether `scene`'s meshes, textures and environment (image,
-    /// intensity, rotation) are the ones this renderer holds state for.
+    /// intensity, rotation, prefilter size) are the ones this renderer
+    /// holds state for.
     fn serves(&self, scene: &Scene) -> bool {
         scene.models.len() == self.model_mesh.len()
             && scene
@@ -168,7 +170,8 @@ impl Renderer {
                 .all(|(m, &k)| Arc::ptr_eq(&m.mesh, &self.meshes[k]))
             && match (&scene.environment, &self.env_image) {
                 (Some(e), Some(i)) => {
-                    Arc::ptr_eq(&e.image, i) && self.env_params == Some((e.intensity, e.rotation))
+                    Arc::ptr_eq(&e.image, i)
+                        && self.env_params == Some((e.intensity, e.rotation, e.prefilter_size))
                 }
                 (None, None) => true,
                 _ => false,
@@ -187,7 +190,12 @@ impl Renderer {
         self.env
             .get_or_init(|| {
                 let e = scene.environment.as_ref()?;
-                Some(EnvLight::new(&e.image, e.intensity, e.rotation))
+                Some(EnvLight::with_size(
+                    &e.image,
+                    e.intensity,
+                    e.rotation,
+                    e.prefilter_size,
+                ))
             })
             .as_ref()
     }

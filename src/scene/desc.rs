@@ -68,6 +68,9 @@ pub struct EnvironmentDesc {
     pub method: Option<S<EnvMethodName>>,
     /// Sampled: direction pairs a point (default 64).
     pub samples: Option<S<i64>>,
+    /// Prefiltered: width in texels of the sharpest glossy level
+    /// (roughness 0.2; the rougher levels get half); default 128.
+    pub prefilter_size: Option<S<i64>>,
     /// A shadow-casting directional light from the brightest region.
     pub sun: Option<S<bool>>,
 }
@@ -809,6 +812,7 @@ fn validate_environment(c: &Ctx, e: &S<EnvironmentDesc>) -> Result<(), Error> {
     c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
     c.finite(&e.rotation, "environment.rotation")?;
     c.int_range(&e.samples, "environment.samples", 1, 65536)?;
+    c.int_range(&e.prefilter_size, "environment.prefilter_size", 8, 2048)?;
     Ok(())
 }
 

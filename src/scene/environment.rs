@@ -24,4 +24,10 @@ pub struct Environment {
     pub intensity: f32,
     /// Degrees about +Y, counter-clockwise seen from above (default 0).
     pub rotation: f32,
+    /// Prefiltered: width of the sharpest glossy level (default
+    /// `DEFAULT_PREFILTER_SIZE`).
+    pub prefilter_size: u32,
 }
+
+/// `environment.prefilter_size` when the scene does not give it.
+pub const DEFAULT_PREFILTER_SIZE: u32 = 128;

@@ -17,46 +17,63 @@
 
 use std::f32::consts::PI;
 
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Mat3, Vec2, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use crate::assets::environment::EnvImage;
 
 /// Prefiltered roughness levels: 0, 0.2, ..., 1.
 const LEVELS: usize = 6;
+/// Widest mirror level (roughness 0 and the sharp background).
+const MIRROR_MAX_WIDTH: usize = 2048;
 /// Importance samples per prefiltered texel.
 const PREFILTER_SAMPLES: u32 = 128;
 /// BRDF table resolution (n.v by roughness) and samples per entry.
 const LUT_SIZE: usize = 32;
 const LUT_SAMPLES: u32 = 256;
 
-/// An equirectangular RGB float image.
+/// An equirectangular RGB float image (16-byte texels: a bilinear lookup
+/// is four SIMD loads and three SIMD lerps).
 #[derive(Debug, Clone)]
 struct Equirect {
     width: usize,
     height: usize,
-    texels: Vec<Vec3>,
+    texels: Vec<Vec3A>,
 }
 
 impl Equirect {
     /// Bilinear lookup, wrapping in u and clamping in v.
     fn sample(&self, d: Vec3) -> Vec3 {
-        self.sample_uv(direction_to_uv(d))
+        Vec3::from(self.sample_uv(direction_to_uv(d)))
     }
 
-    /// Bilinear lookup at image coordinates `uv`.
-    fn sample_uv(&self, uv: Vec2) -> Vec3 {
+    /// Bilinear lookup at image coordinates `uv` (u in [0, 1] as
+    /// `direction_to_uv` gives it; any finite u wraps).
+    #[inline]
+    fn sample_uv(&self, uv: Vec2) -> Vec3A {
         let x = uv.x * self.width as f32 - 0.5;
         let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
+        // floor without a library call: truncate, then step down where
+        // truncation went up (negative non-integers).
+        let xt = x as i64;
+        let x0 = if (xt as f32) > x { xt - 1 } else { xt };
+        let y0 = y as usize; // y >= 0: truncation is floor
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
         let w = self.width as i64;
-        let xi = |k: i64| ((x0 as i64 + k).rem_euclid(w)) as usize;
-        let y1 = (y0 as usize + 1).min(self.height - 1);
-        let t = |x: usize, y: usize| self.texels[y * self.width + x];
-        let (y0, xa, xb) = (y0 as usize, xi(0), xi(1));
-        let top = t(xa, y0).lerp(t(xb, y0), fx);
-        let bottom = t(xa, y1).lerp(t(xb, y1), fx);
+        // x0 lies in [-1, w - 1] for u in [0, 1]: one step wraps it.
+        let wrap = |k: i64| -> usize {
+            if (0..w).contains(&k) {
+                k as usize
+            } else {
+                k.rem_euclid(w) as usize
+            }
+        };
+        let (xa, xb) = (wrap(x0), wrap(x0 + 1));
+        let y1 = (y0 + 1).min(self.height - 1);
+        let row0 = &self.texels[y0 * self.width..(y0 + 1) * self.width];
+        let row1 = &self.texels[y1 * self.width..(y1 + 1) * self.width];
+        let top = row0[xa].lerp(row0[xb], fx);
+        let bottom = row1[xa].lerp(row1[xb], fx);
         top.lerp(bottom, fy)
     }
 
@@ -65,11 +82,11 @@ impl Equirect {
     /// which cover little of the sphere, as much say as the equator's).
     fn half(&self) -> Equirect {
         let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
-        let mut texels = vec![Vec3::ZERO; w * h];
+        let mut texels = vec![Vec3A::ZERO; w * h];
         let sin = |y: usize| ((y as f32 + 0.5) / self.height as f32 * PI).sin();
         texels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
-                let (mut acc, mut weight) = (Vec3::ZERO, 0.0);
+                let (mut acc, mut weight) = (Vec3A::ZERO, 0.0);
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let sx = (2 * x + dx).min(self.width - 1);
                     let sy = (2 * y + dy).min(self.height - 1);
@@ -93,13 +110,59 @@ impl Equirect {
     }
 }
 
-/// The image coordinates of a direction (u from the left, v from the top).
+/// The image coordinates of a direction (u from the left, v from the top);
+/// `d` need not be unit length (zero or non-finite reads as +Y).
+#[inline]
 pub fn direction_to_uv(d: Vec3) -> Vec2 {
-    let d = d.normalize_or(Vec3::Y);
+    if !d.is_finite() {
+        return Vec2::new(0.5, 0.0);
+    }
+    // acos(y / |d|) = atan2(|(x, z)|, y): both angles are ratios, so no
+    // normalization is needed, and the second is exact near the poles.
+    let horizontal = (d.x * d.x + d.z * d.z).sqrt();
     Vec2::new(
-        0.5 + d.x.atan2(-d.z) / (2.0 * PI),
-        d.y.clamp(-1.0, 1.0).acos() / PI,
+        0.5 + atan2(d.x, -d.z) * (0.5 / PI),
+        atan2(horizontal, d.y) * (1.0 / PI),
     )
+}
+
+/// atan2(y, x) to within 6e-7 radians (f32 rounding included) (libm's is a call and several times
+/// slower; a thousandth of a texel of a 2048-wide image is 3e-6 rad).
+/// Odd polynomial of degree 13 for atan on [0, 1], fitted to minimize the
+/// largest error, then folded into the four quadrants.
+#[inline]
+fn atan2(y: f32, x: f32) -> f32 {
+    const C: [f32; 7] = [
+        0.999_996_1,
+        -0.333_173_7,
+        0.198_078_17,
+        -0.132_333_43,
+        0.079_623_66,
+        -0.033_604_197,
+        0.006_811_782,
+    ];
+    if x.is_nan() || y.is_nan() {
+        return f32::NAN;
+    }
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let a = lo / hi;
+    let s = a * a;
+    let mut p = C[6];
+    for &c in C[..6].iter().rev() {
+        p = p * s + c;
+    }
+    let mut r = p * a;
+    if ay > ax {
+        r = std::f32::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 { -r } else { r }
 }
 
 /// The direction at image coordinates `uv` (the inverse of
@@ -130,12 +193,19 @@ pub struct EnvLight {
 
 impl EnvLight {
     /// Prefilters `image`, seen turned by `rotation_deg` about +Y
-    /// (counter-clockwise seen from above) and scaled by `intensity`.
+    /// (counter-clockwise seen from above) and scaled by `intensity`, with
+    /// the default level sizes.
     pub fn new(image: &EnvImage, intensity: f32, rotation_deg: f32) -> EnvLight {
+        EnvLight::with_size(image, intensity, rotation_deg, 128)
+    }
+
+    /// `new` with the sharpest glossy level (roughness 0.2) `size` texels
+    /// wide and the rougher ones half that (at least 8).
+    pub fn with_size(image: &EnvImage, intensity: f32, rotation_deg: f32, size: u32) -> EnvLight {
         let base = Equirect {
             width: image.width as usize,
             height: image.height as usize,
-            texels: image.texels.clone(),
+            texels: image.texels.iter().map(|&t| Vec3A::from(t)).collect(),
         };
         let mut chain = vec![base];
         while chain.last().is_some_and(|l| l.height > 4) {
@@ -143,16 +213,21 @@ impl EnvLight {
             chain.push(next);
         }
         let sh = irradiance_sh(&chain[0]);
-        // Mirror level: the image itself, at most 512 wide.
+        // Mirror level (also the background): the image itself, at most
+        // 2048 wide (25 MB). A narrower cap blurred `background =
+        // "environment"` against the image: at 512 wide, the courtyard
+        // behind a sphere row was the largest part of the difference to
+        // Mitsuba's render (benches/mitsuba_env.py).
         let mirror = chain
             .iter()
-            .find(|l| l.width <= 512)
+            .find(|l| l.width <= MIRROR_MAX_WIDTH)
             .unwrap_or(&chain[chain.len() - 1])
             .clone();
         let mut levels = vec![mirror];
         for k in 1..LEVELS {
             let roughness = k as f32 / (LEVELS - 1) as f32;
-            let width = if k == 1 { 128 } else { 64 };
+            let size = (size as usize).max(8);
+            let width = if k == 1 { size } else { (size / 2).max(8) };
             levels.push(prefilter(&chain, roughness, width));
         }
         EnvLight {
@@ -184,21 +259,23 @@ impl EnvLight {
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
         let uv = direction_to_uv(self.env_from_world * r);
         let x = roughness.clamp(0.0, 1.0) * (LEVELS - 1) as f32;
-        let k = (x.floor() as usize).min(LEVELS - 2);
+        // x >= 0: truncation is floor.
+        let k = (x as usize).min(LEVELS - 2);
         let f = x - k as f32;
         let a = self.levels[k].sample_uv(uv);
         if f <= 0.0 {
-            return a * self.intensity;
+            return Vec3::from(a * self.intensity);
         }
         let b = self.levels[k + 1].sample_uv(uv);
-        a.lerp(b, f) * self.intensity
+        Vec3::from(a.lerp(b, f) * self.intensity)
     }
 
     /// The split sum's (scale, bias) of f0 for `n.v` and `roughness`.
     pub fn brdf(&self, ndv: f32, roughness: f32) -> Vec2 {
         let fx = ndv.clamp(0.0, 1.0) * (LUT_SIZE - 1) as f32;
         let fy = roughness.clamp(0.0, 1.0) * (LUT_SIZE - 1) as f32;
-        let (x0, y0) = (fx.floor() as usize, fy.floor() as usize);
+        // Both are >= 0: truncation is floor.
+        let (x0, y0) = (fx as usize, fy as usize);
         let (x1, y1) = ((x0 + 1).min(LUT_SIZE - 1), (y0 + 1).min(LUT_SIZE - 1));
         let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
         let at = |x: usize, y: usize| self.lut[y * LUT_SIZE + x];
@@ -248,7 +325,7 @@ fn irradiance_sh(img: &Equirect) -> [Vec3; 9] {
                     (y as f32 + 0.5) / img.height as f32,
                 );
                 let b = sh_basis(uv_to_direction(uv));
-                let l = img.texels[y * img.width + x] * dw;
+                let l = Vec3::from(img.texels[y * img.width + x]) * dw;
                 for (a, bi) in acc.iter_mut().zip(b) {
                     *a += l * bi;
                 }
@@ -324,7 +401,7 @@ fn prefilter(chain: &[Equirect], roughness: f32, width: usize) -> Equirect {
             Some((l, lod))
         })
         .collect();
-    let mut texels = vec![Vec3::ZERO; width * height];
+    let mut texels = vec![Vec3A::ZERO; width * height];
     texels
         .par_chunks_mut(width)
         .enumerate()
@@ -335,20 +412,20 @@ fn prefilter(chain: &[Equirect], roughness: f32, width: usize) -> Equirect {
                     (y as f32 + 0.5) / height as f32,
                 );
                 let m = frame(uv_to_direction(uv));
-                let (mut acc, mut weight) = (Vec3::ZERO, 0.0);
+                let (mut acc, mut weight) = (Vec3A::ZERO, 0.0);
                 for &(l, lod) in &samples {
                     let k = (lod.floor() as usize).min(chain.len() - 1);
                     let k1 = (k + 1).min(chain.len() - 1);
                     let f = (lod - k as f32).clamp(0.0, 1.0);
-                    let d = m * l;
-                    let c = chain[k].sample(d).lerp(chain[k1].sample(d), f);
+                    let uv = direction_to_uv(m * l);
+                    let c = chain[k].sample_uv(uv).lerp(chain[k1].sample_uv(uv), f);
                     acc += c * l.z;
                     weight += l.z;
                 }
                 *out = if weight > 0.0 {
                     acc / weight
                 } else {
-                    Vec3::ZERO
+                    Vec3A::ZERO
                 };
             }
         });
@@ -398,6 +475,50 @@ fn brdf_lut() -> Vec<Vec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_polynomial_atan2_is_within_0_6_microradians_of_f64() {
+        let mut worst = 0.0f64;
+        let n = 2000;
+        for i in 0..n {
+            let t = i as f32 / n as f32 * 2.0 * PI;
+            for r in [1e-3f32, 1.0, 7.5e4] {
+                let (y, x) = (r * t.sin(), r * t.cos());
+                let e = (atan2(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+                // -pi and pi are the same direction.
+                let e = e.min((e - 2.0 * std::f64::consts::PI).abs());
+                worst = worst.max(e);
+            }
+        }
+        assert!(worst < 6e-7, "worst error {worst}");
+        assert_eq!(atan2(0.0, 0.0), 0.0);
+        assert_eq!(atan2(0.0, 1.0), 0.0);
+        assert!((atan2(1.0, 0.0) - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!((atan2(0.0, -1.0) - PI).abs() < 1e-6);
+        assert!(atan2(f32::NAN, 1.0).is_nan());
+    }
+
+    #[test]
+    fn lookups_wrap_in_u_and_clamp_in_v() {
+        // Four columns 0, 1, 2, 3 on two rows; the second row adds 10.
+        let img = Equirect {
+            width: 4,
+            height: 2,
+            texels: (0..8)
+                .map(|i| Vec3A::splat((i % 4) as f32 + 10.0 * (i / 4) as f32))
+                .collect(),
+        };
+        // u = 0: halfway between the last column and the first.
+        let v = img.sample_uv(Vec2::new(0.0, 0.25));
+        assert!((v.x - 1.5).abs() < 1e-6, "{v}");
+        // u = 1 wraps to the same place.
+        assert!((img.sample_uv(Vec2::new(1.0, 0.25)).x - 1.5).abs() < 1e-6);
+        // Texel centres read their own texel; v clamps at the edges.
+        assert!((img.sample_uv(Vec2::new(0.375, 0.0)).x - 1.0).abs() < 1e-6);
+        assert!((img.sample_uv(Vec2::new(0.375, 1.0)).x - 11.0).abs() < 1e-6);
+        // Far outside [0, 1] in u still wraps.
+        assert!((img.sample_uv(Vec2::new(3.0, 0.25)).x - 1.5).abs() < 1e-5);
+    }
 
     #[test]
     fn directions_and_image_coordinates_are_inverse() {

@@ -18,7 +18,7 @@ use glam::Vec3;
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, S, SceneDesc};
-use super::environment::{EnvMethod, Environment};
+use super::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::EnvImage;
 use crate::error::Error;
@@ -201,6 +201,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             image: Arc::new(EnvImage::studio()),
             intensity: 1.0,
             rotation: 0.0,
+            prefilter_size: DEFAULT_PREFILTER_SIZE,
         }),
         None => None,
     };
@@ -303,6 +304,7 @@ fn environment(
             image: Arc::new(image),
             intensity,
             rotation,
+            prefilter_size: get(&e.prefilter_size, DEFAULT_PREFILTER_SIZE as i64) as u32,
         },
         sun,
     ))

@@ -26,9 +26,10 @@ use std::time::Instant;
 use crate::error::Error;
 use crate::output::{self, Image8};
 use crate::render::{Frame, Renderer};
-use crate::scene::environment::EnvMethod;
+use crate::scene::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod};
 use crate::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use crate::scene::{AoSettings, Scene};
+use crate::shade::env::EnvLight;
 use crate::tools::compare::{Metric, score};
 
 /// The knobs, in chart order.
@@ -386,7 +387,10 @@ fn sweep_texture(
 }
 
 /// Environment lighting, for scenes with an `[environment]`: the
-/// prefiltered split sum and sampled estimates of 4 to 64 direction pairs,
+/// prefiltered split sum at several prefilter sizes (the sharpest glossy
+/// level 32 to 256 texels wide; each with a renderer of its own, warmed
+/// first, so the time is per frame; the one-off prefiltering time goes to
+/// standard error) and sampled estimates of 4 to 64 direction pairs,
 /// against the sampled reference (256 pairs; 64 with `quick`).
 fn sweep_env(
     renderer: &Renderer,
@@ -394,44 +398,73 @@ fn sweep_env(
     opts: &ChartOptions,
     rows: &mut Vec<Row>,
 ) -> Result<(), Error> {
-    let Some(original) = scene.environment.as_ref().map(|e| e.method) else {
+    let Some(original) = scene
+        .environment
+        .as_ref()
+        .map(|e| (e.method, e.prefilter_size))
+    else {
         return Ok(());
     };
-    let set = |scene: &mut Scene, m: EnvMethod| {
+    let set = |scene: &mut Scene, m: EnvMethod, size: u32| {
         if let Some(e) = scene.environment.as_mut() {
             e.method = m;
+            e.prefilter_size = size;
         }
     };
     let reference = if opts.quick { 64 } else { 256 };
-    set(scene, EnvMethod::Sampled { samples: reference });
+    set(scene, EnvMethod::Sampled { samples: reference }, original.1);
     let (_, reference_img, t) = timed(renderer, scene, opts.frame, 1);
     let against = format!("sampled {reference}");
     let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
         flip(&reference_img, img, None)
     })?;
     rows.push(row(Knob::Env, &against, false, true, t, e, &against));
-    let counts: &[u32] = if opts.quick { &[4, 16] } else { &[4, 16, 64] };
-    let methods = std::iter::once(EnvMethod::Prefiltered)
-        .chain(counts.iter().map(|&samples| EnvMethod::Sampled { samples }));
-    for m in methods {
-        set(scene, m);
-        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+    let sizes: &[u32] = if opts.quick {
+        &[64, 128]
+    } else {
+        &[32, 64, 128, 256]
+    };
+    for &size in sizes {
+        set(scene, EnvMethod::Prefiltered, size);
+        let prefilter = scene.environment.as_ref().map_or(0.0, |e| {
+            let t = Instant::now();
+            let _ = EnvLight::with_size(&e.image, e.intensity, e.rotation, size);
+            t.elapsed().as_secs_f64() * 1e3
+        });
+        let own = Renderer::new(scene);
+        let mut warm = Frame::new(0, 0);
+        own.render(scene, 0, opts.frame, &mut warm);
+        let (_, img, t) = timed(&own, scene, opts.frame, opts.runs);
         let e = flip(&reference_img, &img, None)?;
-        let name = match m {
-            EnvMethod::Prefiltered => "prefiltered".to_string(),
-            EnvMethod::Sampled { samples } => format!("sampled {samples}"),
-        };
+        // Once per run, not per frame: printed beside the table (the
+        // setting's name stays the same from run to run).
+        eprintln!("env: prefilter_size {size}: prefiltering takes {prefilter:.0} ms once");
         rows.push(row(
             Knob::Env,
-            name,
-            m == EnvMethod::Prefiltered,
+            format!("prefiltered {size}"),
+            size == DEFAULT_PREFILTER_SIZE,
             false,
             t,
             e,
             &against,
         ));
     }
-    set(scene, original);
+    let counts: &[u32] = if opts.quick { &[4, 16] } else { &[4, 16, 64] };
+    for &samples in counts {
+        set(scene, EnvMethod::Sampled { samples }, original.1);
+        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+        let e = flip(&reference_img, &img, None)?;
+        rows.push(row(
+            Knob::Env,
+            format!("sampled {samples}"),
+            false,
+            false,
+            t,
+            e,
+            &against,
+        ));
+    }
+    set(scene, original.0, original.1);
     Ok(())
 }
 
