@@ -111,3 +111,79 @@ fn a_flat_scene_is_seen_from_above() {
         "{fwd}"
     );
 }
+
+/// The default look on one-line scenes of varied real models (a game
+/// character, a sphere, a terrain tile, a flat scene with props): the
+/// models span at least 65% of the width or height, the background is not
+/// black, and where a model stands on the catcher its ground shadow shows.
+#[test]
+fn one_line_scenes_of_varied_models_fill_the_frame_over_a_lit_background() {
+    use softraster::procedural::sphere;
+    let Some(assets) = common::shared_assets() else {
+        return;
+    };
+    let dir = scratch("framing_varied");
+    let tr = assets.join("tinyrenderer");
+    let common_dir = assets.join("common");
+    std::fs::write(dir.join("sphere.obj"), obj(sphere(1.0, 64, 32))).unwrap();
+    let model = |p: &std::path::Path, extra: &str| {
+        format!("[[model]]\npath = {:?}\n{extra}", p.display().to_string())
+    };
+    let cases = [
+        (
+            "character",
+            model(&tr.join("diablo3_pose/diablo3_pose.obj"), ""),
+            true,
+        ),
+        ("sphere", model(&dir.join("sphere.obj"), ""), true),
+        ("terrain tile", model(&tr.join("floor.obj"), ""), false),
+        (
+            "flat scene with props",
+            model(&tr.join("floor.obj"), "scale = 4.0\n")
+                // Suzanne's mesh sits off its origin: these put both
+                // props on the floor (y = -4), left and right of centre.
+                + &model(
+                    &common_dir.join("suzanne.obj"),
+                    "translate = [0.5, -4.21, -3.3]\nscale = 0.8\n",
+                )
+                + &model(
+                    &common_dir.join("teapot.obj"),
+                    "translate = [1.7, -4.0, 1.0]\nscale = 0.5\n",
+                ),
+            false,
+        ),
+    ];
+    for (name, models, shadow) in cases {
+        let text = format!("[output]\nwidth = 160\nheight = 120\n{models}");
+        let s = scene_in(&dir, &text, &[]);
+        let f = render_frame(&s, 0, 0);
+        let (x0, y0, x1, y1) = covered(&f);
+        let fill = ((x1 - x0 + 1) as f32 / 160.0).max((y1 - y0 + 1) as f32 / 120.0);
+        let corner = f.color[0].truncate();
+        let luminance = |c: glam::Vec3| c.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+        println!(
+            "{name}: fill {fill:.2}, background corner luminance {:.3}",
+            luminance(corner)
+        );
+        assert!(fill >= 0.65, "{name}: fill {fill}");
+        assert!(luminance(corner) > 0.05, "{name}: background {corner}");
+        if shadow {
+            // The same scene without the catcher's shadow: pixels the
+            // shadow darkens, below the model's middle.
+            let plain = scene_in(&dir, &format!("{text}[ground]\nshadow = false\n"), &[]);
+            let g = render_frame(&plain, 0, 0);
+            let darker = f
+                .color
+                .iter()
+                .zip(&g.color)
+                .enumerate()
+                .filter(|(i, (a, b))| {
+                    (*i as u32 / 160) > (y0 + y1) / 2
+                        && luminance(b.truncate()) - luminance(a.truncate()) > 0.02
+                })
+                .count();
+            println!("{name}: {darker} pixels darkened by the ground shadow");
+            assert!(darker > 160, "{name}: {darker} shadowed pixels");
+        }
+    }
+}
