@@ -576,31 +576,26 @@ fn prefilter_size_is_checked_and_changes_only_the_glossy_levels() {
             dir.display()
         )
     };
+    // The command line on the scene with `keys`: exit code and stderr.
+    let cli = |keys: &str| {
+        std::fs::write(dir.join("s.toml"), scene(keys)).unwrap();
+        let (code, _, err) = common::run(&[
+            "render",
+            dir.join("s.toml").to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        (code, err)
+    };
     // Out of range: exit 2 naming the key with its line.
-    std::fs::write(dir.join("s.toml"), scene("prefilter_size = 4")).unwrap();
-    let (code, _, err) = common::run(&[
-        "render",
-        dir.join("s.toml").to_str().unwrap(),
-        "--out",
-        dir.join("out").to_str().unwrap(),
-    ]);
+    let (code, err) = cli("prefilter_size = 4");
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("environment.prefilter_size") && err.contains("s.toml:"),
         "{err}"
     );
     // With the sampled method it does nothing, and says so.
-    std::fs::write(
-        dir.join("s.toml"),
-        scene("method = \"sampled\"\nsamples = 1\nprefilter_size = 64"),
-    )
-    .unwrap();
-    let (code, _, err) = common::run(&[
-        "render",
-        dir.join("s.toml").to_str().unwrap(),
-        "--out",
-        dir.join("out").to_str().unwrap(),
-    ]);
+    let (code, err) = cli("method = \"sampled\"\nsamples = 1\nprefilter_size = 64");
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("environment.prefilter_size has no effect"),
