@@ -378,20 +378,20 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
     let (text, _) = common::gltf_text(
         &tri,
         "",
-        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_clearcoat"]"#),
+        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_sheen"]"#),
         None,
     );
-    write(&dir, "clearcoat.gltf", &text);
+    write(&dir, "sheen.gltf", &text);
     let (code, err) = run(&[
         "render",
-        scene("clearcoat.gltf").to_str().unwrap(),
+        scene("sheen.gltf").to_str().unwrap(),
         "--out",
         dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("warning:")
-            && err.contains("`KHR_materials_clearcoat`")
+            && err.contains("`KHR_materials_sheen`")
             && err.contains("ignores"),
         "{err}"
     );

@@ -492,6 +492,17 @@ fn strips_fans_and_unindexed_primitives_with_flat_normals_and_vertex_colors() {
 /// neutral environment (radiance 1) and `lights` (TOML): the linear colour
 /// at the center of its front face.
 fn cube_face_color(name: &str, material: &str, used: &str, lights: &str) -> Vec3 {
+    cube_face_color_over(name, material, used, lights, "")
+}
+
+/// `cube_face_color` with more `[output]` keys (e.g. the background).
+fn cube_face_color_over(
+    name: &str,
+    material: &str,
+    used: &str,
+    lights: &str,
+    output: &str,
+) -> Vec3 {
     let dir = common::scratch(name);
     let (text, _) = gltf_text(
         &cube(),
@@ -504,7 +515,7 @@ fn cube_face_color(name: &str, material: &str, used: &str, lights: &str) -> Vec3
     );
     std::fs::write(dir.join("c.gltf"), text).unwrap();
     let scene = format!(
-        "[output]\nwidth = 32\nheight = 32\n[render]\nshading = \"pbr\"\n\
+        "[output]\nwidth = 32\nheight = 32\n{output}[render]\nshading = \"pbr\"\n\
          [environment]\npreset = \"neutral\"\n{lights}[[model]]\npath = \"c.gltf\"\n\
          [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n"
     );
@@ -801,4 +812,88 @@ fn draco_compressed_files_render_like_plain_ones() {
     let covered = a.data.chunks(3).filter(|c| c != &[0, 0, 0]).count();
     assert!(covered > 1500, "the cube covers {covered} pixels");
     assert!(differing <= 8, "{differing} pixels differ");
+}
+
+#[test]
+fn khr_materials_clearcoat_transmission_and_volume() {
+    // A matte base (specularFactor 0) shows its base colour exactly in the
+    // uniform environment; a smooth clearcoat seen head-on reflects
+    // F0 = 0.04 of the light and takes that share from the base.
+    let matte = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5}, "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}"#;
+    let used = r#""KHR_materials_specular", "KHR_materials_clearcoat""#;
+    let coated = cube_face_color(
+        "gltf_clearcoat",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.0}}}}}}"#
+        ),
+        used,
+        "",
+    );
+    let expect = Vec3::new(0.2, 0.4, 0.6) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (coated - expect).abs().max_element() < 4e-3,
+        "{coated} vs {expect}"
+    );
+    // A factor of 0 is no coat at all.
+    let uncoated = cube_face_color(
+        "gltf_clearcoat0",
+        &format!(r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 0.0}}}}}}"#),
+        used,
+        "",
+    );
+    assert!(
+        (uncoated - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 2e-3,
+        "{uncoated}"
+    );
+    // Under a light straight on, the coat adds its highlight.
+    let light =
+        "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n";
+    let lit_coat = cube_face_color(
+        "gltf_clearcoat_lit",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.3}}}}}}"#
+        ),
+        used,
+        light,
+    );
+    let lit_plain = cube_face_color("gltf_clearcoat_lit0", &format!("{matte}}}}}"), used, light);
+    assert!(lit_coat.x > lit_plain.x + 0.1, "{lit_coat} vs {lit_plain}");
+
+    // Transmission: a white, fully transmissive dielectric in a uniform
+    // environment in front of that environment is invisible (what it
+    // reflects plus what it lets through is all the light).
+    let clear = |name: &str, base: &str, volume: &str| {
+        cube_face_color_over(
+            name,
+            &format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorFactor": {base}, "metallicFactor": 0.0, "roughnessFactor": 0.3}}, "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1.0}}{volume}}}}}"#
+            ),
+            r#""KHR_materials_transmission", "KHR_materials_volume""#,
+            "",
+            "background = \"environment\"\n",
+        )
+    };
+    let glass = clear("gltf_transmission", "[1.0, 1.0, 1.0, 1.0]", "");
+    assert!(
+        (glass - Vec3::ONE).abs().max_element() < 0.01,
+        "white glass: {glass}"
+    );
+    // A tinted one lets its base colour through (and reflects ~0.04).
+    let tinted = clear("gltf_transmission_tint", "[0.2, 0.4, 0.6, 1.0]", "");
+    let expect = Vec3::new(0.2, 0.4, 0.6) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (tinted - expect).abs().max_element() < 0.01,
+        "{tinted} vs {expect}"
+    );
+    // A volume attenuates by attenuationColor^(thickness / distance).
+    let volume = clear(
+        "gltf_volume",
+        "[1.0, 1.0, 1.0, 1.0]",
+        r#", "KHR_materials_volume": {"thicknessFactor": 2.0, "attenuationColor": [0.5, 0.8, 1.0], "attenuationDistance": 1.0}"#,
+    );
+    let expect = Vec3::new(0.25, 0.64, 1.0) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (volume - expect).abs().max_element() < 0.01,
+        "{volume} vs {expect}"
+    );
 }

@@ -345,3 +345,83 @@ fn render_state_carried_across_frames_changes_no_pixel() {
     assert_eq!(foreign.color, fresh.color);
     assert_eq!(foreign.depth, fresh.depth);
 }
+
+/// The centre of a square facing +Z with MTL `mtl`, seen head-on under the
+/// neutral environment (radiance 1), shaded `shading`; `files` are written
+/// beside it (maps).
+fn mtl_square(name: &str, mtl: &str, shading: &str, files: &[(&str, Vec<u8>)]) -> glam::Vec3 {
+    let dir = common::scratch(name);
+    for (n, bytes) in files {
+        std::fs::write(dir.join(n), bytes).unwrap();
+    }
+    let obj = "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+               vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nusemtl m\n\
+               f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+    let scene = format!(
+        "[output]\nwidth = 16\nheight = 16\n[render]\nshading = \"{shading}\"\n\
+         [environment]\npreset = \"neutral\"\n[[model]]\npath = \"sq.obj\"\n\
+         [[camera]]\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         projection = \"orthographic\"\nheight = 1.0\n"
+    );
+    let s = common::scene_in(&dir, &scene, &[("sq.obj", obj), ("m.mtl", mtl)]);
+    common::render_frame(&s, 0, 0).color[8 * 16 + 8].truncate()
+}
+
+/// A 2x2 grey PNG of value `v`.
+fn grey_png(v: u8) -> Vec<u8> {
+    let img = image::GrayImage::from_pixel(2, 2, image::Luma([v]));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+#[test]
+fn mtl_pbr_extension_pr_pm_their_maps_and_clearcoat() {
+    let kd = "newmtl m\nKd 0.2 0.4 0.6\nKs 0.5 0.5 0.5\nNs 200\n";
+    // Pr/Pm make the material metallic-roughness: `auto` shades it as pbr.
+    let pbr_mtl = format!("{kd}Pr 0.8\nPm 0\n");
+    let auto = mtl_square("mtl_pbr_auto", &pbr_mtl, "auto", &[]);
+    let pbr = mtl_square("mtl_pbr_pbr", &pbr_mtl, "pbr", &[]);
+    let phong = mtl_square("mtl_pbr_phong", &pbr_mtl, "blinn-phong", &[]);
+    assert_eq!(auto, pbr);
+    assert!((auto - phong).abs().max_element() > 0.02, "{auto} {phong}");
+    // Without them it stays Blinn-Phong.
+    let plain_auto = mtl_square("mtl_plain_auto", kd, "auto", &[]);
+    let plain_phong = mtl_square("mtl_plain_phong", kd, "blinn-phong", &[]);
+    assert_eq!(plain_auto, plain_phong);
+    // A rough dielectric in a uniform environment: the base colour plus a
+    // little specular; a metal of the same colour has no diffuse part.
+    let metal = mtl_square("mtl_pbr_metal", &format!("{kd}Pr 0.8\nPm 1\n"), "auto", &[]);
+    assert!(
+        (auto - glam::Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 0.06,
+        "{auto}"
+    );
+    assert!((metal - auto).abs().max_element() > 0.05, "{metal} {auto}");
+    // map_Pm and map_Pr multiply the factors (red channel, linear): a
+    // black metallic map makes Pm 1 a dielectric, a white roughness map
+    // leaves Pr as it is.
+    let maps = [("black.png", grey_png(0)), ("white.png", grey_png(255))];
+    let mapped = mtl_square(
+        "mtl_pbr_maps",
+        &format!("{kd}Pr 0.8\nPm 1\nmap_Pm black.png\nmap_Pr white.png\n"),
+        "auto",
+        &maps,
+    );
+    assert!(
+        (mapped - auto).abs().max_element() < 1e-5,
+        "{mapped} {auto}"
+    );
+    // Pc/Pcr: a smooth clearcoat seen head-on reflects 0.04 and takes that
+    // share from the layer below.
+    let coated = mtl_square(
+        "mtl_pbr_coat",
+        &format!("{kd}Pr 0.8\nPm 0\nPc 1\nPcr 0\n"),
+        "auto",
+        &[],
+    );
+    let expect = auto * 0.96 + glam::Vec3::splat(0.04);
+    assert!(
+        (coated - expect).abs().max_element() < 4e-3,
+        "{coated} vs {expect}"
+    );
+}

@@ -33,10 +33,13 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_meshopt_compression",
     "KHR_draco_mesh_compression",
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
+    "KHR_materials_transmission",
     "KHR_materials_unlit",
+    "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
@@ -109,6 +112,40 @@ pub struct GltfMaterial {
     /// KHR_materials_specular: factor (the dielectric's F90 and weight on
     /// F0), colour factor (on F0), and their textures (alpha; sRGB RGB).
     pub specular: Option<GltfSpecular>,
+    /// KHR_materials_clearcoat (None without it, or with a factor of 0).
+    pub clearcoat: Option<GltfClearcoat>,
+    /// KHR_materials_transmission (None without it, or with a factor of 0).
+    pub transmission: Option<GltfTransmission>,
+}
+
+/// KHR_materials_clearcoat: a second, colourless GGX layer over the
+/// material (F0 0.04), with its own roughness and normal map.
+#[derive(Debug, Clone)]
+pub struct GltfClearcoat {
+    pub factor: f32,
+    /// Red channel multiplies `factor`.
+    pub texture: Option<TexInfo>,
+    pub roughness: f32,
+    /// Green channel multiplies `roughness`.
+    pub roughness_texture: Option<TexInfo>,
+    pub normal_texture: Option<TexInfo>,
+    pub normal_scale: f32,
+}
+
+/// KHR_materials_transmission, with KHR_materials_volume's thickness and
+/// attenuation when the material has that extension too.
+#[derive(Debug, Clone)]
+pub struct GltfTransmission {
+    pub factor: f32,
+    /// Red channel multiplies `factor`.
+    pub texture: Option<TexInfo>,
+    /// KHR_materials_volume thicknessFactor (0: thin-walled).
+    pub thickness: f32,
+    /// Green channel multiplies `thickness`.
+    pub thickness_texture: Option<TexInfo>,
+    pub attenuation_color: Vec3,
+    /// +inf: no attenuation.
+    pub attenuation_distance: f32,
 }
 
 #[derive(Debug, Clone)]
@@ -141,6 +178,8 @@ impl GltfMaterial {
             unlit: false,
             ior: 1.5,
             specular: None,
+            clearcoat: None,
+            transmission: None,
         }
     }
 
@@ -161,6 +200,32 @@ impl GltfMaterial {
                     .as_ref()
                     .and_then(|s| s.color_texture.as_ref()),
                 true,
+            ),
+            (
+                self.clearcoat.as_ref().and_then(|c| c.texture.as_ref()),
+                false,
+            ),
+            (
+                self.clearcoat
+                    .as_ref()
+                    .and_then(|c| c.roughness_texture.as_ref()),
+                false,
+            ),
+            (
+                self.clearcoat
+                    .as_ref()
+                    .and_then(|c| c.normal_texture.as_ref()),
+                false,
+            ),
+            (
+                self.transmission.as_ref().and_then(|t| t.texture.as_ref()),
+                false,
+            ),
+            (
+                self.transmission
+                    .as_ref()
+                    .and_then(|t| t.thickness_texture.as_ref()),
+                false,
             ),
         ]
         .into_iter()
@@ -308,7 +373,7 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
 
     let mut materials: Vec<GltfMaterial> = doc
         .materials()
-        .map(|m| material(&m, &images, &mut warnings, path))
+        .map(|m| material(&m, doc, &images, &mut warnings, path))
         .collect();
     let mut b = Builder {
         mesh: Mesh::default(),
@@ -1045,6 +1110,7 @@ fn read_attributes(
 
 fn material(
     m: &gltf::Material,
+    doc: &gltf::Document,
     images: &[ImageSource],
     warnings: &mut Vec<String>,
     path: &Path,
@@ -1122,7 +1188,123 @@ fn material(
             color: Vec3::from(s.specular_color_factor()).max(Vec3::ZERO),
             color_texture: info(s.specular_color_texture(), warnings),
         }),
+        clearcoat: clearcoat(m, doc, images, warnings, path),
+        transmission: transmission(m, doc, images, warnings, path),
     }
+}
+
+/// A number of an extension object, when it is a finite number.
+fn json_number(v: &gltf::json::Value, key: &str) -> Option<f32> {
+    v.get(key)
+        .and_then(|x| x.as_f64())
+        .map(|x| x as f32)
+        .filter(|x| x.is_finite())
+}
+
+/// A textureInfo given as raw JSON inside a material extension (the
+/// gltf crate does not parse these extensions): its texture, set and
+/// KHR_texture_transform. An index that names no texture is a warning.
+fn json_tex(
+    v: &gltf::json::Value,
+    key: &str,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<TexInfo> {
+    let t = v.get(key)?;
+    let texture = t
+        .get("index")
+        .and_then(|i| i.as_u64())
+        .and_then(|i| doc.textures().nth(usize::try_from(i).ok()?));
+    let Some(texture) = texture else {
+        warnings.push(format!(
+            "{}: `{key}` names no texture of the file; it is ignored",
+            path.display()
+        ));
+        return None;
+    };
+    let set = t.get("texCoord").and_then(|c| c.as_u64()).unwrap_or(0);
+    let transform = Transform::of_json(
+        t.get("extensions")
+            .and_then(|e| e.get("KHR_texture_transform")),
+    );
+    tex_info(
+        texture,
+        u32::try_from(set).unwrap_or(u32::MAX),
+        transform,
+        images,
+        warnings,
+        path,
+    )
+}
+
+fn clearcoat(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfClearcoat> {
+    let v = m.extension_value("KHR_materials_clearcoat")?;
+    let factor = json_number(v, "clearcoatFactor")
+        .unwrap_or(0.0)
+        .clamp(0.0, 1.0);
+    if factor <= 0.0 {
+        return None;
+    }
+    let normal_scale = v
+        .get("clearcoatNormalTexture")
+        .map_or(1.0, |t| json_number(t, "scale").unwrap_or(1.0));
+    Some(GltfClearcoat {
+        factor,
+        texture: json_tex(v, "clearcoatTexture", doc, images, warnings, path),
+        roughness: json_number(v, "clearcoatRoughnessFactor")
+            .unwrap_or(0.0)
+            .clamp(0.0, 1.0),
+        roughness_texture: json_tex(v, "clearcoatRoughnessTexture", doc, images, warnings, path),
+        normal_texture: json_tex(v, "clearcoatNormalTexture", doc, images, warnings, path),
+        normal_scale,
+    })
+}
+
+fn transmission(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfTransmission> {
+    let v = m.extension_value("KHR_materials_transmission")?;
+    let factor = json_number(v, "transmissionFactor")
+        .unwrap_or(0.0)
+        .clamp(0.0, 1.0);
+    if factor <= 0.0 {
+        return None;
+    }
+    let volume = m.extension_value("KHR_materials_volume");
+    let vol_number = |k: &str| volume.and_then(|v| json_number(v, k));
+    let attenuation_color = volume
+        .and_then(|v| v.get("attenuationColor"))
+        .and_then(|c| c.as_array())
+        .filter(|c| c.len() == 3)
+        .and_then(|c| {
+            let ch = |i: usize| c[i].as_f64().map(|x| x as f32).filter(|x| x.is_finite());
+            Some(Vec3::new(ch(0)?, ch(1)?, ch(2)?))
+        })
+        .unwrap_or(Vec3::ONE)
+        .clamp(Vec3::ZERO, Vec3::ONE);
+    Some(GltfTransmission {
+        factor,
+        texture: json_tex(v, "transmissionTexture", doc, images, warnings, path),
+        thickness: vol_number("thicknessFactor").unwrap_or(0.0).max(0.0),
+        thickness_texture: volume
+            .and_then(|vv| json_tex(vv, "thicknessTexture", doc, images, warnings, path)),
+        attenuation_color,
+        attenuation_distance: vol_number("attenuationDistance")
+            .filter(|d| *d > 0.0)
+            .unwrap_or(f32::INFINITY),
+    })
 }
 
 fn light(l: &gltf::khr_lights_punctual::Light, node: &gltf::Node, world: Mat4) -> GltfLight {

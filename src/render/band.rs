@@ -309,15 +309,11 @@ impl<'a> FrameData<'a> {
                     [Gradients::default(); 2]
                 };
                 let frag = it.at_pixel(px, py);
-                let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
-                let (m, uv, vcolor) = self.material_uv(t, frag.lambda);
-                let tc = TexCoords::new(uv, g);
-                let a = self.ctx.opacity(m, &tc, vcolor).clamp(0.0, 1.0);
-                if !c.is_finite() {
+                let Some((add, through, a)) = self.layer(t, &it, frag, (px, py), g) else {
                     return;
-                }
+                };
                 let dst = color[i];
-                color[i] = (c * a + dst.truncate() * (1.0 - a)).extend(a + dst.w * (1.0 - a));
+                color[i] = (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a));
             });
         }
     }
@@ -349,17 +345,31 @@ impl<'a> FrameData<'a> {
                 [Gradients::default(); 2]
             };
             let frag = self.shading_point(&it, px, py, m);
-            let (c, _) = self.shade(t, &it, frag, (px, py), g, 1.0);
-            let (mat, uv, vcolor) = self.material_uv(t, frag.lambda);
-            let tc = TexCoords::new(uv, g);
-            let a = self.ctx.opacity(mat, &tc, vcolor).clamp(0.0, 1.0) * m.count_ones() as f32
-                / n as f32;
-            if !c.is_finite() {
+            let Some((add, through, a)) = self.layer(t, &it, frag, (px, py), g) else {
                 return;
-            }
+            };
+            // Over the fraction of samples it covers.
+            let k = m.count_ones() as f32 / n as f32;
+            let (add, through, a) = (add * k, through * k + Vec3::splat(1.0 - k), a * k);
             let dst = color[i];
-            color[i] = (c * a + dst.truncate() * (1.0 - a)).extend(a + dst.w * (1.0 - a));
+            color[i] = (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a));
         });
+    }
+
+    /// A blended fragment as a layer (`ShadeContext::layer`): the light it
+    /// adds, what it lets through and its alpha; None where shading is not
+    /// finite (degenerate input), so the fragment is skipped.
+    fn layer(
+        &self,
+        t: &Tri,
+        it: &Interpolator,
+        frag: Fragment,
+        px: (i32, i32),
+        grads: [Gradients; 2],
+    ) -> Option<(Vec3, Vec3, f32)> {
+        let surface = self.surface(t, it, frag, px, grads, [None; 2], 1.0);
+        let (add, through, a) = self.ctx.layer(&surface);
+        (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
 
     /// Shades each triangle visible in a pixel once (one per pixel without
@@ -554,22 +564,8 @@ impl<'a> FrameData<'a> {
     }
 
     /// Color (linear, or the data view's value) and view depth of triangle
-    /// `t` at pixel (px, py).
-    fn shade(
-        &self,
-        t: &Tri,
-        it: &Interpolator,
-        frag: Fragment,
-        px: (i32, i32),
-        grads: [Gradients; 2],
-        ao: f32,
-    ) -> (Vec3, f32) {
-        let (c, d, _) = self.shade_with(t, it, frag, px, grads, [None; 2], ao);
-        (c, d)
-    }
-
-    /// `shade`, given the filter footprints already known for `grads`;
-    /// also returns the footprints known afterwards.
+    /// `t` at pixel (px, py), given the filter footprints already known for
+    /// `grads`; also returns the footprints known afterwards.
     #[allow(clippy::too_many_arguments)]
     fn shade_with(
         &self,

@@ -64,6 +64,10 @@ pub struct Pbr {
     pub roughness: f32,
     /// Linear; roughness in green, metallic in blue.
     pub metallic_roughness_map: Option<TextureRef>,
+    /// Linear, red: separate roughness and metallic maps (MTL `map_Pr`,
+    /// `map_Pm`), multiplying the factors like the combined map.
+    pub roughness_map: Option<TextureRef>,
+    pub metallic_map: Option<TextureRef>,
     /// Linear; occlusion in red, applied to the ambient term.
     pub occlusion_map: Option<TextureRef>,
     pub occlusion_strength: f32,
@@ -74,6 +78,41 @@ pub struct Pbr {
     /// KHR_materials_ior / KHR_materials_specular; None: ior 1.5 (F0
     /// 0.04), F90 1.
     pub specular: Option<DielectricSpecular>,
+    /// KHR_materials_clearcoat (glTF; MTL `Pc`/`Pcr`).
+    pub clearcoat: Option<Clearcoat>,
+    /// KHR_materials_transmission with KHR_materials_volume.
+    pub transmission: Option<Transmission>,
+}
+
+/// A clear, colourless GGX layer over the material: F0 0.04, its own
+/// roughness and normal.
+#[derive(Debug, Clone)]
+pub struct Clearcoat {
+    pub factor: f32,
+    /// Linear; red multiplies `factor`.
+    pub map: Option<TextureRef>,
+    pub roughness: f32,
+    /// Linear; green multiplies `roughness`.
+    pub roughness_map: Option<TextureRef>,
+    /// The layer's own normal map (None: the interpolated normal).
+    pub normal_map: Option<NormalMap>,
+}
+
+/// Light passing through a thin dielectric surface (no refraction offset),
+/// tinted by the base colour and, with a volume, attenuated along the
+/// thickness by Beer's law.
+#[derive(Debug, Clone)]
+pub struct Transmission {
+    pub factor: f32,
+    /// Linear; red multiplies `factor`.
+    pub map: Option<TextureRef>,
+    /// Path length through the volume in the model's units (0: thin).
+    pub thickness: f32,
+    /// Linear; green multiplies `thickness`.
+    pub thickness_map: Option<TextureRef>,
+    /// Colour that white light becomes after `attenuation_distance`.
+    pub attenuation_color: Vec3,
+    pub attenuation_distance: f32,
 }
 
 /// A dielectric's reflectance when the file gives it.
@@ -98,11 +137,15 @@ impl Pbr {
             metallic: 1.0,
             roughness: 1.0,
             metallic_roughness_map: None,
+            roughness_map: None,
+            metallic_map: None,
             occlusion_map: None,
             occlusion_strength: 1.0,
             emissive: Vec3::ZERO,
             emissive_map: None,
             specular: None,
+            clearcoat: None,
+            transmission: None,
         }
     }
 }
@@ -197,14 +240,30 @@ impl Material {
 impl Material {
     /// Whether shading needs per-corner tangents.
     pub fn needs_tangents(&self) -> bool {
-        matches!(
-            &self.normal_map,
-            Some(NormalMap::Height { .. })
+        self.tangent_map().is_some()
+    }
+
+    /// The first map read in the surface's tangent frame (the normal or
+    /// bump map, else the clearcoat's normal map): its set decides the
+    /// tangents.
+    pub fn tangent_map(&self) -> Option<&TextureRef> {
+        fn in_tangent_space(nm: &Option<NormalMap>) -> Option<&TextureRef> {
+            match nm {
+                Some(NormalMap::Height { map, .. })
                 | Some(NormalMap::Normals {
+                    map,
                     space: NormalSpace::Tangent,
                     ..
-                })
-        )
+                }) => Some(map),
+                _ => None,
+            }
+        }
+        in_tangent_space(&self.normal_map).or_else(|| {
+            self.pbr
+                .clearcoat
+                .as_ref()
+                .and_then(|c| in_tangent_space(&c.normal_map))
+        })
     }
 
     /// Every texture the material samples.
@@ -228,8 +287,24 @@ impl Material {
             p.emissive_map.as_ref(),
             p.specular.as_ref().and_then(|s| s.weight_map.as_ref()),
             p.specular.as_ref().and_then(|s| s.color_map.as_ref()),
+            p.roughness_map.as_ref(),
+            p.metallic_map.as_ref(),
         ]
         .into_iter()
+        .chain(p.clearcoat.iter().flat_map(|c| {
+            let nm = match &c.normal_map {
+                Some(NormalMap::Normals { map, .. }) | Some(NormalMap::Height { map, .. }) => {
+                    Some(map)
+                }
+                None => None,
+            };
+            [c.map.as_ref(), c.roughness_map.as_ref(), nm]
+        }))
+        .chain(
+            p.transmission
+                .iter()
+                .flat_map(|t| [t.map.as_ref(), t.thickness_map.as_ref()]),
+        )
         .flatten()
     }
 }

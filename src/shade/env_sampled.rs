@@ -227,7 +227,7 @@ pub fn radiance(
             return Vec3::ZERO;
         }
         match lobes {
-            Lobes::Pbr(c) => pbr::brdf(n, v, l, c) * ndl,
+            Lobes::Pbr(c) => pbr::f_cos(n, v, l, c),
             Lobes::BlinnPhong { kd, ks, .. } => {
                 // The normalized lobe: D (n.h) / (4 v.h) integrates to ~1.
                 let h = (l + v).normalize_or_zero();

@@ -299,10 +299,16 @@ impl ShadeContext<'_> {
         let base = p.base_color.truncate()
             * get(&p.base_color_map).map_or(Vec3::ONE, |c| c.truncate())
             * s.color.truncate();
-        let (roughness, metallic) = match get(&p.metallic_roughness_map) {
+        let (mut roughness, mut metallic) = match get(&p.metallic_roughness_map) {
             Some(mr) => (p.roughness * mr.y, p.metallic * mr.z),
             None => (p.roughness, p.metallic),
         };
+        if let Some(r) = get(&p.roughness_map) {
+            roughness *= r.x;
+        }
+        if let Some(m) = get(&p.metallic_map) {
+            metallic *= m.x;
+        }
         let occlusion = match get(&p.occlusion_map) {
             Some(o) => 1.0 + p.occlusion_strength * (o.x - 1.0),
             None => 1.0,
@@ -317,6 +323,36 @@ impl ShadeContext<'_> {
             let weight = d.weight * get(&d.weight_map).map_or(1.0, |c| c.w);
             ((d.f0 * color).min(Vec3::ONE) * weight, weight)
         });
+        let coat = p.clearcoat.as_ref().and_then(|k| {
+            let factor = (k.factor * get(&k.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
+            (factor > 0.0).then(|| pbr::Coat {
+                factor,
+                roughness: (k.roughness * get(&k.roughness_map).map_or(1.0, |c| c.y))
+                    .clamp(0.0, 1.0),
+                normal: match &k.normal_map {
+                    Some(m) => self.apply_normal_map(s, m),
+                    None => s.normal,
+                },
+            })
+        });
+        let (transmission, attenuation) = match &p.transmission {
+            None => (0.0, Vec3::ONE),
+            Some(t) => {
+                let factor = (t.factor * get(&t.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
+                let thickness = t.thickness * get(&t.thickness_map).map_or(1.0, |c| c.y);
+                let attenuation = if t.attenuation_distance.is_finite() && thickness > 0.0 {
+                    let k = thickness / t.attenuation_distance;
+                    Vec3::new(
+                        t.attenuation_color.x.powf(k),
+                        t.attenuation_color.y.powf(k),
+                        t.attenuation_color.z.powf(k),
+                    )
+                } else {
+                    Vec3::ONE
+                };
+                (factor, attenuation)
+            }
+        };
         PbrColor {
             base,
             metallic: metallic.clamp(0.0, 1.0),
@@ -324,7 +360,37 @@ impl ShadeContext<'_> {
             occlusion,
             emissive,
             dielectric,
+            coat,
+            transmission,
+            attenuation,
         }
+    }
+
+    /// Whether a point of `m` is shaded with metallic-roughness.
+    fn shades_pbr(&self, m: &Material) -> bool {
+        match self.mode {
+            ShadingMode::Pbr => true,
+            ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
+            _ => false,
+        }
+    }
+
+    /// A blended surface as a layer over what lies behind it: the light
+    /// it adds, the fraction of the light behind that it lets through (per
+    /// channel) and its coverage for the alpha channel. Opacity (d, maps,
+    /// base alpha) gives (c a, 1 - a, a); transmission (pbr) gives the
+    /// reflected light, its transmittance and 1 - their mean.
+    pub fn layer(&self, s: &Surface) -> (Vec3, Vec3, f32) {
+        let c = self.shade(s);
+        if s.material.pbr.transmission.is_some() && self.shades_pbr(s.material) {
+            let pc = self.pbr_color(s);
+            let n = self.mapped_normal(s);
+            let t = pbr::transmittance(n, self.view_vector(s.position), &pc);
+            let t = t.clamp(Vec3::ZERO, Vec3::ONE);
+            return (c, t, 1.0 - (t.x + t.y + t.z) / 3.0);
+        }
+        let a = self.opacity(s.material, &s.tc, s.color).clamp(0.0, 1.0);
+        (c * a, Vec3::splat(1.0 - a), a)
     }
 
     /// A filtered lookup of `t` at the point's coordinates in its set (None
@@ -415,9 +481,14 @@ impl ShadeContext<'_> {
 
     /// The shading normal with the material's normal or bump map applied.
     pub fn mapped_normal(&self, s: &Surface) -> Vec3 {
-        let Some(map) = &s.material.normal_map else {
-            return s.normal;
-        };
+        match &s.material.normal_map {
+            Some(map) => self.apply_normal_map(s, map),
+            None => s.normal,
+        }
+    }
+
+    /// The interpolated normal perturbed by `map`.
+    fn apply_normal_map(&self, s: &Surface, map: &NormalMap) -> Vec3 {
         let tc = &s.tc;
         let n = s.normal;
         let frame = |t: Vec4| {

@@ -16,6 +16,18 @@
 //! (Karis, "Physically Based Shading on Mobile", 2014). Under uniform light
 //! a white dielectric then reflects exactly what it receives, never more.
 //!
+//! Layers (the KHR_materials extensions):
+//! - clearcoat: a colourless GGX layer (F0 0.04, its own roughness and
+//!   normal nc) over the material. With w = factor x F(nc.v) (Schlick),
+//!   L = (1 - w) L_base + factor L_coat, emission included in L_base.
+//! - transmission t: the diffuse lobe becomes (1 - t) of itself; the
+//!   light behind the surface comes through, times
+//!   t (1 - metallic) base (1 - S) attenuation (1 - w), with S the
+//!   specular albedo (so a white, fully transmissive dielectric in a
+//!   uniform environment is invisible) and attenuation
+//!   attenuation_color^(thickness / attenuation_distance) (Beer's law,
+//!   KHR_materials_volume). Thin-walled: no refraction offset.
+//!
 //! Note the 1/pi: under the same light, a white Lambertian pbr surface is
 //! 1/pi as bright as Blinn-Phong Kd 1, whose formula (the scene format's)
 //! has none. Lights are in the same units for both.
@@ -41,6 +53,51 @@ pub struct PbrColor {
     /// A dielectric's F0 and F90 when the material gives them (None: 0.04
     /// and 1).
     pub dielectric: Option<(Vec3, f32)>,
+    /// A clearcoat layer over the material.
+    pub coat: Option<Coat>,
+    /// Fraction of the diffuse lobe that is transmitted instead (0..1).
+    pub transmission: f32,
+    /// Volume transmittance along the thickness (1: none).
+    pub attenuation: Vec3,
+}
+
+/// A clearcoat layer at one point.
+#[derive(Debug, Clone, Copy)]
+pub struct Coat {
+    /// clearcoatFactor times its map (0..1).
+    pub factor: f32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: f32,
+    /// The layer's unit normal (its own normal map, else the surface's
+    /// interpolated normal).
+    pub normal: Vec3,
+}
+
+/// The coat's reflectance at normal incidence (ior 1.5).
+const COAT_F0: f32 = 0.04;
+
+impl Coat {
+    /// The share of the light below that the layer reflects away, towards
+    /// `v`: factor times Schlick's Fresnel at nc.v.
+    #[inline]
+    pub fn weight(&self, v: Vec3) -> f32 {
+        let ndv = self.normal.dot(v).abs().min(1.0);
+        self.factor * (COAT_F0 + (1.0 - COAT_F0) * (1.0 - ndv).powi(5))
+    }
+
+    /// The layer's BRDF times its cosine, times factor, for light from `l`.
+    #[inline]
+    pub fn f_cos(&self, v: Vec3, l: Vec3) -> f32 {
+        let nc = self.normal;
+        let ndl = nc.dot(l);
+        if ndl <= 0.0 {
+            return 0.0;
+        }
+        let h = (l + v).normalize_or_zero();
+        let fresnel = COAT_F0 + (1.0 - COAT_F0) * (1.0 - v.dot(h).abs()).powi(5);
+        let a = (self.roughness * self.roughness).max(MIN_ALPHA);
+        self.factor * fresnel * d_vis(nc, v, l, ndl, a * a) * ndl
+    }
 }
 
 /// Smallest alpha: a perfect mirror would make D a delta that point lights
@@ -78,20 +135,33 @@ impl PbrColor {
 }
 
 /// The BRDF f(v, l) (no cosine), with unit normal `n`, unit view `v` and
-/// unit light direction `l`, all pointing away from the surface.
+/// unit light direction `l`, all pointing away from the surface (the base
+/// layer only: `f_cos` adds the clearcoat).
 #[inline]
 pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     let ndl = n.dot(l);
     if ndl <= 0.0 {
         return Vec3::ZERO;
     }
-    let ndv = n.dot(v).abs().max(1e-4);
     let h = (l + v).normalize_or_zero();
-    let ndh = n.dot(h);
     let vdh = v.dot(h).abs();
     let a2 = c.alpha() * c.alpha();
     let f0 = c.f0();
     let fresnel = f0 + (Vec3::splat(c.f90()) - f0) * (1.0 - vdh).powi(5);
+    let diffuse = if c.transmission > 0.0 {
+        c.c_diff() * (1.0 - c.transmission)
+    } else {
+        c.c_diff()
+    };
+    (Vec3::ONE - fresnel) * diffuse / PI + fresnel * d_vis(n, v, l, ndl, a2)
+}
+
+/// GGX's D times the separable Smith visibility, for n.l = `ndl` > 0.
+#[inline(always)]
+fn d_vis(n: Vec3, v: Vec3, l: Vec3, ndl: f32, a2: f32) -> f32 {
+    let ndv = n.dot(v).abs().max(1e-4);
+    let h = (l + v).normalize_or_zero();
+    let ndh = n.dot(h);
     let d = if ndh > 0.0 {
         let t = ndh * ndh * (a2 - 1.0) + 1.0;
         a2 / (PI * t * t)
@@ -102,7 +172,29 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     let vis = 1.0
         / ((ndl + (a2 + (1.0 - a2) * ndl * ndl).sqrt())
             * (ndv + (a2 + (1.0 - a2) * ndv * ndv).sqrt()));
-    (Vec3::ONE - fresnel) * c.c_diff() / PI + fresnel * (d * vis)
+    d * vis
+}
+
+/// The whole material's f(v, l) cos: the base layer's BRDF times n.l,
+/// under the clearcoat when there is one.
+#[inline]
+pub fn f_cos(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
+    let base = brdf(n, v, l, c) * n.dot(l).max(0.0);
+    match &c.coat {
+        None => base,
+        Some(coat) => base * (1.0 - coat.weight(v)) + Vec3::splat(coat.f_cos(v, l)),
+    }
+}
+
+/// What of the light behind the surface comes through towards `v`, per
+/// channel (zero without transmission).
+pub fn transmittance(n: Vec3, v: Vec3, c: &PbrColor) -> Vec3 {
+    if c.transmission <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let spec = specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
+    let coat = c.coat.map_or(1.0, |k| 1.0 - k.weight(v));
+    (Vec3::ONE - spec) * c.base * c.attenuation * (c.transmission * (1.0 - c.metallic) * coat)
 }
 
 /// Specular albedo under uniform light for reflectance `f0`, from the
@@ -137,14 +229,36 @@ pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> V
     let ndv = n.dot(v).abs().max(1e-4);
     let ab = env.brdf(ndv, c.roughness);
     let spec = c.f0() * ab.x + Vec3::splat(ab.y * c.f90());
-    let diffuse = c.c_diff() * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
+    let c_diff = if c.transmission > 0.0 {
+        c.c_diff() * (1.0 - c.transmission)
+    } else {
+        c.c_diff()
+    };
+    let diffuse = c_diff * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
     let r = super::env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, c.roughness);
-    let so = if ao >= 1.0 {
+    let so = specular_occlusion(ndv, ao, c.roughness);
+    let base = (diffuse + env.prefiltered(r, c.roughness) * spec * so) * c.occlusion;
+    let Some(coat) = &c.coat else {
+        return base;
+    };
+    // The clearcoat: a dielectric lobe (F0 0.04) about its own normal.
+    let nc = coat.normal;
+    let ndv = nc.dot(v).abs().max(1e-4);
+    let ab = env.brdf(ndv, coat.roughness);
+    let r = super::env::dominant_direction(nc, nc * (2.0 * nc.dot(v)) - v, coat.roughness);
+    let layer = env.prefiltered(r, coat.roughness)
+        * ((COAT_F0 * ab.x + ab.y) * specular_occlusion(ndv, ao, coat.roughness));
+    base * (1.0 - coat.weight(v)) + layer * (coat.factor * c.occlusion)
+}
+
+/// Lagarde's specular occlusion from ambient occlusion `ao`.
+#[inline]
+fn specular_occlusion(ndv: f32, ao: f32, roughness: f32) -> f32 {
+    if ao >= 1.0 {
         1.0
     } else {
-        ((ndv + ao).powf((-16.0 * c.roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0)
-    };
-    (diffuse + env.prefiltered(r, c.roughness) * spec * so) * c.occlusion
+        ((ndv + ao).powf((-16.0 * roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0)
+    }
 }
 
 /// Outgoing radiance at `p` towards `v`.
@@ -158,13 +272,50 @@ pub fn radiance(
     lights: &[Light],
     shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> Vec3 {
+    if let Some(coat) = &c.coat {
+        return coated_radiance(p, n, v, c, coat, ambient, lights, shadow);
+    }
     let mut out = c.emissive;
     for_each_lit(lights, shadow, p, n, |l, e| out += e * brdf(n, v, l, c));
     if ambient != Vec3::ZERO {
         let spec = specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
-        out += ambient * c.occlusion * (c.c_diff() * (Vec3::ONE - spec) + spec);
+        let c_diff = if c.transmission > 0.0 {
+            c.c_diff() * (1.0 - c.transmission)
+        } else {
+            c.c_diff()
+        };
+        out += ambient * c.occlusion * (c_diff * (Vec3::ONE - spec) + spec);
     }
     out
+}
+
+/// `radiance` under a clearcoat: the base (emission included) times
+/// 1 - w, plus the layer's reflection of each light and of the ambient.
+/// A light below the base's normal but above the coat's is not seen.
+#[allow(clippy::too_many_arguments)]
+fn coated_radiance(
+    p: Vec3,
+    n: Vec3,
+    v: Vec3,
+    c: &PbrColor,
+    coat: &Coat,
+    ambient: Vec3,
+    lights: &[Light],
+    shadow: &impl Fn(usize, Vec3) -> f32,
+) -> Vec3 {
+    let base = PbrColor { coat: None, ..*c };
+    let under = radiance(p, n, v, &base, ambient, lights, shadow);
+    let mut layer = Vec3::ZERO;
+    for_each_lit(lights, shadow, p, n, |l, e| {
+        // e carries n.l; the layer's cosine is its own normal's.
+        layer += e * (coat.f_cos(v, l) / n.dot(l));
+    });
+    if ambient != Vec3::ZERO {
+        let nc = coat.normal;
+        let s = specular_albedo(Vec3::splat(COAT_F0), 1.0, coat.roughness, nc.dot(v).abs());
+        layer += ambient * c.occlusion * s * coat.factor;
+    }
+    under * (1.0 - coat.weight(v)) + layer
 }
 
 #[cfg(test)]
@@ -180,6 +331,9 @@ mod tests {
             occlusion: 1.0,
             emissive: Vec3::ZERO,
             dielectric: None,
+            coat: None,
+            transmission: 0.0,
+            attenuation: Vec3::ONE,
         }
     }
 

@@ -62,6 +62,14 @@ pub struct MtlMaterial {
     /// `norm`: always a normal map.
     pub norm: Option<MapSpec>,
     pub disp: Option<MapSpec>,
+    /// The PBR extension of MTL (Exocortex; Blender and tinyobjloader
+    /// write it): roughness, metallic, clearcoat thickness and roughness.
+    pub pr: Option<f32>,
+    pub pm: Option<f32>,
+    pub pc: Option<f32>,
+    pub pcr: Option<f32>,
+    pub map_pr: Option<MapSpec>,
+    pub map_pm: Option<MapSpec>,
     /// `newmtl` gave no name (`name` is then `material<position>`).
     pub unnamed: bool,
     /// Made up by the loader for faces without a material (no MTL, or no

@@ -9,21 +9,16 @@ use super::parse::{numbers, split_tag};
 use super::{MapSpec, MtlMaterial, parse_map};
 
 /// Keys of MTL's PBR extension and of renderers' dialects that softraster
-/// reads no value from; they are skipped without a warning.
+/// reads no value from (sheen, anisotropy, transmission filter, ...); they
+/// are skipped without a warning.
 const SILENT: &[&str] = &[
     "Tf",
     "sharpness",
     "refl",
     "map_refl",
-    "Pr",
-    "Pm",
     "Ps",
-    "Pc",
-    "Pcr",
     "aniso",
     "anisor",
-    "map_Pr",
-    "map_Pm",
     "map_Ps",
     "Km",
     "map_aat",
@@ -131,6 +126,12 @@ pub fn parse(path: &Path, text: &str, warnings: &mut Vec<String>) -> Vec<MtlMate
             "map_Bump" | "map_bump" | "bump" => m.map_bump = map(&mut warn).or(m.map_bump.take()),
             "norm" | "map_Kn" => m.norm = map(&mut warn).or(m.norm.take()),
             "disp" => m.disp = map(&mut warn).or(m.disp.take()),
+            "Pr" => m.pr = scalar(&mut warn).or(m.pr),
+            "Pm" => m.pm = scalar(&mut warn).or(m.pm),
+            "Pc" => m.pc = scalar(&mut warn).or(m.pc),
+            "Pcr" => m.pcr = scalar(&mut warn).or(m.pcr),
+            "map_Pr" => m.map_pr = map(&mut warn).or(m.map_pr.take()),
+            "map_Pm" => m.map_pm = map(&mut warn).or(m.map_pm.take()),
             t if SILENT.contains(&t) => {}
             t => warn(format!("unknown material key `{t}` ignored")),
         }
@@ -160,6 +161,7 @@ mod tests {
         assert_eq!(mats[1].name, "material1");
         assert_eq!(mats[1].d, Some(0.5));
         assert_eq!(mats[2].kd, Some([0.1, 0.2, 0.3]));
+        assert_eq!(mats[0].pr, Some(0.5));
         // before newmtl, Ks, Ns, map_Kd, foo
         assert_eq!(w.len(), 5, "{w:#?}");
         assert!(w[0].starts_with("/m/a.mtl:1: "), "{}", w[0]);

@@ -14,8 +14,8 @@ use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
 use crate::scene::material::{
-    AlphaMode, DielectricSpecular, Material, Native, NormalMap, NormalSpace, Pbr,
-    ns_from_roughness, roughness_from_ns,
+    AlphaMode, Clearcoat, DielectricSpecular, Material, Native, NormalMap, NormalSpace, Pbr,
+    Transmission, ns_from_roughness, roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -71,7 +71,7 @@ impl SourceMaterial {
             SourceMaterial::Mtl(m) => shading_maps(&m.mtl)
                 .into_iter()
                 .enumerate()
-                .filter(|(k, _)| !normals_only || *k >= 6)
+                .filter(|(k, _)| !normals_only || *k >= 8)
                 .filter_map(|(_, (map, srgb))| {
                     map.as_ref()
                         .map(|m| (ImageSource::File(m.path.clone()), srgb))
@@ -267,8 +267,9 @@ fn mtl_transform(spec: &MapSpec) -> Affine2 {
 }
 
 /// The maps shading reads, with whether they hold sRGB color (`disp` is
-/// read at load time, by `displace`). The last two are the normal maps.
-fn shading_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 8] {
+/// read at load time, by `displace`). The last two are the normal maps
+/// (indices 8 and 9).
+fn shading_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 10] {
     [
         (&m.map_ka, true),
         (&m.map_kd, true),
@@ -276,6 +277,8 @@ fn shading_maps(m: &MtlMaterial) -> [(&Option<MapSpec>, bool); 8] {
         (&m.map_ke, true),
         (&m.map_ns, false),
         (&m.map_d, false),
+        (&m.map_pr, false),
+        (&m.map_pm, false),
         (&m.map_bump, false),
         (&m.norm, false),
     ]
@@ -359,19 +362,42 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
     let ke = constant(m.ke, &m.map_ke, Vec3::ZERO);
     let ns = m.ns.unwrap_or(d.ns);
     let map_ke = tex(&m.map_ke, true);
-    // MTL as pbr: Kd is the base color, a dielectric (metallic 0), the
-    // roughness whose GGX lobe matches Ns; Ks does not carry over.
+    // MTL as pbr: Kd is the base color; the PBR extension's Pr and Pm
+    // (and their maps) where the file gives them, else a dielectric
+    // (metallic 0) with the roughness whose GGX lobe matches Ns; Ks does
+    // not carry over. Pc and Pcr are a clearcoat.
+    let pbr_keys = m.pr.is_some() || m.pm.is_some() || m.map_pr.is_some() || m.map_pm.is_some();
+    let unit = |v: f32| v.clamp(0.0, 1.0);
     let pbr = Pbr {
         base_color: kd.extend(opacity),
         base_color_map: map_kd.clone(),
-        metallic: x.metallic.unwrap_or(0.0),
-        roughness: x.roughness.unwrap_or_else(|| roughness_from_ns(ns)),
+        metallic: x
+            .metallic
+            .or(m.pm.map(unit))
+            .unwrap_or(if m.map_pm.is_some() { 1.0 } else { 0.0 }),
+        roughness: x.roughness.or(m.pr.map(unit)).unwrap_or_else(|| {
+            if m.map_pr.is_some() {
+                1.0
+            } else {
+                roughness_from_ns(ns)
+            }
+        }),
         metallic_roughness_map: None,
+        roughness_map: tex(&m.map_pr, false),
+        metallic_map: tex(&m.map_pm, false),
         occlusion_map: None,
         occlusion_strength: 1.0,
         emissive: ke,
         emissive_map: map_ke.clone(),
         specular: None,
+        clearcoat: m.pc.map(unit).filter(|c| *c > 0.0).map(|factor| Clearcoat {
+            factor,
+            map: None,
+            roughness: m.pcr.map_or(0.0, unit),
+            roughness_map: None,
+            normal_map: None,
+        }),
+        transmission: None,
     };
     Material {
         name: m.name.clone(),
@@ -394,7 +420,13 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         normal_map,
         alpha,
         pbr,
-        native: Native::BlinnPhong,
+        // A file that gives the PBR extension's roughness or metallic is
+        // described in metallic-roughness terms.
+        native: if pbr_keys {
+            Native::Pbr
+        } else {
+            Native::BlinnPhong
+        },
         double_sided: false,
         unlit: false,
     }
@@ -440,11 +472,32 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
         metallic: g.metallic,
         roughness: g.roughness,
         metallic_roughness_map: tex(&g.metallic_roughness_tex, false),
+        roughness_map: None,
+        metallic_map: None,
         occlusion_map: tex(&g.occlusion_tex, false),
         occlusion_strength: g.occlusion_strength,
         emissive: g.emissive,
         emissive_map: emissive_map.clone(),
         specular: dielectric_specular(g, &tex),
+        clearcoat: g.clearcoat.as_ref().map(|c| Clearcoat {
+            factor: c.factor,
+            map: tex(&c.texture, false),
+            roughness: c.roughness,
+            roughness_map: tex(&c.roughness_texture, false),
+            normal_map: tex(&c.normal_texture, false).map(|map| NormalMap::Normals {
+                map,
+                space: NormalSpace::Tangent,
+                scale: c.normal_scale,
+            }),
+        }),
+        transmission: g.transmission.as_ref().map(|t| Transmission {
+            factor: t.factor,
+            map: tex(&t.texture, false),
+            thickness: t.thickness,
+            thickness_map: tex(&t.thickness_texture, false),
+            attenuation_color: t.attenuation_color,
+            attenuation_distance: t.attenuation_distance,
+        }),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the
     // specular color at normal incidence (0.04 for dielectrics, the base
@@ -471,7 +524,9 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
         map_ks: None,
         map_ke: emissive_map,
         map_ns: None,
-        d: g.base_color.w,
+        // Transmitted light shows what is behind; as Blinn-Phong, that is
+        // a partly transparent surface.
+        d: g.base_color.w * (1.0 - g.transmission.as_ref().map_or(0.0, |t| t.factor)),
         map_d: None,
         normal_map: tex(&g.normal_tex, false).map(|map| NormalMap::Normals {
             map,
@@ -479,6 +534,8 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             scale: g.normal_scale,
         }),
         alpha: match g.alpha_mode {
+            // Transmission is composited over what lies behind.
+            _ if g.transmission.is_some() => AlphaMode::Blend,
             GltfAlphaMode::Opaque => AlphaMode::Opaque,
             GltfAlphaMode::Mask => AlphaMode::Mask(g.alpha_cutoff),
             GltfAlphaMode::Blend => AlphaMode::Blend,

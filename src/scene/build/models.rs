@@ -23,7 +23,7 @@ use crate::error::Error;
 use crate::scene::animation::{NodeLight, Playback};
 use crate::scene::desc::{self, Ctx, SceneDesc};
 use crate::scene::light::Light;
-use crate::scene::material::{Material, NormalMap};
+use crate::scene::material::Material;
 use crate::scene::{Model, RenderSettings};
 
 /// What the models bring: themselves, the decoded textures (`Texture::id`
@@ -387,13 +387,10 @@ fn decode_textures(
 /// The texture-coordinate set of the first material whose normal or bump
 /// map needs per-corner tangents (None: no material needs them).
 fn tangent_set(materials: &[Material]) -> Option<usize> {
-    let nm = materials.iter().find(|m| m.needs_tangents())?;
-    Some(match &nm.normal_map {
-        Some(NormalMap::Normals { map, .. }) | Some(NormalMap::Height { map, .. }) => {
-            map.texcoord as usize
-        }
-        None => 0,
-    })
+    materials
+        .iter()
+        .find_map(|m| m.tangent_map())
+        .map(|map| map.texcoord as usize)
 }
 
 /// `model.lights` and `model.cameras`: glTF files only; an import that
