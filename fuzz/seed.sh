@@ -5,7 +5,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 corpus="$root/fuzz/corpus"
-mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render}
+mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture}
 
 # obj_mtl: OBJ bytes, a NUL, MTL bytes (the first .mtl in the same folder).
 n=0
@@ -35,4 +35,11 @@ for i in 0 1 2 3 4 5 6 7; do
   head -c $((64 + i * 48)) /dev/urandom > "$corpus/render/seed_$i"
 done
 printf '\x03\x01\x00\x00\x80\xbf\x00\x00\x80\xbf\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x80\xbf\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00\x00\x01\x02' > "$corpus/render/seed_triangle"
-echo "seeded $(ls "$corpus"/obj_mtl | wc -l) obj_mtl, $(ls "$corpus"/gltf | wc -l) gltf, $(ls "$corpus"/scene_toml | wc -l) scene_toml, $(ls "$corpus"/render | wc -l) render inputs in $corpus"
+# texture: the small images (every format the corpus holds).
+while IFS= read -r -d '' img; do
+  size=$(stat -c %s "$img")
+  [ "$size" -gt 200000 ] && continue
+  cp "$img" "$corpus/texture/$(basename "$img")"
+done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.png' -o -name '*.dds' -o -name '*.tga' -o -name '*.bmp' -o -name '*.tif' -o -name '*.jpg' -o -name '*.hdr' \) -print0)
+
+echo "seeded $(ls "$corpus"/obj_mtl | wc -l) obj_mtl, $(ls "$corpus"/gltf | wc -l) gltf, $(ls "$corpus"/scene_toml | wc -l) scene_toml, $(ls "$corpus"/render | wc -l) render, $(ls "$corpus"/texture | wc -l) texture inputs in $corpus"

@@ -3,6 +3,7 @@
 
 pub mod accessor;
 pub mod clip;
+pub mod dds;
 pub mod draco;
 pub mod environment;
 pub mod gltf;

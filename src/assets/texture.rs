@@ -269,18 +269,22 @@ impl Level {
 }
 
 impl Texture {
-    /// Decodes PNG, TGA (RLE, either origin) or JPEG by content.
+    /// Decodes PNG, TGA (RLE, either origin), JPEG, BMP, TIFF, Radiance
+    /// HDR or DDS by content.
     pub fn load(path: &Path, srgb: bool) -> Result<Texture, Error> {
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| Error::asset(path, None, format!("cannot open texture: {e}")))?
-            .with_guessed_format()
-            .map_err(|e| Error::asset(path, None, format!("cannot read texture: {e}")))?;
-        Texture::decode_image(reader, path, srgb)
+        let bytes = std::fs::read(path)
+            .map_err(|e| Error::asset(path, None, format!("cannot open texture: {e}")))?;
+        Texture::from_bytes(&bytes, path, srgb)
     }
 
     /// Decodes an image held in memory (a glTF image in a buffer or a data
     /// URI); `name` stands for it in errors.
     pub fn from_bytes(bytes: &[u8], name: &Path, srgb: bool) -> Result<Texture, Error> {
+        if super::dds::is_dds(bytes) {
+            let d = super::dds::decode(bytes)
+                .map_err(|e| Error::asset(name, None, format!("cannot decode texture: {e}")))?;
+            return Ok(Texture::from_rgba8(d.width, d.height, d.texels, srgb));
+        }
         let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| Error::asset(name, None, format!("cannot read texture: {e}")))?;
