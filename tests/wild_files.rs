@@ -145,15 +145,17 @@ fn every_file_in_the_corpus_has_its_outcome() {
     );
 }
 
-/// The DDS checkers of the corpus (uncompressed BGRA, and BC1 and BC3 as
-/// Pillow writes them) decode to the PNG they were made from: exactly
-/// when uncompressed, within BC1's 5-6-5 quantization otherwise.
+/// The checkers of the corpus in other formats (TGA, found by its
+/// extension since it has no magic number; DDS uncompressed BGRA, and BC1
+/// and BC3 as Pillow writes them) decode to the PNG they were made from:
+/// exactly when uncompressed, within BC1's 5-6-5 quantization otherwise.
 #[test]
-fn dds_textures_decode_to_their_source_image() {
+fn tga_and_dds_textures_decode_to_their_source_image() {
     use softraster::assets::texture::Texture;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     let png = Texture::load(&dir.join("checker.png"), false).unwrap();
     for (name, tolerance) in [
+        ("checker.tga", 0),
         ("checker.dds", 0),
         ("checker_bc1.dds", 8),
         ("checker_bc3.dds", 8),
