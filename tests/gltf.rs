@@ -834,6 +834,20 @@ fn khr_materials_clearcoat_transmission_and_volume() {
         (coated - expect).abs().max_element() < 4e-3,
         "{coated} vs {expect}"
     );
+    // The sampled reference (Monte Carlo over the environment, with the
+    // coat as a lobe of its own) agrees.
+    let sampled = cube_face_color(
+        "gltf_clearcoat_sampled",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.0}}}}}}"#
+        ),
+        used,
+        "method = \"sampled\"\nsamples = 64\n",
+    );
+    assert!(
+        (sampled - expect).abs().max_element() < 0.01,
+        "sampled {sampled} vs {expect}"
+    );
     // A factor of 0 is no coat at all.
     let uncoated = cube_face_color(
         "gltf_clearcoat0",

@@ -201,6 +201,14 @@ pub fn radiance(
         Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness),
     };
     let a = alpha(roughness);
+    // A clearcoat is a third, sharper lobe about its own normal: drawn
+    // with probability COAT_SHARE.
+    const COAT_SHARE: f32 = 0.3;
+    let coat = match lobes {
+        Lobes::Pbr(c) => c.coat.filter(|k| k.factor > 0.0),
+        Lobes::BlinnPhong { .. } => None,
+    };
+    let qc = if coat.is_some() { COAT_SHARE } else { 0.0 };
     // Probability of drawing the diffuse lobe.
     let q = {
         let d = luminance(c_diff);
@@ -209,16 +217,21 @@ pub fn radiance(
         } else {
             d / (d + spec_weight)
         }
-    };
+    } * (1.0 - qc);
     let m = frame(n);
+    let coat_frame = coat.map(|k| (frame(k.normal), k.normal, alpha(k.roughness)));
+    // GGX's distribution of reflected directions about normal `n`.
+    let ggx_pdf = |n: Vec3, a: f32, l: Vec3| {
+        let h = (l + v).normalize_or_zero();
+        ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
+    };
     let brdf_pdf = |l: Vec3| {
         let ndl = n.dot(l);
         if ndl <= 0.0 {
             return 0.0;
         }
-        let h = (l + v).normalize_or_zero();
-        let spec = ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6));
-        q * ndl / PI + (1.0 - q) * spec
+        let coat = coat_frame.map_or(0.0, |(_, nc, ac)| qc * ggx_pdf(nc, ac, l));
+        q * ndl / PI + (1.0 - q - qc) * ggx_pdf(n, a, l) + coat
     };
     // f(l) cos(l): the integrand without radiance and visibility.
     let f_cos = |l: Vec3| -> Vec3 {
@@ -250,18 +263,26 @@ pub fn radiance(
         }
         // From the BRDF.
         let xi = point(i, samples, Vec2::new(shift.y, shift.x));
-        let l = if xi.x < q {
-            let u = Vec2::new(xi.x / q.max(1e-6), xi.y);
-            let r = u.x.sqrt();
-            let phi = 2.0 * PI * u.y;
-            m * Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
-        } else {
-            let u = Vec2::new((xi.x - q) / (1.0 - q).max(1e-6), xi.y);
+        // A reflected direction from GGX about frame `m` (alpha `a`).
+        let ggx_sample = |m: Mat3, a: f32, u: Vec2| {
             let phi = 2.0 * PI * u.x;
             let cos_t = ((1.0 - u.y) / (1.0 + (a * a - 1.0) * u.y)).max(0.0).sqrt();
             let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
             let h = m * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
             h * (2.0 * v.dot(h)) - v
+        };
+        let l = if xi.x < q {
+            let u = Vec2::new(xi.x / q.max(1e-6), xi.y);
+            let r = u.x.sqrt();
+            let phi = 2.0 * PI * u.y;
+            m * Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+        } else if xi.x < 1.0 - qc {
+            let u = Vec2::new((xi.x - q) / (1.0 - q - qc).max(1e-6), xi.y);
+            ggx_sample(m, a, u)
+        } else {
+            let (mc, _, ac) = coat_frame.unwrap_or((m, n, a));
+            let u = Vec2::new((xi.x - (1.0 - qc)) / qc.max(1e-6), xi.y);
+            ggx_sample(mc, ac, u)
         };
         let fc = f_cos(l);
         if fc != Vec3::ZERO && visible(l) {
