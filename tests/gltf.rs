@@ -911,3 +911,39 @@ fn khr_materials_clearcoat_transmission_and_volume() {
         "{volume} vs {expect}"
     );
 }
+
+#[test]
+fn khr_materials_sheen_prefiltered_agrees_with_sampled() {
+    // A black, matte base (no specular) shows the sheen alone: under the
+    // uniform environment, head-on, its albedo E(1, r) times the colour;
+    // the sampled reference integrates the lobe itself and agrees.
+    let sheen = |name: &str, env: &str, color: &str| {
+        cube_face_color(
+            name,
+            &format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0}}, "extensions": {{"KHR_materials_specular": {{"specularFactor": 0.0}}, "KHR_materials_sheen": {{"sheenColorFactor": {color}, "sheenRoughnessFactor": 0.5}}}}}}"#
+            ),
+            r#""KHR_materials_specular", "KHR_materials_sheen""#,
+            env,
+        )
+    };
+    let pre = sheen("gltf_sheen", "", "[1.0, 0.5, 0.25]");
+    let expect = Vec3::new(1.0, 0.5, 0.25) * softraster::shade::sheen::albedo(1.0, 0.5);
+    assert!(
+        (pre - expect).abs().max_element() < 2e-3,
+        "{pre} vs {expect}"
+    );
+    assert!(pre.x > 0.02, "{pre}");
+    let sampled = sheen(
+        "gltf_sheen_sampled",
+        "method = \"sampled\"\nsamples = 64\n",
+        "[1.0, 0.5, 0.25]",
+    );
+    assert!(
+        (sampled - pre).abs().max_element() < 0.01,
+        "sampled {sampled} vs prefiltered {pre}"
+    );
+    // A black sheen is none.
+    let none = sheen("gltf_sheen_black", "", "[0.0, 0.0, 0.0]");
+    assert!(none.max_element() < 1e-4, "{none}");
+}

@@ -36,6 +36,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_sheen",
     "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_materials_unlit",
@@ -116,6 +117,19 @@ pub struct GltfMaterial {
     pub clearcoat: Option<GltfClearcoat>,
     /// KHR_materials_transmission (None without it, or with a factor of 0).
     pub transmission: Option<GltfTransmission>,
+    /// KHR_materials_sheen (None without it, or with a black colour).
+    pub sheen: Option<GltfSheen>,
+}
+
+/// KHR_materials_sheen.
+#[derive(Debug, Clone)]
+pub struct GltfSheen {
+    pub color: Vec3,
+    /// sRGB; RGB multiplies `color`.
+    pub color_texture: Option<TexInfo>,
+    pub roughness: f32,
+    /// Alpha multiplies `roughness`.
+    pub roughness_texture: Option<TexInfo>,
 }
 
 /// KHR_materials_clearcoat: a second, colourless GGX layer over the
@@ -180,6 +194,7 @@ impl GltfMaterial {
             specular: None,
             clearcoat: None,
             transmission: None,
+            sheen: None,
         }
     }
 
@@ -225,6 +240,16 @@ impl GltfMaterial {
                 self.transmission
                     .as_ref()
                     .and_then(|t| t.thickness_texture.as_ref()),
+                false,
+            ),
+            (
+                self.sheen.as_ref().and_then(|t| t.color_texture.as_ref()),
+                true,
+            ),
+            (
+                self.sheen
+                    .as_ref()
+                    .and_then(|t| t.roughness_texture.as_ref()),
                 false,
             ),
         ]
@@ -1190,7 +1215,39 @@ fn material(
         }),
         clearcoat: clearcoat(m, doc, images, warnings, path),
         transmission: transmission(m, doc, images, warnings, path),
+        sheen: sheen(m, doc, images, warnings, path),
     }
+}
+
+fn sheen(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfSheen> {
+    let v = m.extension_value("KHR_materials_sheen")?;
+    let color = v
+        .get("sheenColorFactor")
+        .and_then(|c| c.as_array())
+        .filter(|c| c.len() == 3)
+        .and_then(|c| {
+            let ch = |i: usize| c[i].as_f64().map(|x| x as f32).filter(|x| x.is_finite());
+            Some(Vec3::new(ch(0)?, ch(1)?, ch(2)?))
+        })
+        .unwrap_or(Vec3::ZERO)
+        .clamp(Vec3::ZERO, Vec3::ONE);
+    if color == Vec3::ZERO {
+        return None;
+    }
+    Some(GltfSheen {
+        color,
+        color_texture: json_tex(v, "sheenColorTexture", doc, images, warnings, path),
+        roughness: json_number(v, "sheenRoughnessFactor")
+            .unwrap_or(0.0)
+            .clamp(0.0, 1.0),
+        roughness_texture: json_tex(v, "sheenRoughnessTexture", doc, images, warnings, path),
+    })
 }
 
 /// A number of an extension object, when it is a finite number.

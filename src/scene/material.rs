@@ -82,6 +82,20 @@ pub struct Pbr {
     pub clearcoat: Option<Clearcoat>,
     /// KHR_materials_transmission with KHR_materials_volume.
     pub transmission: Option<Transmission>,
+    /// KHR_materials_sheen.
+    pub sheen: Option<SheenLayer>,
+}
+
+/// The fuzz of cloth: a Charlie lobe of this colour and roughness.
+#[derive(Debug, Clone)]
+pub struct SheenLayer {
+    /// Linear.
+    pub color: Vec3,
+    /// sRGB; RGB multiplies `color`.
+    pub color_map: Option<TextureRef>,
+    pub roughness: f32,
+    /// Linear; alpha multiplies `roughness`.
+    pub roughness_map: Option<TextureRef>,
 }
 
 /// A clear, colourless GGX layer over the material: F0 0.04, its own
@@ -146,6 +160,7 @@ impl Pbr {
             specular: None,
             clearcoat: None,
             transmission: None,
+            sheen: None,
         }
     }
 }
@@ -304,6 +319,11 @@ impl Material {
             p.transmission
                 .iter()
                 .flat_map(|t| [t.map.as_ref(), t.thickness_map.as_ref()]),
+        )
+        .chain(
+            p.sheen
+                .iter()
+                .flat_map(|t| [t.color_map.as_ref(), t.roughness_map.as_ref()]),
         )
         .flatten()
     }

@@ -9,6 +9,7 @@ pub mod gouraud;
 pub mod light;
 pub mod pbr;
 pub mod shadow;
+pub mod sheen;
 
 use std::cell::Cell;
 
@@ -353,6 +354,10 @@ impl ShadeContext<'_> {
                 (factor, attenuation)
             }
         };
+        let sheen = p.sheen.as_ref().map(|k| pbr::Sheen {
+            color: k.color * get(&k.color_map).map_or(Vec3::ONE, |c| c.truncate()),
+            roughness: (k.roughness * get(&k.roughness_map).map_or(1.0, |c| c.w)).clamp(0.0, 1.0),
+        });
         PbrColor {
             base,
             metallic: metallic.clamp(0.0, 1.0),
@@ -361,6 +366,7 @@ impl ShadeContext<'_> {
             emissive,
             dielectric,
             coat,
+            sheen,
             transmission,
             attenuation,
         }

@@ -15,7 +15,7 @@ use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
 use crate::scene::material::{
     AlphaMode, Clearcoat, DielectricSpecular, Material, Native, NormalMap, NormalSpace, Pbr,
-    Transmission, ns_from_roughness, roughness_from_ns,
+    SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -390,6 +390,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         emissive: ke,
         emissive_map: map_ke.clone(),
         specular: None,
+        sheen: None,
         clearcoat: m.pc.map(unit).filter(|c| *c > 0.0).map(|factor| Clearcoat {
             factor,
             map: None,
@@ -497,6 +498,12 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             thickness_map: tex(&t.thickness_texture, false),
             attenuation_color: t.attenuation_color,
             attenuation_distance: t.attenuation_distance,
+        }),
+        sheen: g.sheen.as_ref().map(|t| SheenLayer {
+            color: t.color,
+            color_map: tex(&t.color_texture, true),
+            roughness: t.roughness,
+            roughness_map: tex(&t.roughness_texture, false),
         }),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the
