@@ -90,6 +90,11 @@ struct RenderArgs {
     /// `render.max_memory`.
     #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
     max_memory: Option<u64>,
+    /// Keep decoded textures and their mip chains in DIR between runs,
+    /// keyed by a hash of each image's content (opt-in; created if
+    /// missing; safe to share between runs and machines' renders).
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
 }
 
 fn parse_memory(s: &str) -> Result<u64, String> {
@@ -295,7 +300,7 @@ fn chart(args: ChartArgs) -> Result<(), Error> {
     if args.runs == 0 {
         return Err(Error::Argument("--runs must be at least 1".into()));
     }
-    let opts = load_options(&args.sets, None, false)?;
+    let opts = load_options(&args.sets, None, false, None)?;
     let out = args
         .out
         .clone()
@@ -472,6 +477,7 @@ fn load_options(
     sets: &[String],
     out_dir: Option<PathBuf>,
     strict: bool,
+    cache: Option<PathBuf>,
 ) -> Result<LoadOptions, Error> {
     let sets = sets
         .iter()
@@ -482,11 +488,17 @@ fn load_options(
         out_dir,
         plain_look: false,
         strict,
+        cache,
     })
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {
-    let opts = load_options(&args.sets, args.out.clone(), args.strict)?;
+    let opts = load_options(
+        &args.sets,
+        args.out.clone(),
+        args.strict,
+        args.cache.clone(),
+    )?;
     let pool = thread_pool(args.threads)?;
     pool.install(|| {
         let t0 = std::time::Instant::now();

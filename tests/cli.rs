@@ -570,3 +570,100 @@ fn max_memory_refuses_before_rendering() {
     assert!(err.contains("memory: about"), "{err}");
     assert!(out.join("camera_0000.png").exists());
 }
+
+#[test]
+fn texture_cache_gives_the_same_frames_and_survives_damage() {
+    let dir = common::scratch("texture_cache");
+    let cache = dir.join("cache");
+    let scene = root().join("scenes/showcase.toml");
+    let render = |name: &str| {
+        let out = dir.join(name);
+        let (code, err) = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--cache",
+            cache.to_str().unwrap(),
+            "--frames",
+            "0..2",
+            "--set",
+            "output.width=96",
+            "--set",
+            "output.height=72",
+            "--quiet",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let mut frames: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "png"))
+            .collect();
+        frames.sort();
+        assert!(!frames.is_empty());
+        frames
+            .iter()
+            .map(|p| std::fs::read(p).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let (code, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.join("plain").to_str().unwrap(),
+        "--frames",
+        "0..2",
+        "--set",
+        "output.width=96",
+        "--set",
+        "output.height=72",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut plain: Vec<_> = std::fs::read_dir(dir.join("plain"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    plain.sort();
+    let plain: Vec<_> = plain.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    // Cold (entries written), warm (entries read): the frames of a run
+    // without the cache, byte for byte.
+    assert_eq!(render("cold"), plain);
+    let entries: Vec<_> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert!(
+        !entries.is_empty() && entries.iter().all(|p| p.extension().unwrap() == "srtex"),
+        "{entries:?}"
+    );
+    assert_eq!(render("warm"), plain);
+    // Damaged entries (cut short, or garbage) are decoded again.
+    for (k, p) in entries.iter().enumerate() {
+        let bytes = std::fs::read(p).unwrap();
+        let damaged = if k % 2 == 0 {
+            bytes[..bytes.len() / 2].to_vec()
+        } else {
+            vec![7u8; 100]
+        };
+        std::fs::write(p, damaged).unwrap();
+    }
+    assert_eq!(render("damaged"), plain);
+    // A cache path that cannot be a directory: exit 2 naming it.
+    let file = write(&dir, "not_a_dir", "x");
+    let (code, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.join("bad").to_str().unwrap(),
+        "--cache",
+        file.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("not_a_dir") && err.contains("texture cache"),
+        "{err}"
+    );
+}

@@ -49,6 +49,7 @@ impl Goldens {
             out_dir: None,
             plain_look: false,
             strict: false,
+            cache: None,
         };
         let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
         let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);

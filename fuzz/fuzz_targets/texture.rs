@@ -1,7 +1,9 @@
 //! Texture decoding: the input as an image file of any format softraster
 //! reads (DDS by its own reader; PNG, JPEG, TGA, BMP, TIFF and HDR by the
 //! image crate), decoded as a colour map and as a data map, with its mip
-//! chain built. Errors are fine; a panic, crash or hang is not.
+//! chain built; and as a texture-cache entry (`--cache`), while every small
+//! image that decodes must come back from its own entry unchanged. Errors
+//! are fine; a panic, crash or hang is not.
 
 #![no_main]
 
@@ -15,8 +17,20 @@ fuzz_target!(|data: &[u8]| {
             // Keep the work per input small: mip chains of big images
             // would only slow the fuzzer down.
             if (t.width as u64) * (t.height as u64) <= 1 << 16 {
-                let _ = softraster::assets::mip::build_chain(&t);
+                let chain = softraster::assets::mip::build_chain(&t);
+                let entry = t.to_cache_bytes(&chain);
+                let back = Texture::from_cache_bytes(&entry, srgb).expect("own cache entry");
+                assert_eq!((back.width, back.height), (t.width, t.height));
+                for y in 0..t.height {
+                    for x in 0..t.width {
+                        assert_eq!(back.base().texel(x, y), t.base().texel(x, y));
+                    }
+                }
+                assert_eq!(softraster::assets::mip::build_chain(&back).len(), chain.len());
             }
+        }
+        if let Some(t) = Texture::from_cache_bytes(data, srgb) {
+            let _ = softraster::assets::mip::build_chain(&t);
         }
     }
 });

@@ -17,3 +17,4 @@ pub mod rig;
 pub mod stl;
 pub mod text;
 pub mod texture;
+pub mod texture_cache;

@@ -77,6 +77,9 @@ pub struct Texture {
     pub binary_alpha: f32,
     /// Every texel has R = G = B (a height map rather than a normal map).
     pub grey: bool,
+    /// Levels 1.. read from the texture cache (`--cache`), which
+    /// `mip::build_chain` hands over instead of building them.
+    cached_chain: std::sync::Mutex<Option<Vec<Level>>>,
 }
 
 /// A data texel as `[b as f32 * (1.0 / 255.0); 4]`: on x86-64 the four
@@ -151,6 +154,13 @@ static ALPHA_TABLE: [f32; 256] = {
 #[repr(C, align(64))]
 struct Block([[u8; 4]; 16]);
 
+// SAFETY: a Block is 64 bytes of u8 (size 64, alignment 64: no padding),
+// so every bit pattern is a valid Block and it has no interior pointers;
+// this lets the texture cache read and write levels as bytes.
+unsafe impl bytemuck::Zeroable for Block {}
+// SAFETY: as above.
+unsafe impl bytemuck::Pod for Block {}
+
 /// How a material refers to a texture: the texture plus the MTL options that
 /// change its lookup.
 #[derive(Debug, Clone)]
@@ -207,6 +217,10 @@ pub enum Footprint {
     /// coordinates) centred on the lookup.
     Probes { n: f32, lod: f32, axis: Vec2 },
 }
+
+/// The first bytes of a texture-cache entry (`Texture::to_cache_bytes`);
+/// a new layout takes a new number.
+const CACHE_MAGIC: &[u8] = b"softraster-texture-1\n";
 
 /// Border color for `address = "border"` and NaN coordinates: transparent black.
 pub const BORDER: Vec4 = Vec4::ZERO;
@@ -368,7 +382,121 @@ impl Texture {
                 hard as f32 / partial as f32
             },
             grey,
+            cached_chain: Default::default(),
         }
+    }
+
+    /// With levels 1.. already built (`chain`), for `mip::build_chain`.
+    pub fn with_cached_chain(self, chain: Vec<Level>) -> Texture {
+        *self.cached_chain.lock().unwrap_or_else(|e| e.into_inner()) = Some(chain);
+        self
+    }
+
+    /// The mip chain read from the texture cache, once (None otherwise).
+    pub fn take_cached_chain(&self) -> Option<Vec<Level>> {
+        self.cached_chain.lock().map_or(None, |mut c| c.take())
+    }
+
+    /// The texture and its levels 1.. (`chain`) as a texture-cache entry:
+    /// a header, then each level's size and blocks as stored.
+    pub fn to_cache_bytes(&self, chain: &[Level]) -> Vec<u8> {
+        let mut out = Vec::with_capacity(
+            CACHE_MAGIC.len()
+                + 32
+                + std::iter::once(&self.base)
+                    .chain(chain)
+                    .map(|l| 8 + l.blocks.len() * 64)
+                    .sum::<usize>(),
+        );
+        out.extend_from_slice(CACHE_MAGIC);
+        out.extend_from_slice(&self.width.to_le_bytes());
+        out.extend_from_slice(&self.height.to_le_bytes());
+        out.extend_from_slice(&[self.srgb as u8, self.has_alpha as u8, self.grey as u8, 0]);
+        out.extend_from_slice(&self.binary_alpha.to_le_bytes());
+        out.extend_from_slice(&(1 + chain.len() as u32).to_le_bytes());
+        for l in std::iter::once(&self.base).chain(chain) {
+            out.extend_from_slice(&l.width.to_le_bytes());
+            out.extend_from_slice(&l.height.to_le_bytes());
+            out.extend_from_slice(bytemuck::cast_slice(&l.blocks));
+        }
+        out
+    }
+
+    /// A texture-cache entry back (`to_cache_bytes`) from `r`, which
+    /// holds `len` bytes: the chain kept for `take_cached_chain`. None for
+    /// anything that is not a whole, valid entry of a `srgb` texture
+    /// (checked against `len` before any level is allocated).
+    pub fn from_cache_reader(r: &mut impl std::io::Read, len: u64, srgb: bool) -> Option<Texture> {
+        let mut head = [0u8; 21 + 24];
+        debug_assert_eq!(CACHE_MAGIC.len(), 21);
+        r.read_exact(&mut head).ok()?;
+        let rest = head.strip_prefix(CACHE_MAGIC)?;
+        let u32_at =
+            |i: usize| u32::from_le_bytes([rest[i], rest[i + 1], rest[i + 2], rest[i + 3]]);
+        let (width, height) = (u32_at(0), u32_at(4));
+        let flags = &rest[8..12];
+        let binary_alpha = f32::from_bits(u32_at(12));
+        let count = u32_at(16);
+        // rest[20..24]: the first level's width, read with its height.
+        if flags[0] != srgb as u8 || flags[1] > 1 || flags[2] > 1 || width == 0 || height == 0 {
+            return None;
+        }
+        // The levels' sizes follow from the base's: check the length first.
+        let mut sizes = Vec::new();
+        let (mut w, mut h) = (width, height);
+        let mut total: u64 = head.len() as u64 - 4;
+        for k in 0..count {
+            if k > 0 {
+                if (w, h) == (1, 1) {
+                    return None;
+                }
+                (w, h) = ((w / 2).max(1), (h / 2).max(1));
+            }
+            let blocks = w.div_ceil(4) as u64 * h.div_ceil(4) as u64;
+            total = total.checked_add(8 + blocks * 64)?;
+            sizes.push((w, h));
+        }
+        if count == 0 || total != len || (count > 1 && (w, h) != (1, 1)) {
+            return None;
+        }
+        let mut levels = Vec::with_capacity(sizes.len());
+        for (k, &(w, h)) in sizes.iter().enumerate() {
+            let mut size = [0u8; 8];
+            if k == 0 {
+                size[..4].copy_from_slice(&rest[20..24]);
+                r.read_exact(&mut size[4..]).ok()?;
+            } else {
+                r.read_exact(&mut size).ok()?;
+            }
+            let lw = u32::from_le_bytes([size[0], size[1], size[2], size[3]]);
+            let lh = u32::from_le_bytes([size[4], size[5], size[6], size[7]]);
+            if (lw, lh) != (w, h) {
+                return None;
+            }
+            let mut l = Level::new(w, h);
+            r.read_exact(bytemuck::cast_slice_mut(&mut l.blocks)).ok()?;
+            levels.push(l);
+        }
+        let mut levels = levels.into_iter();
+        let base = levels.next()?;
+        let chain: Vec<Level> = levels.collect();
+        Some(Texture {
+            width,
+            height,
+            base,
+            srgb,
+            id: 0,
+            has_alpha: flags[1] == 1,
+            binary_alpha,
+            grey: flags[2] == 1,
+            cached_chain: std::sync::Mutex::new((count > 1).then_some(chain)),
+        })
+    }
+
+    /// `from_cache_reader` of an entry held in memory.
+    pub fn from_cache_bytes(mut bytes: &[u8], srgb: bool) -> Option<Texture> {
+        let len = bytes.len() as u64;
+        Texture::from_cache_reader(&mut bytes, len, srgb)
     }
 
     /// Level 0.

@@ -39,6 +39,9 @@ pub struct LoadOptions {
     /// `--strict`: every warning (a missing material library or texture,
     /// an unknown MTL key, a setting without effect) is an error.
     pub strict: bool,
+    /// `--cache DIR`: decoded textures and their mip chains kept between
+    /// runs (`assets::texture_cache`).
+    pub cache: Option<PathBuf>,
 }
 
 impl LoadOptions {
@@ -130,7 +133,11 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         opts.out_dir.as_deref(),
     )?;
     let mut warnings = settings::no_effect_warnings(d, ctx, &settings);
-    let mut models = models::build(d, ctx, &settings, &scene_dir, &mut warnings)?;
+    let cache = match &opts.cache {
+        Some(dir) => Some(crate::assets::texture_cache::TextureCache::new(dir)?),
+        None => None,
+    };
+    let mut models = models::build(d, ctx, &settings, &scene_dir, cache.as_ref(), &mut warnings)?;
     // Point and line sizes without points or lines to draw.
     for (key, v, has) in [
         (

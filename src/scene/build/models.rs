@@ -19,6 +19,7 @@ use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
 use crate::assets::rig::Parts;
 use crate::assets::texture::{AddressMode, Texture};
+use crate::assets::texture_cache::TextureCache;
 use crate::error::Error;
 use crate::scene::animation::{NodeLight, Playback};
 use crate::scene::desc::{self, Ctx, SceneDesc};
@@ -66,6 +67,7 @@ pub(super) fn build(
     ctx: &Ctx,
     settings: &RenderSettings,
     scene_dir: &Path,
+    cache: Option<&TextureCache>,
     warnings: &mut Vec<String>,
 ) -> Result<Models, Error> {
     let files = load_files(d, ctx, scene_dir)?;
@@ -79,7 +81,7 @@ pub(super) fn build(
     );
     let normals_view = settings.shading == crate::scene::settings::ShadingMode::Normals;
     let (textures, by_key) = if textured {
-        decode_textures(d, &files, &model_mats, normals_view, warnings)?
+        decode_textures(d, &files, &model_mats, normals_view, cache, warnings)?
     } else {
         (Vec::new(), BTreeMap::new())
     };
@@ -330,12 +332,14 @@ fn source_materials(
 type TextureKeys = BTreeMap<(PathBuf, bool), Arc<Texture>>;
 
 /// Decodes, in parallel and once per (image, sRGB), the images that the
-/// materials of drawn triangles read; ids follow the images' sorted order.
+/// materials of drawn triangles read (or reads them from `cache`, which
+/// then also holds their mip chains); ids follow the images' sorted order.
 fn decode_textures(
     d: &SceneDesc,
     files: &Files,
     model_mats: &[Vec<SourceMaterial>],
     normals_view: bool,
+    cache: Option<&TextureCache>,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<Arc<Texture>>, TextureKeys), Error> {
     let mut wanted: BTreeMap<(PathBuf, bool), ImageSource> = BTreeMap::new();
@@ -354,11 +358,27 @@ fn decode_textures(
         }
     }
     let keys: Vec<_> = wanted.iter().collect();
-    let results: Vec<Result<Texture, Error>> = keys
+    let results: Vec<Result<(Texture, Option<String>), Error>> = keys
         .par_iter()
-        .map(|((_, srgb), img)| match img {
-            ImageSource::File(p) => Texture::load(p, *srgb),
-            ImageSource::Memory { name, bytes } => Texture::from_bytes(bytes, name, *srgb),
+        .map(|((_, srgb), img)| {
+            let srgb = *srgb;
+            match (img, cache) {
+                (ImageSource::File(p), None) => Ok((Texture::load(p, srgb)?, None)),
+                (ImageSource::Memory { name, bytes }, None) => {
+                    Ok((Texture::from_bytes(bytes, name, srgb)?, None))
+                }
+                (ImageSource::File(p), Some(c)) => {
+                    let bytes = std::fs::read(p)
+                        .map_err(|e| Error::asset(p, None, format!("cannot open texture: {e}")))?;
+                    let (t, _, w) = c.load(&bytes, srgb, || Texture::load(p, srgb))?;
+                    Ok((t, w))
+                }
+                (ImageSource::Memory { name, bytes }, Some(c)) => {
+                    let (t, _, w) =
+                        c.load(bytes, srgb, || Texture::from_bytes(bytes, name, srgb))?;
+                    Ok((t, w))
+                }
+            }
         })
         .collect();
     // Lenient: a texture that cannot be read is a warning, and the
@@ -368,7 +388,8 @@ fn decode_textures(
     let mut by_key = TextureKeys::new();
     for ((key, _), r) in keys.iter().zip(results) {
         match r {
-            Ok(mut t) => {
+            Ok((mut t, cache_warning)) => {
+                warnings.extend(cache_warning);
                 t.id = decoded.len();
                 let t = Arc::new(t);
                 decoded.push(t.clone());

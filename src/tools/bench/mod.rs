@@ -60,6 +60,10 @@ pub struct BenchArgs {
     /// Append one JSON line per case (the table's numbers) to this file.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Keep decoded textures and mip chains in this directory between
+    /// runs (as `render --cache`); without it every load is cold.
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone)]
@@ -270,7 +274,10 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     let mut scene = Scene::from_text(
         Path::new(&format!("bench-{case}.toml")),
         &text,
-        &LoadOptions::plain(),
+        &LoadOptions {
+            cache: args.cache.clone(),
+            ..LoadOptions::plain()
+        },
     )?;
     // Mip chains are built when a frame first minifies a texture; the
     // benchmark builds them up front and counts them as loading.
