@@ -40,6 +40,6 @@ while IFS= read -r -d '' img; do
   size=$(stat -c %s "$img")
   [ "$size" -gt 200000 ] && continue
   cp "$img" "$corpus/texture/$(basename "$img")"
-done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.png' -o -name '*.dds' -o -name '*.tga' -o -name '*.bmp' -o -name '*.tif' -o -name '*.jpg' -o -name '*.hdr' \) -print0)
+done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.png' -o -name '*.dds' -o -name '*.tga' -o -name '*.bmp' -o -name '*.tif' -o -name '*.jpg' -o -name '*.hdr' -o -name '*.ktx2' \) -print0)
 
 echo "seeded $(ls "$corpus"/obj_mtl | wc -l) obj_mtl, $(ls "$corpus"/gltf | wc -l) gltf, $(ls "$corpus"/scene_toml | wc -l) scene_toml, $(ls "$corpus"/render | wc -l) render, $(ls "$corpus"/texture | wc -l) texture inputs in $corpus"

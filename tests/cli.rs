@@ -363,14 +363,14 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
         &tri,
         "",
         &format!(
-            r#"{nodes}, "extensionsUsed": ["KHR_texture_basisu"], "extensionsRequired": ["KHR_texture_basisu"]"#
+            r#"{nodes}, "extensionsUsed": ["EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"]"#
         ),
         None,
     );
-    write(&dir, "basisu.gltf", &text);
-    let err = exit_2(&scene("basisu.gltf"), &dir);
+    write(&dir, "webp.gltf", &text);
+    let err = exit_2(&scene("webp.gltf"), &dir);
     assert!(
-        err.contains("requires the glTF extension `KHR_texture_basisu`"),
+        err.contains("requires the glTF extension `EXT_texture_webp`"),
         "{err}"
     );
 

@@ -147,19 +147,33 @@ fn every_file_in_the_corpus_has_its_outcome() {
 
 /// The checkers of the corpus in other formats (TGA, found by its
 /// extension since it has no magic number; DDS uncompressed BGRA, and BC1
-/// and BC3 as Pillow writes them) decode to the PNG they were made from:
-/// exactly when uncompressed, within BC1's 5-6-5 quantization otherwise.
+/// and BC3 as Pillow writes them; KTX2 as RGBA8 with zlib
+/// supercompression and with DDS's BC1 blocks, written by hand, and as
+/// Basis Universal ETC1S and UASTC, written by the basis_universal
+/// encoder through the npm package ktx2-encoder 0.6.0) decode to the PNG
+/// they were made from: exactly when uncompressed, within BC1's 5-6-5
+/// quantization, and within the Basis codecs' loss otherwise.
 #[test]
-fn tga_and_dds_textures_decode_to_their_source_image() {
+fn tga_dds_and_ktx2_textures_decode_to_their_source_image() {
     use softraster::assets::texture::Texture;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
-    let png = Texture::load(&dir.join("checker.png"), false).unwrap();
     for (name, tolerance) in [
         ("checker.tga", 0),
         ("checker.dds", 0),
         ("checker_bc1.dds", 8),
         ("checker_bc3.dds", 8),
+        ("checker_rgba8_zlib.ktx2", 0),
+        ("checker_bc1.ktx2", 8),
+        ("checker_uastc.ktx2", 8),
+        // ETC1S keeps one colour per half block: its file holds 4x4
+        // blocks of one colour each (blocks.png).
+        ("blocks_etc1s.ktx2", 8),
     ] {
+        let png = if name.starts_with("blocks") {
+            Texture::load(&dir.join("blocks.png"), false).unwrap()
+        } else {
+            Texture::load(&dir.join("checker.png"), false).unwrap()
+        };
         let dds = Texture::load(&dir.join(name), false).unwrap();
         assert_eq!((dds.width, dds.height), (png.width, png.height), "{name}");
         for y in 0..png.height {

@@ -21,8 +21,9 @@ pub fn is_dds(bytes: &[u8]) -> bool {
     bytes.starts_with(b"DDS ")
 }
 
+/// How texels are stored (shared with the KTX2 reader).
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Format {
+pub(super) enum Format {
     Bc1,
     Bc2,
     Bc3,
@@ -111,6 +112,23 @@ pub fn decode(b: &[u8]) -> Result<Decoded, String> {
         return Err("the DDS pixel format names neither a FourCC nor RGB masks".into());
     };
     let data = b.get(data_at..).unwrap_or(&[]);
+    let texels = unpack(format, data, width, height).map_err(|e| format!("the DDS file {e}"))?;
+    Ok(Decoded {
+        width,
+        height,
+        texels,
+    })
+}
+
+/// Row-major RGBA8 texels of a `width` x `height` image stored as `format`
+/// at the start of `data`; an error (completing "the ... file") when
+/// `data` is too short.
+pub(super) fn unpack(
+    format: Format,
+    data: &[u8],
+    width: u32,
+    height: u32,
+) -> Result<Vec<[u8; 4]>, String> {
     let (w, h) = (width as usize, height as usize);
     let (bw, bh) = (w.div_ceil(4), h.div_ceil(4));
     let needed = match format {
@@ -120,7 +138,7 @@ pub fn decode(b: &[u8]) -> Result<Decoded, String> {
     };
     if data.len() < needed {
         return Err(format!(
-            "the DDS file holds {} bytes of texels where its {width}x{height} level needs {needed}",
+            "holds {} bytes of texels where its {width}x{height} level needs {needed}",
             data.len()
         ));
     }
@@ -161,11 +179,7 @@ pub fn decode(b: &[u8]) -> Result<Decoded, String> {
             }
         }
     }
-    Ok(Decoded {
-        width,
-        height,
-        texels,
-    })
+    Ok(texels)
 }
 
 /// The DX10 header's format (DXGI_FORMAT values).

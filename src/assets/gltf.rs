@@ -42,6 +42,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_unlit",
     "KHR_materials_volume",
     "KHR_mesh_quantization",
+    "KHR_texture_basisu",
     "KHR_texture_transform",
 ];
 
@@ -943,7 +944,29 @@ fn tex_info(
     warnings: &mut Vec<String>,
     path: &Path,
 ) -> Option<TexInfo> {
-    let image = images.get(texture.source().index())?.clone();
+    // The texture's own image (a PNG or JPEG fallback, when
+    // KHR_texture_basisu gives one), else its KTX2 image.
+    let basisu = texture
+        .extension_value("KHR_texture_basisu")
+        .and_then(|v| v.get("source"))
+        .and_then(|i| i.as_u64())
+        .and_then(|i| usize::try_from(i).ok());
+    let Some(index) = texture.source().map(|i| i.index()).or(basisu) else {
+        warnings.push(format!(
+            "{}: texture {} has no image; materials use it without that map",
+            path.display(),
+            texture.index()
+        ));
+        return None;
+    };
+    let Some(image) = images.get(index).cloned() else {
+        warnings.push(format!(
+            "{}: texture {} names image {index}, which the file does not have",
+            path.display(),
+            texture.index()
+        ));
+        return None;
+    };
     let (transform, tc) = texture_transform(transform);
     let set = tc.unwrap_or(tex_coord);
     let texcoord = if set > 1 {

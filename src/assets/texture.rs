@@ -284,17 +284,17 @@ impl Level {
 
 impl Texture {
     /// Decodes PNG, TGA (RLE, either origin), JPEG, BMP, TIFF, Radiance
-    /// HDR or DDS by content.
+    /// HDR, DDS or KTX2 by content.
     pub fn load(path: &Path, srgb: bool) -> Result<Texture, Error> {
         let open_err =
             |e: std::io::Error| Error::asset(path, None, format!("cannot open texture: {e}"));
-        let mut magic = [0u8; 4];
-        let n = std::io::Read::read(
-            &mut std::fs::File::open(path).map_err(open_err)?,
+        let mut magic = Vec::with_capacity(12);
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(std::fs::File::open(path).map_err(open_err)?, 12),
             &mut magic,
         )
         .map_err(open_err)?;
-        if super::dds::is_dds(&magic[..n]) {
+        if super::dds::is_dds(&magic) || super::ktx2::is_ktx2(&magic) {
             return Texture::from_bytes(&std::fs::read(path).map_err(open_err)?, path, srgb);
         }
         // The image crate guesses by content, then by the extension (TGA
@@ -309,9 +309,16 @@ impl Texture {
     /// Decodes an image held in memory (a glTF image in a buffer or a data
     /// URI); `name` stands for it in errors.
     pub fn from_bytes(bytes: &[u8], name: &Path, srgb: bool) -> Result<Texture, Error> {
-        if super::dds::is_dds(bytes) {
-            let d = super::dds::decode(bytes)
-                .map_err(|e| Error::asset(name, None, format!("cannot decode texture: {e}")))?;
+        let special = if super::dds::is_dds(bytes) {
+            Some(super::dds::decode(bytes))
+        } else if super::ktx2::is_ktx2(bytes) {
+            Some(super::ktx2::decode(bytes))
+        } else {
+            None
+        };
+        if let Some(d) = special {
+            let d =
+                d.map_err(|e| Error::asset(name, None, format!("cannot decode texture: {e}")))?;
             return Ok(Texture::from_rgba8(d.width, d.height, d.texels, srgb));
         }
         let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
