@@ -459,8 +459,10 @@ impl Texture {
                 }
                 (w, h) = ((w / 2).max(1), (h / 2).max(1));
             }
-            let blocks = w.div_ceil(4) as u64 * h.div_ceil(4) as u64;
-            total = total.checked_add(8 + blocks * 64)?;
+            let bytes = (w.div_ceil(4) as u64)
+                .checked_mul(h.div_ceil(4) as u64)?
+                .checked_mul(64)?;
+            total = total.checked_add(bytes)?.checked_add(8)?;
             sizes.push((w, h));
         }
         if count == 0 || total != len || (count > 1 && (w, h) != (1, 1)) {

@@ -163,7 +163,25 @@ mod tests {
         let mut long = bytes.clone();
         long.push(0);
         assert!(Texture::from_cache_bytes(&long, false).is_none());
-        // Sizes that do not match the data, including enormous ones.
+        // Sizes that do not match the data, including enormous ones (the
+        // fuzzer's first find: a size whose byte count overflowed).
+        let mut b = bytes.clone();
+        let magic = b"softraster-texture-1\n".len();
+        b[magic..magic + 8].copy_from_slice(&[0xff; 8]);
+        assert!(Texture::from_cache_bytes(&b, false).is_none());
+        let fuzzed = [
+            &b"softraster-texture-1\n"[..],
+            &[
+                0x89, 0x50, 0x0e, 0xb9, 0xf2, 0xf5, 0x07, 0xd1, 0, 0, 0, 0x0f,
+            ],
+            &[
+                0x49, 0x48, 0x52, 0x60, 0x26, 0x93, 0x09, 0x2b, 0x48, 0x44, 0x52, 0,
+            ],
+            &[0x37, 0x07, 0, 0],
+        ]
+        .concat();
+        assert!(Texture::from_cache_bytes(&fuzzed, false).is_none());
+        assert!(Texture::from_cache_bytes(&fuzzed, true).is_none());
         let magic = b"softraster-texture-1\n".len();
         for (at, v) in [
             (0, u32::MAX),
