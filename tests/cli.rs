@@ -378,20 +378,20 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
     let (text, _) = common::gltf_text(
         &tri,
         "",
-        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_iridescence"]"#),
+        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_anisotropy"]"#),
         None,
     );
-    write(&dir, "iridescence.gltf", &text);
+    write(&dir, "anisotropy.gltf", &text);
     let (code, err) = run(&[
         "render",
-        scene("iridescence.gltf").to_str().unwrap(),
+        scene("anisotropy.gltf").to_str().unwrap(),
         "--out",
         dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("warning:")
-            && err.contains("`KHR_materials_iridescence`")
+            && err.contains("`KHR_materials_anisotropy`")
             && err.contains("ignores"),
         "{err}"
     );

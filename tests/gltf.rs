@@ -947,3 +947,83 @@ fn khr_materials_sheen_prefiltered_agrees_with_sampled() {
     let none = sheen("gltf_sheen_black", "", "[0.0, 0.0, 0.0]");
     assert!(none.max_element() < 1e-4, "{none}");
 }
+
+#[test]
+fn khr_materials_iridescence_colours_the_reflection_as_the_film_model_says() {
+    use softraster::shade::iridescence::Iridescence;
+    // A black, smooth dielectric in the uniform environment, seen head on,
+    // reflects F0 = 0.04 of the light; under a 400 nm film of index 1.3
+    // (the extension's defaults without a thickness texture) it reflects
+    // the film's Fresnel over that F0 instead.
+    let black = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0}"#;
+    let used = r#""KHR_materials_iridescence""#;
+    let plain = cube_face_color("gltf_iridescence_plain", &format!("{black}}}"), used, "");
+    let film = |name: &str, ext: &str, env: &str| {
+        cube_face_color(
+            name,
+            &format!(r#"{black}, "extensions": {{"KHR_materials_iridescence": {ext}}}}}"#),
+            used,
+            env,
+        )
+    };
+    let coloured = film(
+        "gltf_iridescence",
+        r#"{"iridescenceFactor": 1.0, "iridescenceIor": 1.3}"#,
+        "",
+    );
+    let model = Iridescence {
+        factor: 1.0,
+        ior: 1.3,
+        thickness: 400.0,
+    }
+    .fresnel(1.0, Vec3::splat(0.04));
+    let expect = plain / 0.04 * model;
+    assert!(
+        (coloured - expect).abs().max_element() < 0.01 * expect.max_element(),
+        "{coloured} vs {expect} (plain {plain})"
+    );
+    // Coloured, not grey.
+    assert!(coloured.max_element() - coloured.min_element() > 0.2 * coloured.max_element());
+    // The thickness range: without a texture, the maximum is used.
+    let thin = film(
+        "gltf_iridescence_thin",
+        r#"{"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 250.0}"#,
+        "",
+    );
+    let model_thin = Iridescence {
+        factor: 1.0,
+        ior: 1.3,
+        thickness: 250.0,
+    }
+    .fresnel(1.0, Vec3::splat(0.04));
+    let expect_thin = plain / 0.04 * model_thin;
+    assert!(
+        (thin - expect_thin).abs().max_element() < 0.01 * expect_thin.max_element(),
+        "{thin} vs {expect_thin}"
+    );
+    // A factor of 0 is no film.
+    let off = film("gltf_iridescence_off", r#"{"iridescenceFactor": 0.0}"#, "");
+    assert!((off - plain).abs().max_element() < 1e-6, "{off} vs {plain}");
+    // The sampled reference (the film in the BRDF at v.h) agrees with the
+    // split sum (the film at n.v) on a rough film.
+    let rough = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.3}"#;
+    let rough_film = |name: &str, env: &str| {
+        cube_face_color(
+            name,
+            &format!(
+                r#"{rough}, "extensions": {{"KHR_materials_iridescence": {{"iridescenceFactor": 1.0}}}}}}"#
+            ),
+            used,
+            env,
+        )
+    };
+    let prefiltered = rough_film("gltf_iridescence_rough", "");
+    let sampled = rough_film(
+        "gltf_iridescence_rough_sampled",
+        "method = \"sampled\"\nsamples = 256\n",
+    );
+    assert!(
+        (prefiltered - sampled).abs().max_element() < 0.15 * sampled.max_element(),
+        "prefiltered {prefiltered} vs sampled {sampled}"
+    );
+}

@@ -36,6 +36,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_iridescence",
     "KHR_materials_sheen",
     "KHR_materials_specular",
     "KHR_materials_transmission",
@@ -120,6 +121,22 @@ pub struct GltfMaterial {
     pub transmission: Option<GltfTransmission>,
     /// KHR_materials_sheen (None without it, or with a black colour).
     pub sheen: Option<GltfSheen>,
+    /// KHR_materials_iridescence (None without it, or with a factor of 0).
+    pub iridescence: Option<GltfIridescence>,
+}
+
+/// KHR_materials_iridescence.
+#[derive(Debug, Clone)]
+pub struct GltfIridescence {
+    pub factor: f32,
+    /// Red multiplies `factor`.
+    pub texture: Option<TexInfo>,
+    pub ior: f32,
+    /// Nanometres.
+    pub thickness_min: f32,
+    pub thickness_max: f32,
+    /// Green: from `thickness_min` to `thickness_max`.
+    pub thickness_texture: Option<TexInfo>,
 }
 
 /// KHR_materials_sheen.
@@ -196,6 +213,7 @@ impl GltfMaterial {
             clearcoat: None,
             transmission: None,
             sheen: None,
+            iridescence: None,
         }
     }
 
@@ -251,6 +269,16 @@ impl GltfMaterial {
                 self.sheen
                     .as_ref()
                     .and_then(|t| t.roughness_texture.as_ref()),
+                false,
+            ),
+            (
+                self.iridescence.as_ref().and_then(|t| t.texture.as_ref()),
+                false,
+            ),
+            (
+                self.iridescence
+                    .as_ref()
+                    .and_then(|t| t.thickness_texture.as_ref()),
                 false,
             ),
         ]
@@ -1239,7 +1267,45 @@ fn material(
         clearcoat: clearcoat(m, doc, images, warnings, path),
         transmission: transmission(m, doc, images, warnings, path),
         sheen: sheen(m, doc, images, warnings, path),
+        iridescence: iridescence(m, doc, images, warnings, path),
     }
+}
+
+fn iridescence(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfIridescence> {
+    let v = m.extension_value("KHR_materials_iridescence")?;
+    let factor = json_number(v, "iridescenceFactor")
+        .unwrap_or(0.0)
+        .clamp(0.0, 1.0);
+    if factor <= 0.0 {
+        return None;
+    }
+    // An index of refraction below 1 or absurdly high is clamped to what
+    // films are made of; thicknesses are kept to 0..10 um.
+    let thickness =
+        |key: &str, default: f32| json_number(v, key).unwrap_or(default).clamp(0.0, 10_000.0);
+    Some(GltfIridescence {
+        factor,
+        texture: json_tex(v, "iridescenceTexture", doc, images, warnings, path),
+        ior: json_number(v, "iridescenceIor")
+            .unwrap_or(1.3)
+            .clamp(1.0, 4.0),
+        thickness_min: thickness("iridescenceThicknessMinimum", 100.0),
+        thickness_max: thickness("iridescenceThicknessMaximum", 400.0),
+        thickness_texture: json_tex(
+            v,
+            "iridescenceThicknessTexture",
+            doc,
+            images,
+            warnings,
+            path,
+        ),
+    })
 }
 
 fn sheen(

@@ -84,6 +84,22 @@ pub struct Pbr {
     pub transmission: Option<Transmission>,
     /// KHR_materials_sheen.
     pub sheen: Option<SheenLayer>,
+    /// KHR_materials_iridescence.
+    pub iridescence: Option<IridescenceLayer>,
+}
+
+/// A thin film over the material (KHR_materials_iridescence).
+#[derive(Debug, Clone)]
+pub struct IridescenceLayer {
+    pub factor: f32,
+    /// Linear; red multiplies `factor`.
+    pub map: Option<TextureRef>,
+    pub ior: f32,
+    /// Thickness in nanometres: `thickness_max` without a map, else
+    /// from `thickness_min` to `thickness_max` by the map's green.
+    pub thickness_min: f32,
+    pub thickness_max: f32,
+    pub thickness_map: Option<TextureRef>,
 }
 
 /// The fuzz of cloth: a Charlie lobe of this colour and roughness.
@@ -161,6 +177,7 @@ impl Pbr {
             clearcoat: None,
             transmission: None,
             sheen: None,
+            iridescence: None,
         }
     }
 }
@@ -324,6 +341,11 @@ impl Material {
             p.sheen
                 .iter()
                 .flat_map(|t| [t.color_map.as_ref(), t.roughness_map.as_ref()]),
+        )
+        .chain(
+            p.iridescence
+                .iter()
+                .flat_map(|t| [t.map.as_ref(), t.thickness_map.as_ref()]),
         )
         .flatten()
     }

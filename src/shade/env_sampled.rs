@@ -195,7 +195,7 @@ pub fn radiance(
 ) -> Vec3 {
     let (c_diff, spec_weight, roughness) = match lobes {
         Lobes::Pbr(c) => {
-            let s = pbr::specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
+            let s = c.specular_albedo(n.dot(v).abs());
             (c.c_diff(), luminance(s), c.roughness)
         }
         Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness),

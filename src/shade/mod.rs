@@ -6,6 +6,7 @@ pub mod blinn_phong;
 pub mod env;
 pub mod env_sampled;
 pub mod gouraud;
+pub mod iridescence;
 pub mod light;
 pub mod pbr;
 pub mod shadow;
@@ -358,7 +359,19 @@ impl ShadeContext<'_> {
             color: k.color * get(&k.color_map).map_or(Vec3::ONE, |c| c.truncate()),
             roughness: (k.roughness * get(&k.roughness_map).map_or(1.0, |c| c.w)).clamp(0.0, 1.0),
         });
+        let iridescence = p.iridescence.as_ref().and_then(|k| {
+            let factor = (k.factor * get(&k.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
+            (factor > 0.0).then(|| pbr::Iridescence {
+                factor,
+                ior: k.ior,
+                thickness: match get(&k.thickness_map) {
+                    Some(c) => k.thickness_min + (k.thickness_max - k.thickness_min) * c.y,
+                    None => k.thickness_max,
+                },
+            })
+        });
         PbrColor {
+            iridescence,
             base,
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),

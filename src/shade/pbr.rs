@@ -30,6 +30,10 @@
 //!
 //! - sheen (`shade::sheen`): a Charlie lobe over the base, which it
 //!   scales by 1 - max(C) E (under the clearcoat; emission is not scaled).
+//! - iridescence (`shade::iridescence`): a thin film whose Fresnel
+//!   (at v.h for lights, n.v for the split sum, over the base's F0)
+//!   replaces Schlick's by its factor, in the specular lobe and in the
+//!   1 - F that the diffuse lobe keeps.
 //!
 //! Note the 1/pi: under the same light, a white Lambertian pbr surface is
 //! 1/pi as bright as Blinn-Phong Kd 1, whose formula (the scene format's)
@@ -40,6 +44,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::env::EnvLight;
+pub use super::iridescence::Iridescence;
 use super::light::for_each_lit;
 pub use super::sheen::Sheen;
 use crate::scene::Light;
@@ -65,6 +70,8 @@ pub struct PbrColor {
     pub transmission: f32,
     /// Volume transmittance along the thickness (1: none).
     pub attenuation: Vec3,
+    /// A thin film over the material (KHR_materials_iridescence).
+    pub iridescence: Option<Iridescence>,
 }
 
 /// A clearcoat layer at one point.
@@ -138,6 +145,31 @@ impl PbrColor {
     pub fn c_diff(&self) -> Vec3 {
         self.base * (1.0 - self.metallic)
     }
+
+    /// The split sum's specular albedo f0 A + f90 B for the environment
+    /// BRDF's scale `a` and bias `b`; with a film, blended towards its
+    /// Fresnel at n.v = `ndv` times the lobe's albedo A + B.
+    #[inline]
+    pub fn split_sum(&self, ndv: f32, a: f32, b: f32) -> Vec3 {
+        let f0 = self.f0();
+        let s = f0 * a + Vec3::splat(b * self.f90());
+        match &self.iridescence {
+            Some(film) if film.factor > 0.0 => {
+                let f = film.fresnel(ndv, f0).min(Vec3::ONE);
+                s.lerp(f * (a + b), film.factor)
+            }
+            _ => s,
+        }
+    }
+
+    /// Specular albedo under uniform light at n.v = `ndv` (the analytic
+    /// fit of the environment BRDF, clamped to [0, 1]: the fit overshoots
+    /// slightly at grazing angles).
+    #[inline]
+    pub fn specular_albedo(&self, ndv: f32) -> Vec3 {
+        let (a, b) = env_brdf(self.roughness, ndv);
+        self.split_sum(ndv, a, b).clamp(Vec3::ZERO, Vec3::ONE)
+    }
 }
 
 /// The BRDF f(v, l) (no cosine), with unit normal `n`, unit view `v` and
@@ -153,7 +185,10 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     let vdh = v.dot(h).abs();
     let a2 = c.alpha() * c.alpha();
     let f0 = c.f0();
-    let fresnel = f0 + (Vec3::splat(c.f90()) - f0) * (1.0 - vdh).powi(5);
+    let mut fresnel = f0 + (Vec3::splat(c.f90()) - f0) * (1.0 - vdh).powi(5);
+    if let Some(film) = &c.iridescence {
+        fresnel = film.blend(fresnel, vdh, f0);
+    }
     let diffuse = if c.transmission > 0.0 {
         c.c_diff() * (1.0 - c.transmission)
     } else {
@@ -202,7 +237,7 @@ pub fn transmittance(n: Vec3, v: Vec3, c: &PbrColor) -> Vec3 {
     if c.transmission <= 0.0 {
         return Vec3::ZERO;
     }
-    let spec = specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
+    let spec = c.specular_albedo(n.dot(v).abs());
     let coat = c.coat.map_or(1.0, |k| 1.0 - k.weight(v));
     let sheen = c.sheen.map_or(1.0, |s| s.scaling(n.dot(v).abs(), None));
     (Vec3::ONE - spec)
@@ -242,7 +277,7 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> Vec3 {
     let ndv = n.dot(v).abs().max(1e-4);
     let ab = env.brdf(ndv, c.roughness);
-    let spec = c.f0() * ab.x + Vec3::splat(ab.y * c.f90());
+    let spec = c.split_sum(ndv, ab.x, ab.y);
     let c_diff = if c.transmission > 0.0 {
         c.c_diff() * (1.0 - c.transmission)
     } else {
@@ -301,7 +336,7 @@ pub fn radiance(
     let mut out = c.emissive;
     for_each_lit(lights, shadow, p, n, |l, e| out += e * brdf(n, v, l, c));
     if ambient != Vec3::ZERO {
-        let spec = specular_albedo(c.f0(), c.f90(), c.roughness, n.dot(v).abs());
+        let spec = c.specular_albedo(n.dot(v).abs());
         let c_diff = if c.transmission > 0.0 {
             c.c_diff() * (1.0 - c.transmission)
         } else {
@@ -332,7 +367,7 @@ fn layered_radiance(
     let ndv = n.dot(v).abs();
     let mut under = Vec3::ZERO;
     if ambient != Vec3::ZERO {
-        let spec = specular_albedo(c.f0(), c.f90(), c.roughness, ndv);
+        let spec = c.specular_albedo(ndv);
         let c_diff = c.c_diff() * (1.0 - c.transmission);
         under = ambient * c.occlusion * (c_diff * (Vec3::ONE - spec) + spec);
         if let Some(s) = &c.sheen {
@@ -368,6 +403,7 @@ mod tests {
             sheen: None,
             transmission: 0.0,
             attenuation: Vec3::ONE,
+            iridescence: None,
         }
     }
 

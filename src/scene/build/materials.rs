@@ -14,8 +14,8 @@ use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
 use crate::scene::material::{
-    AlphaMode, Clearcoat, DielectricSpecular, Material, Native, NormalMap, NormalSpace, Pbr,
-    SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
+    AlphaMode, Clearcoat, DielectricSpecular, IridescenceLayer, Material, Native, NormalMap,
+    NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -391,6 +391,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         emissive_map: map_ke.clone(),
         specular: None,
         sheen: None,
+        iridescence: None,
         clearcoat: m.pc.map(unit).filter(|c| *c > 0.0).map(|factor| Clearcoat {
             factor,
             map: None,
@@ -504,6 +505,14 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             color_map: tex(&t.color_texture, true),
             roughness: t.roughness,
             roughness_map: tex(&t.roughness_texture, false),
+        }),
+        iridescence: g.iridescence.as_ref().map(|t| IridescenceLayer {
+            factor: t.factor,
+            map: tex(&t.texture, false),
+            ior: t.ior,
+            thickness_min: t.thickness_min,
+            thickness_max: t.thickness_max,
+            thickness_map: tex(&t.thickness_texture, false),
         }),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the
