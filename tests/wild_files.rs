@@ -185,3 +185,17 @@ fn tga_dds_and_ktx2_textures_decode_to_their_source_image() {
         }
     }
 }
+
+/// Inputs the fuzz targets found crashes with, kept as files: each is now
+/// refused (an error or a miss), never a panic.
+#[test]
+fn fuzz_found_inputs_are_refused_not_panicked_on() {
+    use softraster::assets::texture::Texture;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    // The texture target, 2026-11-24: a texture-cache entry whose level
+    // sizes overflowed the byte count (a multiplication overflow panic).
+    let bytes = std::fs::read(dir.join("fuzz_texture_cache_overflow.srtex")).unwrap();
+    for srgb in [false, true] {
+        assert!(Texture::from_cache_bytes(&bytes, srgb).is_none());
+    }
+}
