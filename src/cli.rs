@@ -92,7 +92,7 @@ struct RenderArgs {
     max_memory: Option<u64>,
     /// Keep decoded textures and their mip chains in DIR between runs,
     /// keyed by a hash of each image's content (opt-in; created if
-    /// missing; safe to share between runs and machines' renders).
+    /// missing; renders running at the same time may share it).
     #[arg(long, value_name = "DIR")]
     cache: Option<PathBuf>,
 }
