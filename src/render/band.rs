@@ -19,10 +19,11 @@ use glam::{Vec2, Vec3, Vec4};
 use super::frame::AovPixel;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
+use super::lanes::{LaneQueue, Pending};
 use super::rays::CameraRays;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
-use crate::assets::texture::Gradients;
+use crate::assets::texture::{Footprint, Gradients};
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
     MAX_SAMPLES, NO_TRIANGLE, Visibility, in_front, raster_samples, raster_triangle,
@@ -34,6 +35,7 @@ use crate::scene::material::AlphaMode;
 use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
 use crate::shade::ao::GPixel;
+use crate::shade::blinn_phong4::{LaneMaterial, MAX_SIZES};
 use crate::shade::env::EnvLight;
 use crate::shade::{ShadeContext, SizedFootprint, Surface, TexCoords, background};
 
@@ -60,11 +62,16 @@ pub(super) struct FrameData<'a> {
     /// Shading reads the triangle's plane normal (flat shading, shadows,
     /// AO); otherwise it is not computed.
     pub geo_normal: bool,
+    /// Per draw: its material prepared for shading four fragments at a
+    /// time, or None (the one-fragment path).
+    lanes: Vec<Option<LaneMaterial<'a>>>,
 }
 
 impl<'a> FrameData<'a> {
     /// `grads`: the texture filter reads derivatives (trilinear,
-    /// anisotropic).
+    /// anisotropic). `lanes`: shade the materials that allow it four
+    /// fragments at a time (`shade::blinn_phong4`; the same pixels).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         fs: &'a FrameSetup<'a>,
         ctx: ShadeContext<'a>,
@@ -73,6 +80,7 @@ impl<'a> FrameData<'a> {
         pattern: &'static [(i8, i8)],
         grads: bool,
         tracer: Option<&'a Tracer<'a>>,
+        lanes: bool,
     ) -> FrameData<'a> {
         let s = &fs.scene.settings;
         let alpha = geo
@@ -84,6 +92,17 @@ impl<'a> FrameData<'a> {
             || !ctx.shadows.lights.is_empty()
             || s.ao.method != AoMethod::Off
             || ctx.env_sampled.is_some();
+        let lanes = geo
+            .draws
+            .iter()
+            .map(|d| {
+                let model = &fs.scene.models[d.model];
+                let uvs = !model.mesh.uvs.is_empty();
+                let tangents = !verts[d.model].tangent.is_empty();
+                let m = &model.materials[d.material];
+                lanes.then(|| ctx.lane_material(m, uvs, tangents)).flatten()
+            })
+            .collect();
         FrameData {
             fs,
             verts,
@@ -97,8 +116,15 @@ impl<'a> FrameData<'a> {
             ground: Ground::new(fs, &ctx, tracer, geo.grid.width, geo.grid.height),
             grads,
             geo_normal,
+            lanes,
             ctx,
         }
+    }
+
+    /// Draw `draw`'s material prepared for the lanes, if it is.
+    #[inline]
+    pub(super) fn lane_material(&self, draw: usize) -> Option<&LaneMaterial<'a>> {
+        self.lanes.get(draw).and_then(|l| l.as_ref())
     }
 
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
@@ -407,6 +433,9 @@ impl<'a> FrameData<'a> {
                 }
             }
         }
+        let mut queue =
+            (self.lanes.iter().any(|l| l.is_some())).then(|| LaneQueue::new(self.draws.len()));
+        let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
         for qy in (0..th).step_by(2) {
             for qx in (0..tw).step_by(2) {
                 if filled {
@@ -452,55 +481,134 @@ impl<'a> FrameData<'a> {
                         continue;
                     }
                     let occlusion = ao.map_or(1.0, |a| a[i]);
-                    let mut acc = Vec4::ZERO;
-                    let mut nearest = f32::INFINITY;
-                    let frags = if n == 1 {
-                        smallvec::smallvec![(ids[0], 1)]
-                    } else {
-                        fragments(ids)
+                    let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
+                    let mut at = FragmentAt {
+                        pixel: i as u32,
+                        px: (px, py),
+                        q0,
+                        ao: occlusion,
+                        cache: &mut cache,
+                        quad: &mut quad,
+                        queue: queue.as_mut(),
                     };
-                    for (id, mask) in frags {
+                    if n == 1 {
+                        // One fragment; a queued one is written by the
+                        // lanes.
+                        if let Some(part) = self.fragment(&mut at, ids[0], 1) {
+                            (color[i], depth[i]) = resolve(&[part], &[], inv_n);
+                        }
+                        continue;
+                    }
+                    let mut parts: smallvec::SmallVec<[Part; 4]> = smallvec::SmallVec::new();
+                    let mut queued = false;
+                    for (id, mask) in fragments(ids) {
                         let count = mask.count_ones() as f32;
                         if id == NO_TRIANGLE {
-                            acc += bg * count;
+                            parts.push(Part::Shaded(bg, f32::INFINITY, count));
                             continue;
                         }
-                        let t = &self.tris[id as usize];
-                        let it = cache.get(id, t);
-                        let k = match quad.iter().position(|q| q.id == id) {
-                            Some(k) => k,
+                        at.pixel = LANE_SLOT;
+                        match self.fragment(&mut at, id, mask) {
+                            Some(p) => parts.push(p),
                             None => {
-                                let grads = if self.grads {
-                                    let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
-                                    self.gradients(t, it, q0)
-                                } else {
-                                    [Gradients::default(); 2]
-                                };
-                                quad.push(QuadEntry {
-                                    id,
-                                    grads,
-                                    footprints: [None; 2],
-                                });
-                                quad.len() - 1
+                                queued = true;
+                                let slot = at.queue.as_ref().map_or(0, |q| q.len() - 1);
+                                parts.push(Part::Queued(slot, count));
                             }
-                        };
-                        let q = &mut quad[k];
-                        let frag = self.shading_point(it, px, py, mask);
-                        let (grads, fps) = (q.grads, q.footprints);
-                        let (c, d, fps) =
-                            self.shade_with(t, it, frag, (px, py), grads, fps, occlusion);
-                        quad[k].footprints = fps;
-                        // A NaN from degenerate input must not poison the
-                        // frame: such a fragment is black.
-                        let c = if c.is_finite() { c } else { Vec3::ZERO };
-                        acc += c.extend(1.0) * count;
-                        nearest = nearest.min(d);
+                        }
                     }
-                    color[i] = acc * inv_n;
-                    depth[i] = nearest;
+                    if queued {
+                        deferred.push((i, parts));
+                    } else {
+                        (color[i], depth[i]) = resolve(&parts, &[], inv_n);
+                    }
                 }
             }
         }
+        // The queued fragments, four at a time: one-sample pixels written
+        // at once, the others resolved after.
+        if let Some(queue) = queue.filter(|q| !q.is_empty()) {
+            let mut shaded = vec![
+                (Vec3::ZERO, 0.0);
+                if deferred.is_empty() {
+                    0
+                } else {
+                    queue.len() as usize
+                }
+            ];
+            queue.shade(self, |slot, pixel, c, d| {
+                if pixel == LANE_SLOT {
+                    shaded[slot as usize] = (c, d);
+                } else {
+                    let i = pixel as usize;
+                    (color[i], depth[i]) = resolve(&[Part::Queued(0, 1.0)], &[(c, d)], inv_n);
+                }
+            });
+            for (i, parts) in deferred {
+                (color[i], depth[i]) = resolve(&parts, &shaded, inv_n);
+            }
+        }
+    }
+
+    /// Shades the fragment of triangle `id` covering samples `mask` of
+    /// the pixel `at` describes: its part of the pixel, or None where it
+    /// is queued for the lanes (`at.queue`, with `at.pixel`).
+    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> Option<Part> {
+        let count = mask.count_ones() as f32;
+        let t = &self.tris[id as usize];
+        let it = at.cache.get(id, t);
+        let lane = self
+            .lane_material(t.draw as usize)
+            .filter(|_| at.queue.is_some());
+        let quad = &mut *at.quad;
+        let k = match quad.iter().position(|q| q.id == id) {
+            Some(k) => k,
+            None => {
+                let grads = if !self.grads {
+                    [Gradients::default(); 2]
+                } else if lane.is_some() {
+                    // The lanes read set 0 only.
+                    [self.gradients0(t, it, at.q0), Gradients::default()]
+                } else {
+                    self.gradients(t, it, at.q0)
+                };
+                quad.push(QuadEntry {
+                    id,
+                    grads,
+                    footprints: [None; 2],
+                    lane_footprints: None,
+                });
+                quad.len() - 1
+            }
+        };
+        let (px, py) = at.px;
+        let frag = self.shading_point(it, px, py, mask);
+        if let (Some(queue), Some(lm)) = (at.queue.as_mut(), lane) {
+            let q = &mut quad[k];
+            let footprints = *q
+                .lane_footprints
+                .get_or_insert_with(|| lm.footprints(&self.ctx, q.grads[0]));
+            queue.push(
+                t.draw,
+                Pending {
+                    id,
+                    pixel: at.pixel,
+                    lambda: frag.lambda,
+                    w: frag.w,
+                    footprints,
+                    ao: at.ao,
+                },
+            );
+            return None;
+        }
+        let q = &quad[k];
+        let (grads, fps) = (q.grads, q.footprints);
+        let (c, d, fps) = self.shade_with(t, it, frag, (px, py), grads, fps, at.ao);
+        quad[k].footprints = fps;
+        // A NaN from degenerate input must not poison the frame: such a
+        // fragment is black.
+        let c = if c.is_finite() { c } else { Vec3::ZERO };
+        Some(Part::Shaded(c.extend(1.0), d, count))
     }
 
     /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
@@ -528,7 +636,11 @@ impl<'a> FrameData<'a> {
 
     /// The material of `t`, its texture coordinates (both sets) and vertex
     /// color at barycentrics `l`.
-    fn material_uv(&self, t: &Tri, l: Vec3) -> (&crate::scene::Material, [Option<Vec2>; 2], Vec4) {
+    pub(super) fn material_uv(
+        &self,
+        t: &Tri,
+        l: Vec3,
+    ) -> (&crate::scene::Material, [Option<Vec2>; 2], Vec4) {
         let d = self.draws[t.draw as usize];
         let model = &self.fs.scene.models[d.model];
         let mesh = &model.mesh;
@@ -561,6 +673,26 @@ impl<'a> FrameData<'a> {
             },
             _ => Gradients::default(),
         })
+    }
+
+    /// `gradients` of set 0 alone.
+    fn gradients0(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
+        let d = self.draws[t.draw as usize];
+        let mesh = &self.fs.scene.models[d.model].mesh;
+        let uv = &mesh.uvs;
+        if uv.is_empty() {
+            return Gradients::default();
+        }
+        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let at = |px: i32, py: i32| {
+            let l = it.at_pixel(px, py).lambda;
+            uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
+        };
+        let (a, b, c) = (at(q0.0, q0.1), at(q0.0 + 1, q0.1), at(q0.0, q0.1 + 1));
+        Gradients {
+            dx: b - a,
+            dy: c - a,
+        }
     }
 
     /// Color (linear, or the data view's value) and view depth of triangle
@@ -656,7 +788,7 @@ impl<'a> FrameData<'a> {
 
     /// Position, normals and view depth of triangle `t` at a fragment.
     #[inline]
-    fn point(&self, t: &Tri, frag: Fragment) -> Point {
+    pub(super) fn point(&self, t: &Tri, frag: Fragment) -> Point {
         let ctx = &self.ctx;
         let d = self.draws[t.draw as usize];
         let model = &self.fs.scene.models[d.model];
@@ -765,17 +897,62 @@ struct QuadEntry {
     id: u32,
     grads: [Gradients; 2],
     footprints: [Option<SizedFootprint>; 2],
+    /// Lane-shaded materials: the footprints per texture size.
+    lane_footprints: Option<[Footprint; MAX_SIZES]>,
+}
+
+/// Where `FrameData::fragment` shades: the pixel (its index in the band,
+/// or `LANE_SLOT` for a pixel resolved after the lanes), its position and
+/// its quad's top-left pixel, its AO, and the band's state.
+struct FragmentAt<'c, 'q> {
+    pixel: u32,
+    px: (i32, i32),
+    q0: (i32, i32),
+    ao: f32,
+    cache: &'c mut InterpolatorCache,
+    quad: &'c mut smallvec::SmallVec<[QuadEntry; 4]>,
+    queue: Option<&'q mut LaneQueue>,
+}
+
+/// A queued fragment whose pixel is resolved from its slot.
+const LANE_SLOT: u32 = u32::MAX;
+
+/// One fragment's share of a pixel: shaded already (linear RGBA, view
+/// depth, sample count) or queued for the lanes (slot, sample count).
+enum Part {
+    Shaded(Vec4, f32, f32),
+    Queued(u32, f32),
+}
+
+/// A pixel's colour and depth from its fragments in order: their colours
+/// weighted by sample counts over `1 / inv_n` samples, the nearest depth.
+/// `shaded`: the lane results by slot.
+fn resolve(parts: &[Part], shaded: &[(Vec3, f32)], inv_n: f32) -> (Vec4, f32) {
+    let mut acc = Vec4::ZERO;
+    let mut nearest = f32::INFINITY;
+    for p in parts {
+        let (c, d, count) = match *p {
+            Part::Shaded(c, d, count) => (c, d, count),
+            Part::Queued(slot, count) => {
+                let (c, d) = shaded[slot as usize];
+                (c.extend(1.0), d, count)
+            }
+        };
+        acc += c * count;
+        nearest = nearest.min(d);
+    }
+    (acc * inv_n, nearest)
 }
 
 /// A surface point as the rasterizer sees it.
-struct Point {
-    position: Vec3,
-    raw_normal: Vec3,
+pub(super) struct Point {
+    pub position: Vec3,
+    pub raw_normal: Vec3,
     /// Interpolated unit normal, on the side the camera sees.
-    normal: Vec3,
+    pub normal: Vec3,
     /// The triangle's plane normal, on the side the camera sees.
-    geo_normal: Vec3,
-    view_depth: f32,
+    pub geo_normal: Vec3,
+    pub view_depth: f32,
 }
 
 /// The distinct triangle ids among one pixel's samples, each with the mask

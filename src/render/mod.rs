@@ -26,6 +26,7 @@ mod exposure;
 mod frame;
 mod geometry;
 mod ground;
+mod lanes;
 mod lines;
 pub mod memory;
 mod rays;
@@ -86,6 +87,9 @@ pub struct Renderer {
     /// The last frame's shadow maps (reused while nothing they depend on
     /// moves).
     shadow_maps: shadow_pass::MapCache,
+    /// Shade the materials that allow it four fragments at a time
+    /// (`shade::blinn_phong4`); off only to compare the two paths.
+    lanes: bool,
 }
 
 impl Renderer {
@@ -118,7 +122,16 @@ impl Renderer {
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
+            lanes: true,
         }
+    }
+
+    /// With `on = false`, every fragment takes the one-fragment shading
+    /// path. The frames are the same either way (tests compare them
+    /// byte for byte); the switch is for those tests and for measuring.
+    pub fn with_lanes(mut self, on: bool) -> Renderer {
+        self.lanes = on;
+        self
     }
 
     /// Renders frame `frame` of camera `camera` into `out`, reusing its
@@ -132,7 +145,9 @@ impl Renderer {
     /// renderer of their own is made for the call.
     pub fn render(&self, scene: &Scene, camera: usize, frame: u32, out: &mut Frame) {
         if !self.serves(scene) {
-            return Renderer::new(scene).render(scene, camera, frame, out);
+            return Renderer::new(scene)
+                .with_lanes(self.lanes)
+                .render(scene, camera, frame, out);
         }
         let fs = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
@@ -311,7 +326,16 @@ impl Renderer {
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
-        let data = band::FrameData::new(fs, ctx, &verts, &geo, pattern, filtered, tracer.as_ref());
+        let data = band::FrameData::new(
+            fs,
+            ctx,
+            &verts,
+            &geo,
+            pattern,
+            filtered,
+            tracer.as_ref(),
+            self.lanes,
+        );
         self.bands(&data, &geo, tracer.as_ref(), out);
         if !s.shading.is_data_view() {
             lines::draw(fs, &verts, width as f32 / s.width as f32, out);

@@ -3,10 +3,12 @@
 
 pub mod ao;
 pub mod blinn_phong;
+pub mod blinn_phong4;
 pub mod env;
 pub mod env_sampled;
 pub mod gouraud;
 pub mod iridescence;
+pub mod lanes;
 pub mod light;
 pub mod pbr;
 pub mod shadow;
@@ -184,7 +186,7 @@ impl ShadeContext<'_> {
             ShadingMode::Gouraud => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let (d, sp) = s.vertex_light.unwrap_or((Vec3::ZERO, Vec3::ZERO));
-                let env = self.env_blinn_phong(s, s.normal, &c);
+                let env = self.env_blinn_phong(s.position, s.normal, s.geo_normal, s.ao, &c);
                 blinn_phong::combine(&c, self.ambient * s.ao, d, sp) + env
             }
             ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
@@ -194,7 +196,7 @@ impl ShadeContext<'_> {
                 let v = self.view_vector(s.position);
                 let n = self.mapped_normal(s);
                 let ambient = self.ambient * s.ao;
-                let env = self.env_blinn_phong(s, n, &c);
+                let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
                 blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
                     + env
             }
@@ -202,7 +204,7 @@ impl ShadeContext<'_> {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 let (n, ambient) = (s.normal, self.ambient * s.ao);
-                let env = self.env_blinn_phong(s, n, &c);
+                let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
                 blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
                     + env
             }
@@ -255,12 +257,20 @@ impl ShadeContext<'_> {
     /// `n`: Kd E(n) / pi (times AO) plus Ks times the radiance prefiltered
     /// along the reflection with the GGX lobe that matches Ns (zero
     /// without an environment).
-    fn env_blinn_phong(&self, s: &Surface, n: Vec3, c: &SurfaceColor) -> Vec3 {
+    /// `position`, `geo_normal` and `ao` are the surface's.
+    fn env_blinn_phong(
+        &self,
+        position: Vec3,
+        n: Vec3,
+        geo_normal: Vec3,
+        ao: f32,
+        c: &SurfaceColor,
+    ) -> Vec3 {
         // illum 0 is the colour alone, without any light.
         let Some(env) = self.env.filter(|_| c.illum > 0) else {
             return Vec3::ZERO;
         };
-        let v = self.view_vector(s.position);
+        let v = self.view_vector(position);
         let roughness = crate::scene::material::roughness_from_ns(c.ns);
         if let Some((e, tracer, samples)) = self.env_sampled {
             let lobes = env_sampled::Lobes::BlinnPhong {
@@ -268,18 +278,9 @@ impl ShadeContext<'_> {
                 ks: c.ks,
                 roughness,
             };
-            return env_sampled::radiance(
-                e,
-                tracer,
-                s.position,
-                n,
-                s.geo_normal,
-                v,
-                &lobes,
-                samples,
-            );
+            return env_sampled::radiance(e, tracer, position, n, geo_normal, v, &lobes, samples);
         }
-        let diffuse = c.kd * env.irradiance(n) * (s.ao / std::f32::consts::PI);
+        let diffuse = c.kd * env.irradiance(n) * (ao / std::f32::consts::PI);
         if c.ks == Vec3::ZERO {
             return diffuse;
         }

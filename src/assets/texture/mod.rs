@@ -13,12 +13,15 @@
 //! both directions. Textures are cache-bound on minified models, so this is
 //! worth a few shifts per fetch.
 
+mod lanes;
+
 use std::path::Path;
 
 use glam::{Affine2, Vec2, Vec4};
 
 use crate::color::srgb_to_linear_table;
 use crate::error::Error;
+pub use lanes::Rgb4;
 
 /// Texture filtering, ordered from the least to the most filtering (a
 /// sampler's limit lowers a scene's filter to it, never raises it).
@@ -607,7 +610,12 @@ impl Texture {
     /// texture of that size looked up with those derivatives, so a
     /// material's maps share it.
     pub fn footprint(&self, g: Gradients, f: &Filtering) -> Footprint {
-        let size = Vec2::new(self.width as f32, self.height as f32);
+        Texture::footprint_of_size(self.width, self.height, g, f)
+    }
+
+    /// `footprint` of any texture of `width` x `height` texels.
+    pub fn footprint_of_size(width: u32, height: u32, g: Gradients, f: &Filtering) -> Footprint {
+        let size = Vec2::new(width as f32, height as f32);
         let (ax, ay) = (g.dx * size, g.dy * size);
         let (lx, ly) = (ax.length(), ay.length());
         if f.filter != TextureFilter::Anisotropic {

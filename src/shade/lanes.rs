@@ -1,0 +1,223 @@
+//! Four shading points at once: 3-vectors held as a structure of arrays
+//! (x, y and z each a `Vec4` of four lanes), with the operations of glam's
+//! `Vec3` done lane by lane in the same order, so that every lane is bit
+//! for bit what the one-point code computes (IEEE operations on SSE lanes
+//! round as scalar ones do, and Rust never fuses a multiply and an add).
+
+// Loops over the four lanes index several per-lane arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+use glam::{BVec4A, Vec3, Vec4};
+
+/// Four 3-vectors, one per lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct V3 {
+    pub x: Vec4,
+    pub y: Vec4,
+    pub z: Vec4,
+}
+
+impl V3 {
+    pub const ZERO: V3 = V3 {
+        x: Vec4::ZERO,
+        y: Vec4::ZERO,
+        z: Vec4::ZERO,
+    };
+
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V3 {
+        V3 {
+            x: Vec4::splat(v.x),
+            y: Vec4::splat(v.y),
+            z: Vec4::splat(v.z),
+        }
+    }
+
+    #[inline(always)]
+    pub fn from_lanes(v: [Vec3; 4]) -> V3 {
+        V3 {
+            x: Vec4::new(v[0].x, v[1].x, v[2].x, v[3].x),
+            y: Vec4::new(v[0].y, v[1].y, v[2].y, v[3].y),
+            z: Vec4::new(v[0].z, v[1].z, v[2].z, v[3].z),
+        }
+    }
+
+    #[inline(always)]
+    pub fn lane(&self, k: usize) -> Vec3 {
+        Vec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    /// `Vec3::dot`: (x x') + (y y') + (z z').
+    #[inline(always)]
+    pub fn dot(self, o: V3) -> Vec4 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// `Vec3::cross`.
+    #[inline(always)]
+    pub fn cross(self, o: V3) -> V3 {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// Each lane's vector times that lane's scalar (`Vec3 * f32`).
+    #[inline(always)]
+    pub fn scale(self, s: Vec4) -> V3 {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+
+    /// Lane by lane: `a` where `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: BVec4A, a: V3, b: V3) -> V3 {
+        V3 {
+            x: Vec4::select(m, a.x, b.x),
+            y: Vec4::select(m, a.y, b.y),
+            z: Vec4::select(m, a.z, b.z),
+        }
+    }
+
+    /// `Vec3::length_recip`: 1 / sqrt(dot).
+    #[inline(always)]
+    pub fn length_recip(self) -> Vec4 {
+        Vec4::ONE / self.dot(self).sqrt()
+    }
+
+    /// `Vec3::try_normalize` per lane: the unit vector and the lanes where
+    /// it exists (the reciprocal length is finite and positive).
+    #[inline(always)]
+    pub fn try_normalize(self) -> (V3, BVec4A) {
+        let rcp = self.length_recip();
+        let ok = rcp.is_finite_mask() & rcp.cmpgt(Vec4::ZERO);
+        (self.scale(rcp), ok)
+    }
+
+    /// `Vec3::normalize_or`.
+    #[inline(always)]
+    pub fn normalize_or(self, fallback: V3) -> V3 {
+        let (n, ok) = self.try_normalize();
+        V3::select(ok, n, fallback)
+    }
+
+    /// The lanes where all three components are finite.
+    #[inline(always)]
+    pub fn is_finite_mask(self) -> BVec4A {
+        self.x.is_finite_mask() & self.y.is_finite_mask() & self.z.is_finite_mask()
+    }
+}
+
+/// Component-wise sum.
+impl Add for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn add(self, o: V3) -> V3 {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+/// Component-wise difference.
+impl Sub for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn sub(self, o: V3) -> V3 {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+/// Component-wise product (`Vec3 * Vec3`).
+impl Mul for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn mul(self, o: V3) -> V3 {
+        V3 {
+            x: self.x * o.x,
+            y: self.y * o.y,
+            z: self.z * o.z,
+        }
+    }
+}
+
+/// Each lane's vector over that lane's scalar (`Vec3 / f32`).
+impl Div<Vec4> for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn div(self, s: Vec4) -> V3 {
+        V3 {
+            x: self.x / s,
+            y: self.y / s,
+            z: self.z / s,
+        }
+    }
+}
+
+impl Neg for V3 {
+    type Output = V3;
+    #[inline(always)]
+    fn neg(self) -> V3 {
+        V3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
+/// `a x + b y + c z` lane by lane, in that order (barycentric weights
+/// (x, y, z) of a triangle's corners, as `Vec3 * f32` sums).
+#[inline(always)]
+pub fn lerp3(a: V3, b: V3, c: V3, l: V3) -> V3 {
+    a.scale(l.x) + b.scale(l.y) + c.scale(l.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lanes_are_bit_for_bit_the_scalar_operations() {
+        let mut s = 12345u32;
+        let mut r = || {
+            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (s >> 8) as f32 / (1u32 << 23) as f32 - 1.0
+        };
+        for _ in 0..500 {
+            let a = [0; 4].map(|_| Vec3::new(r(), r(), r()));
+            let b = [0; 4].map(|_| Vec3::new(r(), r(), r()) * 3.0);
+            let (va, vb) = (V3::from_lanes(a), V3::from_lanes(b));
+            let zero = V3::from_lanes([a[0], Vec3::ZERO, a[2], Vec3::ZERO]);
+            let n = zero.normalize_or(V3::splat(Vec3::Y));
+            for k in 0..4 {
+                assert_eq!(va.dot(vb)[k].to_bits(), a[k].dot(b[k]).to_bits());
+                assert_eq!(va.cross(vb).lane(k), a[k].cross(b[k]));
+                assert_eq!(va.normalize_or(vb).lane(k), a[k].normalize_or(b[k]));
+                assert_eq!(
+                    n.lane(k),
+                    zero.lane(k).normalize_or(Vec3::Y),
+                    "zero vectors fall back"
+                );
+                let l = Vec3::new(r(), r(), r());
+                let vl = V3::splat(l);
+                assert_eq!(
+                    lerp3(va, vb, va, vl).lane(k),
+                    a[k] * l.x + b[k] * l.y + a[k] * l.z
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,223 @@
+//! Shading four fragments at a time (`shade::blinn_phong4`) gives the
+//! frames of the one-fragment path bit for bit: colour and depth of every
+//! pixel, over scenes that reach each of its branches (maps, normal maps,
+//! vertex colours, every light kind with ranges and shadows, the
+//! environment, AO, MSAA, anisotropic and trilinear filtering, address
+//! modes, orthographic cameras, illum 0 and 1).
+
+mod common;
+
+use common::{scene_in, scratch, shared_assets};
+use softraster::render::{Frame, Renderer};
+use softraster::scene::Scene;
+use softraster::scene::build::LoadOptions;
+
+/// Frames `frames` of camera 0 with and without the lanes; panics at the
+/// first pixel that differs in any bit.
+fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
+    let lanes = Renderer::new(scene);
+    let single = Renderer::new(scene).with_lanes(false);
+    for &f in frames {
+        let (mut a, mut b) = (Frame::new(0, 0), Frame::new(0, 0));
+        lanes.render(scene, 0, f, &mut a);
+        single.render(scene, 0, f, &mut b);
+        assert_eq!(a.color.len(), b.color.len());
+        let mut covered = 0;
+        for (i, (x, y)) in a.color.iter().zip(&b.color).enumerate() {
+            let bits = |v: glam::Vec4| v.to_array().map(f32::to_bits);
+            assert!(
+                bits(*x) == bits(*y) && a.depth[i].to_bits() == b.depth[i].to_bits(),
+                "{what}, frame {f}, pixel {} {}: lanes {x} depth {} against {y} depth {}",
+                i as u32 % a.width,
+                i as u32 / a.width,
+                a.depth[i],
+                b.depth[i]
+            );
+            covered += a.depth[i].is_finite() as usize;
+        }
+        assert!(covered > 100, "{what}: only {covered} pixels covered");
+    }
+}
+
+fn with(scene: &Path, sets: &[&str]) -> Scene {
+    let opts = LoadOptions {
+        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
+        ..Default::default()
+    };
+    Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"))
+}
+
+use std::path::Path;
+
+#[test]
+fn the_showcase_is_the_same_with_and_without_lanes() {
+    // Studio environment, ray-traced shadows, SSAO, MSAA 4, MTL maps.
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
+    let small = ["output.width=160", "output.height=120"];
+    same_both_ways(&with(&scene, &small), &[0, 5], "showcase");
+    let mut sets = small.to_vec();
+    sets.extend([
+        "render.msaa=1",
+        "render.shadows=\"pcf\"",
+        "render.ao.method=\"off\"",
+    ]);
+    same_both_ways(&with(&scene, &sets), &[3], "showcase, pcf, one sample");
+}
+
+#[test]
+fn textured_character_is_the_same_with_and_without_lanes() {
+    let Some(assets) = shared_assets() else {
+        return;
+    };
+    let dir = scratch("lanes_diablo3");
+    let d = assets.join("tinyrenderer/diablo3_pose");
+    let scene = format!(
+        r#"
+[output]
+width = 200
+height = 200
+[render]
+texture_filter = "{filter}"
+msaa = {msaa}
+cull = "back"
+[ambient]
+color = [0.06, 0.06, 0.07]
+[animation]
+frames = 72
+turntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360 }}
+[[model]]
+path = "{d}/diablo3_pose.obj"
+[model.material]
+illum = 2
+kd = [1.0, 1.0, 1.0]
+ks = [0.5, 0.5, 0.5]
+ns = 32.0
+map_kd = "{d}/diablo3_pose_diffuse.tga"
+map_ks = "{d}/diablo3_pose_spec.tga"
+norm = "{d}/diablo3_pose_nm_tangent.tga"
+[[light]]
+kind = "directional"
+direction = [0.5, -0.74, -0.45]
+irradiance = 1
+color = [0.9, 0.88, 0.85]
+shadows = {shadows}
+[[light]]
+kind = "point"
+position = [1.8, 0.9, 2.4]
+intensity = 5.8
+color = [1, 0.95, 0.9]
+[[light]]
+kind = "spot"
+position = [-1.5, 2.0, 1.5]
+direction = [0.5, -0.6, -0.5]
+intensity = 8.0
+inner_angle = 15
+outer_angle = 30
+shadows = {shadows}
+[[camera]]
+eye = [0, 0, 3.9]
+target = [0, 0, 0]
+fov = 45.0
+"#,
+        d = d.display(),
+        filter = "trilinear",
+        msaa = 1,
+        shadows = false,
+    );
+    let scene_file = dir.join("d3.toml");
+    std::fs::write(&scene_file, &scene).unwrap();
+    same_both_ways(&with(&scene_file, &[]), &[0, 9, 40], "diablo3, trilinear");
+    same_both_ways(
+        &with(
+            &scene_file,
+            &[
+                "render.texture_filter=\"anisotropic\"",
+                "render.msaa=4",
+                "light.0.shadows=true",
+                "light.2.shadows=true",
+                "render.shadows=\"pcf\"",
+            ],
+        ),
+        &[0, 20],
+        "diablo3, anisotropic, MSAA 4, shadow maps",
+    );
+    same_both_ways(
+        &with(
+            &scene_file,
+            &[
+                "light.0.shadows=true",
+                "render.shadows=\"raytraced\"",
+                "render.ao.method=\"ssao\"",
+                "environment.preset=\"studio\"",
+                "render.address=\"clamp\"",
+            ],
+        ),
+        &[30],
+        "diablo3, environment, ray-traced shadows, SSAO, clamp",
+    );
+    same_both_ways(
+        &with(
+            &scene_file,
+            &[
+                "camera.0.projection=\"orthographic\"",
+                "camera.0.height=2.5",
+                "render.texture_filter=\"bilinear\"",
+            ],
+        ),
+        &[5],
+        "diablo3, orthographic, bilinear",
+    );
+}
+
+#[test]
+fn vertex_colours_illum_and_repeat_are_the_same_with_and_without_lanes() {
+    let dir = scratch("lanes_small");
+    // A tiled quad (coordinates up to 3: repeat), vertex colours, and a
+    // second object of each illum model.
+    let obj = "mtllib m.mtl\n\
+        v -1 -1 0 1 0 0\nv 1 -1 0 0 1 0\nv 1 1 0 0 0 1\nv -1 1 0 1 1 0\n\
+        vt 0 0\nvt 3 0\nvt 3 3\nvt 0 3\nvn 0 0 1\n\
+        usemtl tiled\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n\
+        v -1 -1 -0.5\nv 1 -1 -0.5\nv 0 1.5 -0.5\n\
+        usemtl plain\nf 5//1 6//1 7//1\n";
+    let checker = dir.join("checker.png");
+    let img = image::RgbaImage::from_fn(16, 16, |x, y| {
+        if (x / 4 + y / 4) % 2 == 0 {
+            image::Rgba([230, 200, 40, 255])
+        } else {
+            image::Rgba([20, 60, 200, 255])
+        }
+    });
+    img.save(&checker).unwrap();
+    for illum in [0, 1, 2] {
+        let mtl = format!(
+            "newmtl tiled\nKd 1 1 1\nKa 0.2 0.2 0.2\nKs 0.4 0.4 0.4\nNs 20\nillum {illum}\nmap_Kd checker.png\nmap_Ks checker.png\n\
+             newmtl plain\nKd 0.3 0.6 0.3\nKe 0.05 0 0\nillum {illum}\n"
+        );
+        let scene = scene_in(
+            &dir,
+            r#"
+[output]
+width = 96
+height = 80
+[render]
+cull = "none"
+[ambient]
+color = [0.1, 0.1, 0.1]
+[[model]]
+path = "quad.obj"
+rotate = [-35.0, 20.0, 0.0]
+[[light]]
+kind = "point"
+position = [0.5, 1.0, 2.0]
+intensity = 3.0
+[[light]]
+kind = "directional"
+direction = [0.3, -0.2, -1.0]
+irradiance = 0.7
+"#,
+            &[("quad.obj", obj), ("m.mtl", &mtl)],
+        );
+        same_both_ways(&scene, &[0], &format!("quad, illum {illum}"));
+    }
+}
