@@ -24,15 +24,18 @@ use super::blinn_phong::SurfaceColor;
 use super::lanes::V3;
 use super::light::incidence;
 use crate::assets::texture::{
-    Filtering, Footprint, Gradients, Level, Texture, TextureFilter as Filter, TextureRef, Wrap,
+    Filtering, Footprint, Gradients, Level, Taps4, Texture, TextureFilter as Filter, TextureRef,
+    Wrap,
 };
 use crate::scene::Material;
 use crate::scene::light::LightKind;
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
 
-/// At most this many distinct texture sizes among a lane material's maps
-/// (each fragment carries one filter footprint per size).
+/// At most this many distinct texture sizes (and mip chains) among a lane
+/// material's maps: each fragment carries one filter footprint per size,
+/// and the maps of one size share where their lookups fall
+/// (`Texture::taps4`).
 pub const MAX_SIZES: usize = 3;
 
 /// One map of a lane material, ready for four lookups.
@@ -42,7 +45,8 @@ struct Map<'a> {
     mode: Wrap,
     /// The frame's mip chain of the texture, or None (level 0 only).
     mips: Option<&'a [Level]>,
-    /// Which of the fragment's footprints (by texture size) it reads.
+    /// Which of the fragment's footprints (by texture size and chain) it
+    /// reads, and whose taps.
     slot: usize,
 }
 
@@ -53,8 +57,9 @@ pub struct LaneMaterial<'a> {
     ks: Option<Map<'a>>,
     /// Tangent-space normal map and its scale.
     normal: Option<(Map<'a>, f32)>,
-    /// The distinct (width, height) of the maps that need footprints.
-    sizes: SmallVec<[(u32, u32); MAX_SIZES]>,
+    /// Per slot: the (width, height) of its maps and one of them, whose
+    /// taps the others read.
+    sizes: SmallVec<[((u32, u32), Map<'a>); MAX_SIZES]>,
 }
 
 /// Four fragments of one material, one lane each, as `Surface` holds one.
@@ -93,7 +98,7 @@ impl LaneMaterial<'_> {
             max_anisotropy: ctx.max_anisotropy,
             mips: None,
         };
-        for (k, &(w, h)) in self.sizes.iter().enumerate() {
+        for (k, &((w, h), _)) in self.sizes.iter().enumerate() {
             out[k] = Texture::footprint_of_size(w, h, g, &f);
         }
         out
@@ -125,7 +130,7 @@ impl<'a> ShadeContext<'a> {
         {
             return None;
         }
-        let mut sizes: SmallVec<[(u32, u32); MAX_SIZES]> = SmallVec::new();
+        let mut sizes: SmallVec<[((u32, u32), Map<'a>); MAX_SIZES]> = SmallVec::new();
         let mut map = |t: &'a TextureRef| -> Option<Map<'a>> {
             if !t.is_plain() || t.texcoord != 0 || !uvs {
                 return None;
@@ -133,20 +138,25 @@ impl<'a> ShadeContext<'a> {
             let tex = &*t.texture;
             let mips = self.mips.get(tex.id).copied().flatten();
             let size = (tex.width, tex.height);
-            let slot = match sizes.iter().position(|&s| s == size) {
+            let chain = mips.map(|m| m.len());
+            let mut map = Map {
+                texture: tex,
+                mode: t.address.unwrap_or(self.address.into()),
+                mips,
+                slot: 0,
+            };
+            map.slot = match sizes
+                .iter()
+                .position(|(s, m)| *s == size && m.mips.map(|m| m.len()) == chain)
+            {
                 Some(k) => k,
                 None if sizes.len() < MAX_SIZES => {
-                    sizes.push(size);
+                    sizes.push((size, map));
                     sizes.len() - 1
                 }
                 None => return None,
             };
-            Some(Map {
-                texture: tex,
-                mode: t.address.unwrap_or(self.address.into()),
-                mips,
-                slot,
-            })
+            Some(map)
         };
         let kd = match &m.map_kd {
             Some(t) => Some(map(t)?),
@@ -188,14 +198,22 @@ impl<'a> ShadeContext<'a> {
     /// `shade` of each (before its non-finite guard).
     pub fn shade_lanes(&self, lm: &LaneMaterial<'a>, f: &Lanes) -> V3 {
         let m = lm.material;
+        // Where each slot's lookups fall, found once for its maps.
+        let mut taps: [Option<Taps4>; MAX_SIZES] = Default::default();
+        for (k, (_, map)) in lm.sizes.iter().enumerate() {
+            taps[k] = map.texture.taps4(f.u, f.v, &f.footprints[k], map.mips);
+        }
         let tex = |map: &Map| {
-            let [r, g, b] = map.texture.sample_footprint4(
-                f.u,
-                f.v,
-                &f.footprints[map.slot],
-                map.mode,
-                map.mips,
-            );
+            let [r, g, b] = match &taps[map.slot] {
+                Some(t) => map.texture.read4(t, map.mode, map.mips),
+                None => map.texture.sample_footprint4(
+                    f.u,
+                    f.v,
+                    &f.footprints[map.slot],
+                    map.mode,
+                    map.mips,
+                ),
+            };
             V3 { x: r, y: g, z: b }
         };
         // `surface_color`: constants times maps times the vertex colour.

@@ -1,11 +1,18 @@
 //! Four lookups of one texture at once, for shading that runs four
-//! fragments side by side (`shade::lanes`): the coordinates and results
-//! are held per channel with one lane per lookup (a structure of arrays),
-//! and every lane is bit for bit what the one-lookup functions give for
-//! it (`Texture::sample_footprint`). The arithmetic runs on all four
-//! lanes together; the texel loads and sRGB decoding stay per lane, and
-//! a lane whose footprint leaves the image (an address mode applies)
-//! takes the one-lookup path.
+//! fragments side by side (`shade::blinn_phong4`): the coordinates and
+//! results are held per channel with one lane per lookup (a structure of
+//! arrays), and every lane is bit for bit what the one-lookup functions
+//! give for it (`Texture::sample_footprint`).
+//!
+//! A lookup is found in two steps. `Texture::taps4` places the four
+//! footprints: per lane the level or two levels read, and in each the
+//! bilinear footprint's texels (their positions in the block layout) and
+//! weights. That depends only on the texture's size and mip chain, so the
+//! maps of a material that share a size (diffuse, specular and normal map,
+//! mostly) share it. `Texture::read4` then loads, decodes and blends each
+//! map's texels. A lane whose footprint leaves the image (an address mode
+//! applies) takes the one-lookup path, and anisotropic probes are looked
+//! up probe by probe (`probes4`).
 
 // Loops over the four lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -18,12 +25,27 @@ use crate::color::srgb_to_linear_table;
 /// Red, green and blue of four lookups, one lane each.
 pub type Rgb4 = [Vec4; 3];
 
+/// Where four trilinear lookups fall in any texture of one size and mip
+/// chain (`Texture::taps4`).
+pub struct Taps4 {
+    u: Vec4,
+    v: Vec4,
+    near: Place4,
+    /// Where some lane blends two levels: the farther ones (a lane that
+    /// reads one level reads it again there, at weight 0: a * 1 + a * 0 =
+    /// a) and the weights.
+    far: Option<(Place4, Vec4)>,
+}
+
 /// Bilinear footprints in one level per lane.
-struct Spot4<'t> {
-    levels: [&'t Level; 4],
-    /// Texel coordinates of the footprints' top-left texels, whole.
-    x0: Vec4,
-    y0: Vec4,
+struct Place4 {
+    /// Level per lane (0: the image itself, k: mip level k).
+    level: [usize; 4],
+    /// Per lane: the footprint's top-left texel in the block layout, and
+    /// the steps to its right and lower neighbours (`Level::footprint`).
+    at: [usize; 4],
+    dx: [usize; 4],
+    dy: [usize; 4],
     /// Fractions between the texels.
     fx: Vec4,
     fy: Vec4,
@@ -43,49 +65,38 @@ impl Texture {
         mode: Wrap,
         mips: Option<&[Level]>,
     ) -> Rgb4 {
+        match self.taps4(u, v, fps, mips) {
+            Some(taps) => self.read4(&taps, mode, mips),
+            None => self.probes4(u, v, fps, mode, mips),
+        }
+    }
+
+    /// Where `sample_footprint4` reads at one trilinear probe per lane
+    /// (`Footprint::Lod`), in this texture or any other of its size and
+    /// chain; None where some lane takes anisotropic probes.
+    #[inline]
+    pub fn taps4(
+        &self,
+        u: Vec4,
+        v: Vec4,
+        fps: &[Footprint; 4],
+        mips: Option<&[Level]>,
+    ) -> Option<Taps4> {
         let mut lod = [0.0f32; 4];
         for k in 0..4 {
             match fps[k] {
                 Footprint::Lod(l) => lod[k] = l,
-                Footprint::Probes { .. } => return self.probes4(u, v, fps, mode, mips),
+                Footprint::Probes { .. } => return None,
             }
         }
-        self.sample_lod4(mips, u, v, lod, mode)
+        Some(self.lod_taps4(u, v, lod, mips))
     }
 
-    /// `sample_lod(mips, uv_k, mode, lod[k])` for the four lanes.
-    pub fn sample_lod4(
-        &self,
-        mips: Option<&[Level]>,
-        u: Vec4,
-        v: Vec4,
-        lod: [f32; 4],
-        mode: Wrap,
-    ) -> Rgb4 {
-        let (near, far) = self.levels4(mips, lod);
-        let a = self.bilinear4(&Spot4::new(near, u, v), u, v, mode);
-        match far {
-            None => a,
-            Some((levels, f)) => {
-                let b = self.bilinear4(&Spot4::new(levels, u, v), u, v, mode);
-                blend(a, b, f)
-            }
-        }
-    }
-
-    /// The levels `sample_lod` reads per lane at level of detail `lod[k]`:
-    /// the nearer one, and where some lane blends two, the farther one
-    /// (a lane that reads one level reads it again there, at weight 0:
-    /// a * 1 + a * 0 = a) and the weights.
-    #[allow(clippy::type_complexity)]
-    fn levels4<'t>(
-        &'t self,
-        mips: Option<&'t [Level]>,
-        lod: [f32; 4],
-    ) -> ([&'t Level; 4], Option<([&'t Level; 4], Vec4)>) {
-        let base = &self.base;
-        let mut near: [&Level; 4] = [base; 4];
-        let mut far: [&Level; 4] = [base; 4];
+    /// The taps of `sample_lod(mips, uv_k, mode, lod[k])` per lane: the
+    /// level `lod[k]` selects, and the next one where it blends two.
+    fn lod_taps4(&self, u: Vec4, v: Vec4, lod: [f32; 4], mips: Option<&[Level]>) -> Taps4 {
+        let mut near = [0usize; 4];
+        let mut far = [0usize; 4];
         let mut weight = [0.0f32; 4];
         let mut two = false;
         if let Some(mips) = mips {
@@ -98,61 +109,105 @@ impl Texture {
                 let i = l as u32 as f32;
                 let f = l - i;
                 let i = i as usize;
-                near[k] = if i == 0 { base } else { &mips[i - 1] };
-                far[k] = near[k];
+                near[k] = i;
+                far[k] = i;
                 if f > 0.0 && i < mips.len() {
-                    far[k] = &mips[i];
+                    far[k] = i + 1;
                     weight[k] = f;
                     two = true;
                 }
             }
         }
-        (near, two.then(|| (far, Vec4::from(weight))))
+        let level = |i: usize| level_of(&self.base, mips, i);
+        Taps4 {
+            u,
+            v,
+            near: Place4::new(near, near.map(level), u, v),
+            far: two.then(|| (Place4::new(far, far.map(level), u, v), Vec4::from(weight))),
+        }
     }
 
-    /// `bilinear(spot.levels[k], uv_k, mode)` for the four lanes.
+    /// The lookups `taps` (found in a texture of this size and chain)
+    /// describe, in this texture: red, green and blue.
+    #[inline]
+    pub fn read4(&self, taps: &Taps4, mode: Wrap, mips: Option<&[Level]>) -> Rgb4 {
+        let a = self.bilinear4(&taps.near, taps.u, taps.v, mode, mips);
+        match &taps.far {
+            None => a,
+            Some((far, f)) => blend(a, self.bilinear4(far, taps.u, taps.v, mode, mips), *f),
+        }
+    }
+
+    /// `sample_lod(mips, uv_k, mode, lod[k])` for the four lanes.
+    pub fn sample_lod4(
+        &self,
+        mips: Option<&[Level]>,
+        u: Vec4,
+        v: Vec4,
+        lod: [f32; 4],
+        mode: Wrap,
+    ) -> Rgb4 {
+        self.read4(&self.lod_taps4(u, v, lod, mips), mode, mips)
+    }
+
+    /// `bilinear(level, uv_k, mode)` for the four lanes, each in its level
+    /// of `place`.
     #[inline(always)]
-    fn bilinear4(&self, spot: &Spot4, u: Vec4, v: Vec4, mode: Wrap) -> Rgb4 {
+    fn bilinear4(
+        &self,
+        place: &Place4,
+        u: Vec4,
+        v: Vec4,
+        mode: Wrap,
+        mips: Option<&[Level]>,
+    ) -> Rgb4 {
         // Corner j (top-left, top-right, bottom-left, bottom-right) of
         // lane k, as stored.
         let mut texels = [[0u32; 4]; 4];
         for k in 0..4 {
-            if spot.inside & (1 << k) != 0 {
-                let fp = spot.levels[k].footprint(spot.x0[k] as u32, spot.y0[k] as u32);
-                texels[0][k] = u32::from_le_bytes(fp[0]);
-                texels[1][k] = u32::from_le_bytes(fp[1]);
-                texels[2][k] = u32::from_le_bytes(fp[2]);
-                texels[3][k] = u32::from_le_bytes(fp[3]);
+            if place.inside & (1 << k) != 0 {
+                let t = level_of(&self.base, mips, place.level[k]).texels();
+                let (i, dx, dy) = (place.at[k], place.dx[k], place.dy[k]);
+                texels[0][k] = u32::from_le(t[i]);
+                texels[1][k] = u32::from_le(t[i + dx]);
+                texels[2][k] = u32::from_le(t[i + dy]);
+                texels[3][k] = u32::from_le(t[i + dx + dy]);
             }
         }
-        let (fx, fy) = (spot.fx, spot.fy);
+        let (fx, fy) = (place.fx, place.fy);
         let (gx, gy) = (Vec4::ONE - fx, Vec4::ONE - fy);
-        let [a, b, c, d] = if self.srgb {
-            let lut = srgb_to_linear_table();
-            [
-                decode_srgb4(lut, texels[0]),
-                decode_srgb4(lut, texels[1]),
-                decode_srgb4(lut, texels[2]),
-                decode_srgb4(lut, texels[3]),
-            ]
-        } else {
-            [
-                decode_data4(texels[0]),
-                decode_data4(texels[1]),
-                decode_data4(texels[2]),
-                decode_data4(texels[3]),
-            ]
-        };
         let mut out = [Vec4::ZERO; 3];
-        for ch in 0..3 {
-            let top = a[ch] * gx + b[ch] * fx;
-            let bottom = c[ch] * gx + d[ch] * fx;
-            out[ch] = top * gy + bottom * fy;
+        // Channel by channel: its four corners decoded, then blended as
+        // `bilinear` blends them.
+        if self.srgb {
+            let lut = srgb_to_linear_table();
+            for (ch, o) in out.iter_mut().enumerate() {
+                let shift = 8 * ch as u32;
+                let a = srgb_channel4(lut, &texels[0], shift);
+                let b = srgb_channel4(lut, &texels[1], shift);
+                let c = srgb_channel4(lut, &texels[2], shift);
+                let d = srgb_channel4(lut, &texels[3], shift);
+                let top = a * gx + b * fx;
+                let bottom = c * gx + d * fx;
+                *o = top * gy + bottom * fy;
+            }
+        } else {
+            for (ch, o) in out.iter_mut().enumerate() {
+                let shift = 8 * ch as u32;
+                let a = data_channel4(&texels[0], shift);
+                let b = data_channel4(&texels[1], shift);
+                let c = data_channel4(&texels[2], shift);
+                let d = data_channel4(&texels[3], shift);
+                let top = a * gx + b * fx;
+                let bottom = c * gx + d * fx;
+                *o = top * gy + bottom * fy;
+            }
         }
-        if spot.inside != 0b1111 {
+        if place.inside != 0b1111 {
             for k in 0..4 {
-                if spot.inside & (1 << k) == 0 {
-                    let r = self.bilinear_wrapped(spot.levels[k], Vec2::new(u[k], v[k]), mode);
+                if place.inside & (1 << k) == 0 {
+                    let level = level_of(&self.base, mips, place.level[k]);
+                    let r = self.bilinear_wrapped(level, Vec2::new(u[k], v[k]), mode);
                     out[0][k] = r.x;
                     out[1][k] = r.y;
                     out[2][k] = r.z;
@@ -161,9 +216,7 @@ impl Texture {
         }
         out
     }
-}
 
-impl Texture {
     /// `sample_footprint` of four lanes of which some take anisotropic
     /// probes: the probes' sum over their count per lane, a lane with
     /// fewer probes adding nothing after its last (x + 0 = x); a `Lod`
@@ -222,11 +275,23 @@ impl Texture {
     }
 }
 
-impl<'t> Spot4<'t> {
+/// Level `i` of a chain: the image itself for 0, else mip level i (the
+/// image where the chain has no such level: taps found in a texture of
+/// the same size and chain never ask for one).
+#[inline(always)]
+fn level_of<'a>(base: &'a Level, mips: Option<&'a [Level]>, i: usize) -> &'a Level {
+    match (i, mips) {
+        (0, _) | (_, None) => base,
+        (i, Some(m)) => m.get(i - 1).unwrap_or(base),
+    }
+}
+
+impl Place4 {
     /// As `bilinear` places a lookup at `uv` in a level: x = u w - 1/2,
-    /// y = v h - 1/2, inside where both footprint texels exist.
+    /// y = v h - 1/2, inside where both footprint texels exist; and where
+    /// `Level::footprint` finds the texels.
     #[inline(always)]
-    fn new(levels: [&'t Level; 4], u: Vec4, v: Vec4) -> Spot4<'t> {
+    fn new(level: [usize; 4], levels: [&Level; 4], u: Vec4, v: Vec4) -> Place4 {
         let w = Vec4::new(
             levels[0].width as f32,
             levels[1].width as f32,
@@ -247,10 +312,20 @@ impl<'t> Spot4<'t> {
             & y.cmplt(h - Vec4::ONE))
         .bitmask();
         let (x0, y0) = (x.trunc(), y.trunc());
-        Spot4 {
-            levels,
-            x0,
-            y0,
+        let (xi, yi) = (whole4(x0), whole4(y0));
+        let mut at = [0usize; 4];
+        let mut dx = [0usize; 4];
+        let mut dy = [0usize; 4];
+        for k in 0..4 {
+            if inside & (1 << k) != 0 {
+                (at[k], dx[k], dy[k]) = levels[k].footprint_steps(xi[k], yi[k]);
+            }
+        }
+        Place4 {
+            level,
+            at,
+            dx,
+            dy,
             fx: x - x0,
             fy: y - y0,
             inside,
@@ -269,47 +344,56 @@ fn blend(a: Rgb4, b: Rgb4, f: Vec4) -> Rgb4 {
     ]
 }
 
-/// Red, green and blue of four stored sRGB texels (one per lane), linear:
-/// the decoding table's values.
+/// Four whole, non-negative floats below 2^31 as integers (lanes outside
+/// that range give unspecified values, which callers do not read).
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn decode_srgb4(lut: &[f32; 256], t: [u32; 4]) -> Rgb4 {
-    let at = |k: usize, shift: u32| lut[((t[k] >> shift) & 0xff) as usize];
-    [
-        Vec4::new(at(0, 0), at(1, 0), at(2, 0), at(3, 0)),
-        Vec4::new(at(0, 8), at(1, 8), at(2, 8), at(3, 8)),
-        Vec4::new(at(0, 16), at(1, 16), at(2, 16), at(3, 16)),
-    ]
+fn whole4(v: Vec4) -> [u32; 4] {
+    use std::arch::x86_64::*;
+    let mut out = [0u32; 4];
+    // SAFETY: SSE2 only (in every x86-64 target's base features); the
+    // store writes the 16 bytes of `out`.
+    unsafe { _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_cvttps_epi32(v.into())) };
+    out
 }
 
-/// Red, green and blue of four stored data texels (one per lane), as
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn whole4(v: Vec4) -> [u32; 4] {
+    v.to_array().map(|x| x as u32)
+}
+
+/// Channel `shift / 8` of four stored sRGB texels (one per lane),
+/// linear: the decoding table's values.
+#[inline(always)]
+fn srgb_channel4(lut: &[f32; 256], t: &[u32; 4], shift: u32) -> Vec4 {
+    let at = |k: usize| lut[((t[k] >> shift) & 0xff) as usize];
+    Vec4::new(at(0), at(1), at(2), at(3))
+}
+
+/// Channel `shift / 8` of four stored data texels (one per lane), as
 /// `byte as f32 * (1.0 / 255.0)`.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn decode_data4(t: [u32; 4]) -> Rgb4 {
+fn data_channel4(t: &[u32; 4], shift: u32) -> Vec4 {
     use std::arch::x86_64::*;
     // SAFETY: SSE2 only (in every x86-64 target's base features); the
-    // one memory access reads the four u32 of `t`, a 16-byte array.
+    // one memory access reads the 16 bytes of `t`.
     unsafe {
         let v = _mm_loadu_si128(t.as_ptr() as *const __m128i);
-        let mask = _mm_set1_epi32(0xff);
-        let k = _mm_set1_ps(1.0 / 255.0);
-        let ch = |c: __m128i| Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(_mm_and_si128(c, mask)), k));
-        [ch(v), ch(_mm_srli_epi32(v, 8)), ch(_mm_srli_epi32(v, 16))]
+        let v = _mm_and_si128(
+            _mm_srl_epi32(v, _mm_cvtsi32_si128(shift as i32)),
+            _mm_set1_epi32(0xff),
+        );
+        Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(v), _mm_set1_ps(1.0 / 255.0)))
     }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
-fn decode_data4(t: [u32; 4]) -> Rgb4 {
-    let ch = |s: u32| {
-        Vec4::new(
-            ((t[0] >> s) & 0xff) as f32,
-            ((t[1] >> s) & 0xff) as f32,
-            ((t[2] >> s) & 0xff) as f32,
-            ((t[3] >> s) & 0xff) as f32,
-        ) * Vec4::splat(1.0 / 255.0)
-    };
-    [ch(0), ch(8), ch(16)]
+fn data_channel4(t: &[u32; 4], shift: u32) -> Vec4 {
+    let at = |k: usize| ((t[k] >> shift) & 0xff) as f32;
+    Vec4::new(at(0), at(1), at(2), at(3)) * Vec4::splat(1.0 / 255.0)
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@ use glam::{Affine2, Vec2, Vec4};
 
 use crate::color::srgb_to_linear_table;
 use crate::error::Error;
-pub use lanes::Rgb4;
+pub use lanes::{Rgb4, Taps4};
 
 /// Texture filtering, ordered from the least to the most filtering (a
 /// sampler's limit lowers a scene's filter to it, never raises it).
@@ -282,6 +282,28 @@ impl Level {
         };
         let t = |i: usize| self.blocks[i >> 4].0[i & 15];
         [t(i), t(i + dx), t(i + dy), t(i + dx + dy)]
+    }
+}
+
+impl Level {
+    /// Where `footprint(x, y)` finds its texels: the first one's position
+    /// in the block layout and the steps to its right and lower
+    /// neighbours.
+    #[inline(always)]
+    fn footprint_steps(&self, x: u32, y: u32) -> (usize, usize, usize) {
+        let dx = if x & 3 == 3 { 13 } else { 1 };
+        let dy = if y & 3 == 3 {
+            (self.blocks_x as usize) * 16 - 12
+        } else {
+            4
+        };
+        (self.index(x, y), dx, dy)
+    }
+
+    /// The texels in the block layout, each RGBA8 as a little-endian u32.
+    #[inline(always)]
+    fn texels(&self) -> &[u32] {
+        bytemuck::cast_slice(&self.blocks)
     }
 }
 
