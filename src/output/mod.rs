@@ -40,47 +40,53 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
     let data_view = s.shading.is_data_view();
     let scale = s.exposure.exp2();
     let mut data = vec![0u8; frame.color.len() * channels];
+    let pixel = |c: &Vec4| -> [u8; 4] {
+        let c = if alpha && c.w > 0.0 && c.w < 1.0 {
+            (c.truncate() / c.w).extend(c.w)
+        } else {
+            *c
+        };
+        let rgb = if data_view {
+            [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+        } else {
+            let t = tonemap(c.truncate(), s.tonemap, scale);
+            [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
+        };
+        [rgb[0], rgb[1], rgb[2], encode_linear(c.w)]
+    };
     use rayon::prelude::*;
-    data.par_chunks_mut(channels * frame.width as usize)
-        .zip(frame.color.par_chunks(frame.width as usize))
-        .for_each(|(out, row)| {
-            // Runs of one color (the background, mostly) resolve once.
-            let mut last: Option<(Vec4, [u8; 4])> = None;
-            for (o, c) in out.chunks_exact_mut(channels).zip(row) {
-                let px = match last {
-                    Some((lc, px)) if lc == *c => px,
-                    _ => {
-                        let key = *c;
-                        let c = if alpha && c.w > 0.0 && c.w < 1.0 {
-                            (c.truncate() / c.w).extend(c.w)
-                        } else {
-                            *c
-                        };
-                        let rgb = if data_view {
-                            [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
-                        } else {
-                            let t = tonemap(c.truncate(), s.tonemap, scale);
-                            [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
-                        };
-                        let px = [rgb[0], rgb[1], rgb[2], encode_linear(c.w)];
-                        last = Some((key, px));
-                        px
-                    }
-                };
-                // Fixed-size copies (a slice copy of 3 bytes calls memcpy).
-                o[0] = px[0];
-                o[1] = px[1];
-                o[2] = px[2];
-                if alpha {
-                    o[3] = px[3];
-                }
-            }
-        });
+    let rows = data
+        .par_chunks_mut(channels * frame.width as usize)
+        .zip(frame.color.par_chunks(frame.width as usize));
+    if alpha {
+        rows.for_each(|(out, row)| resolve_row::<4>(out, row, pixel));
+    } else {
+        rows.for_each(|(out, row)| resolve_row::<3>(out, row, pixel));
+    }
     Image8 {
         width: frame.width,
         height: frame.height,
         channels: channels as u8,
         data,
+    }
+}
+
+/// One row of `resolve` into C bytes per pixel; runs of one colour (the
+/// background, mostly) resolve once.
+#[inline]
+fn resolve_row<const C: usize>(out: &mut [u8], row: &[Vec4], pixel: impl Fn(&Vec4) -> [u8; 4]) {
+    let (out, _) = out.as_chunks_mut::<C>();
+    let mut last: Option<(Vec4, [u8; 4])> = None;
+    for (o, c) in out.iter_mut().zip(row) {
+        let px = match last {
+            Some((lc, px)) if lc == *c => px,
+            _ => {
+                let px = pixel(c);
+                last = Some((*c, px));
+                px
+            }
+        };
+        o.copy_from_slice(&px[..C]);
     }
 }
 

@@ -421,15 +421,29 @@ impl<'a> FrameData<'a> {
         // quads without a triangle skipped below.
         let filled = flat_bg.is_some();
         let empty_at = |i: usize| {
-            vis.id[i * n..(i + 1) * n]
-                .iter()
-                .all(|&id| id == NO_TRIANGLE)
+            if n == 1 {
+                vis.id[i] == NO_TRIANGLE
+            } else {
+                vis.id[i * n..(i + 1) * n]
+                    .iter()
+                    .all(|&id| id == NO_TRIANGLE)
+            }
         };
         if filled {
-            for (i, (c, d)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
-                if empty_at(i) {
-                    *c = self.bg;
-                    *d = f32::INFINITY;
+            if n == 1 {
+                let pixels = color.iter_mut().zip(depth.iter_mut()).zip(&vis.id);
+                for ((c, d), &id) in pixels {
+                    if id == NO_TRIANGLE {
+                        *c = self.bg;
+                        *d = f32::INFINITY;
+                    }
+                }
+            } else {
+                for (i, (c, d)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
+                    if empty_at(i) {
+                        *c = self.bg;
+                        *d = f32::INFINITY;
+                    }
                 }
             }
         }
