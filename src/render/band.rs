@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3, Vec4};
 use super::frame::AovPixel;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
-use super::lanes::{LaneQueue, Pending};
+use super::lanes::{LaneBatches, Pending};
 use super::rays::CameraRays;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
@@ -429,33 +429,65 @@ impl<'a> FrameData<'a> {
                     .all(|&id| id == NO_TRIANGLE)
             }
         };
-        if filled {
-            if n == 1 {
-                let pixels = color.iter_mut().zip(depth.iter_mut()).zip(&vis.id);
-                for ((c, d), &id) in pixels {
-                    if id == NO_TRIANGLE {
-                        *c = self.bg;
-                        *d = f32::INFINITY;
-                    }
-                }
-            } else {
-                for (i, (c, d)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
-                    if empty_at(i) {
-                        *c = self.bg;
-                        *d = f32::INFINITY;
-                    }
+        // Per row: the span of pixels some triangle covers (over a flat
+        // background only those are visited; the others are filled here).
+        let mut spans = vec![(usize::MAX, 0usize); th];
+        for (y, span) in spans.iter_mut().enumerate() {
+            let row = y * tw..(y + 1) * tw;
+            if !filled {
+                *span = (0, tw);
+                continue;
+            }
+            let (c, d) = (&mut color[row.clone()], &mut depth[row]);
+            for x in 0..tw {
+                if empty_at(y * tw + x) {
+                    c[x] = self.bg;
+                    d[x] = f32::INFINITY;
+                } else {
+                    span.0 = span.0.min(x);
+                    span.1 = x + 1;
                 }
             }
         }
-        let mut queue =
-            (self.lanes.iter().any(|l| l.is_some())).then(|| LaneQueue::new(self.draws.len()));
+        let mut lanes = self
+            .lanes
+            .iter()
+            .any(|l| l.is_some())
+            .then(|| LaneBatches::new(self.draws.len()));
+        let mut shaded = Vec::new();
         let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
         for qy in (0..th).step_by(2) {
-            for qx in (0..tw).step_by(2) {
+            let below = spans.get(qy + 1).copied().unwrap_or((usize::MAX, 0));
+            let (x0, x1) = (spans[qy].0.min(below.0), spans[qy].1.max(below.1));
+            if x0 >= x1 {
+                continue;
+            }
+            for qx in (x0 & !1..x1).step_by(2) {
                 if filled {
                     let at = |x: usize, y: usize| x >= tw || y >= th || empty_at(y * tw + x);
                     if at(qx, qy) && at(qx + 1, qy) && at(qx, qy + 1) && at(qx + 1, qy + 1) {
                         continue;
+                    }
+                }
+                // A quad of one lane-shaded triangle: its four pixels are
+                // the four lanes.
+                if n == 1 && lanes.is_some() && qx + 1 < tw && qy + 1 < th {
+                    let i0 = qy * tw + qx;
+                    let quad = [i0, i0 + 1, i0 + tw, i0 + tw + 1];
+                    let id = vis.id[i0];
+                    if id != NO_TRIANGLE && quad.iter().all(|&i| vis.id[i] == id) {
+                        let t = &self.tris[id as usize];
+                        if let Some(lm) = self.lane_material(t.draw as usize) {
+                            let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
+                            let it = cache.get(id, t);
+                            let ao = ao.map_or([1.0; 4], |a| quad.map(|i| a[i]));
+                            let shaded = self.shade_quad(t, it, lm, q0, ao);
+                            for (k, &i) in quad.iter().enumerate() {
+                                (color[i], depth[i]) =
+                                    resolve(&[Part::Queued(0, 1.0)], &shaded[k..k + 1], inv_n);
+                            }
+                            continue;
+                        }
                     }
                 }
                 // Per triangle present in the quad: its texture-coordinate
@@ -497,19 +529,32 @@ impl<'a> FrameData<'a> {
                     let occlusion = ao.map_or(1.0, |a| a[i]);
                     let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
                     let mut at = FragmentAt {
-                        pixel: i as u32,
                         px: (px, py),
                         q0,
                         ao: occlusion,
+                        lanes: lanes.is_some(),
                         cache: &mut cache,
                         quad: &mut quad,
-                        queue: queue.as_mut(),
                     };
                     if n == 1 {
-                        // One fragment; a queued one is written by the
-                        // lanes.
-                        if let Some(part) = self.fragment(&mut at, ids[0], 1) {
-                            (color[i], depth[i]) = resolve(&[part], &[], inv_n);
+                        // One fragment, shaded now or by the lanes (which
+                        // write it).
+                        match self.fragment(&mut at, ids[0], 1) {
+                            Shaded::Now(part) => {
+                                (color[i], depth[i]) = resolve(&[part], &[], inv_n);
+                            }
+                            Shaded::Later(draw, mut p) => {
+                                p.pixel = i as u32;
+                                if let Some(b) = lanes.as_mut() {
+                                    let sink = &mut Sink {
+                                        color: &mut *color,
+                                        depth: &mut *depth,
+                                        shaded: &mut shaded,
+                                        inv_n,
+                                    };
+                                    b.push(self, draw, p, sink);
+                                }
+                            }
                         }
                         continue;
                     }
@@ -521,13 +566,21 @@ impl<'a> FrameData<'a> {
                             parts.push(Part::Shaded(bg, f32::INFINITY, count));
                             continue;
                         }
-                        at.pixel = LANE_SLOT;
                         match self.fragment(&mut at, id, mask) {
-                            Some(p) => parts.push(p),
-                            None => {
-                                queued = true;
-                                let slot = at.queue.as_ref().map_or(0, |q| q.len() - 1);
-                                parts.push(Part::Queued(slot, count));
+                            Shaded::Now(part) => parts.push(part),
+                            Shaded::Later(draw, mut p) => {
+                                if let Some(b) = lanes.as_mut() {
+                                    queued = true;
+                                    p.pixel = LANE_SLOT;
+                                    let sink = &mut Sink {
+                                        color: &mut *color,
+                                        depth: &mut *depth,
+                                        shaded: &mut shaded,
+                                        inv_n,
+                                    };
+                                    let slot = b.push(self, draw, p, sink);
+                                    parts.push(Part::Queued(slot, count));
+                                }
                             }
                         }
                     }
@@ -539,41 +592,29 @@ impl<'a> FrameData<'a> {
                 }
             }
         }
-        // The queued fragments, four at a time: one-sample pixels written
-        // at once, the others resolved after.
-        if let Some(queue) = queue.filter(|q| !q.is_empty()) {
-            let mut shaded = vec![
-                (Vec3::ZERO, 0.0);
-                if deferred.is_empty() {
-                    0
-                } else {
-                    queue.len() as usize
-                }
-            ];
-            queue.shade(self, |slot, pixel, c, d| {
-                if pixel == LANE_SLOT {
-                    shaded[slot as usize] = (c, d);
-                } else {
-                    let i = pixel as usize;
-                    (color[i], depth[i]) = resolve(&[Part::Queued(0, 1.0)], &[(c, d)], inv_n);
-                }
-            });
-            for (i, parts) in deferred {
-                (color[i], depth[i]) = resolve(&parts, &shaded, inv_n);
-            }
+        // The lanes' last groups, then the pixels that wait for them.
+        if let Some(b) = lanes.as_mut() {
+            let sink = &mut Sink {
+                color: &mut *color,
+                depth: &mut *depth,
+                shaded: &mut shaded,
+                inv_n,
+            };
+            b.finish(self, sink);
+        }
+        for (i, parts) in deferred {
+            (color[i], depth[i]) = resolve(&parts, &shaded, inv_n);
         }
     }
 
     /// Shades the fragment of triangle `id` covering samples `mask` of
-    /// the pixel `at` describes: its part of the pixel, or None where it
-    /// is queued for the lanes (`at.queue`, with `at.pixel`).
-    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> Option<Part> {
+    /// the pixel `at` describes: its part of the pixel now, or, for a
+    /// lane material, the fragment for the lanes.
+    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> Shaded {
         let count = mask.count_ones() as f32;
         let t = &self.tris[id as usize];
         let it = at.cache.get(id, t);
-        let lane = self
-            .lane_material(t.draw as usize)
-            .filter(|_| at.queue.is_some());
+        let lane = self.lane_material(t.draw as usize).filter(|_| at.lanes);
         let quad = &mut *at.quad;
         let k = match quad.iter().position(|q| q.id == id) {
             Some(k) => k,
@@ -597,23 +638,22 @@ impl<'a> FrameData<'a> {
         };
         let (px, py) = at.px;
         let frag = self.shading_point(it, px, py, mask);
-        if let (Some(queue), Some(lm)) = (at.queue.as_mut(), lane) {
+        if let Some(lm) = lane {
             let q = &mut quad[k];
             let footprints = *q
                 .lane_footprints
                 .get_or_insert_with(|| lm.footprints(&self.ctx, q.grads[0]));
-            queue.push(
+            return Shaded::Later(
                 t.draw,
                 Pending {
                     id,
-                    pixel: at.pixel,
+                    pixel: 0,
                     lambda: frag.lambda,
                     w: frag.w,
                     footprints,
                     ao: at.ao,
                 },
             );
-            return None;
         }
         let q = &quad[k];
         let (grads, fps) = (q.grads, q.footprints);
@@ -622,7 +662,7 @@ impl<'a> FrameData<'a> {
         // A NaN from degenerate input must not poison the frame: such a
         // fragment is black.
         let c = if c.is_finite() { c } else { Vec3::ZERO };
-        Some(Part::Shaded(c.extend(1.0), d, count))
+        Shaded::Now(Part::Shaded(c.extend(1.0), d, count))
     }
 
     /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
@@ -915,21 +955,54 @@ struct QuadEntry {
     lane_footprints: Option<[Footprint; MAX_SIZES]>,
 }
 
-/// Where `FrameData::fragment` shades: the pixel (its index in the band,
-/// or `LANE_SLOT` for a pixel resolved after the lanes), its position and
-/// its quad's top-left pixel, its AO, and the band's state.
-struct FragmentAt<'c, 'q> {
-    pixel: u32,
+/// Where `FrameData::fragment` shades: the pixel's position and its
+/// quad's top-left pixel, its AO, whether lane materials go to the lanes,
+/// and the band's state.
+struct FragmentAt<'c> {
     px: (i32, i32),
     q0: (i32, i32),
     ao: f32,
+    lanes: bool,
     cache: &'c mut InterpolatorCache,
     quad: &'c mut smallvec::SmallVec<[QuadEntry; 4]>,
-    queue: Option<&'q mut LaneQueue>,
 }
 
-/// A queued fragment whose pixel is resolved from its slot.
+/// A fragment shaded now, or waiting for the lanes (its draw and data).
+enum Shaded {
+    Now(Part),
+    Later(u32, Pending),
+}
+
+/// The pixel of a lane result that is resolved from its slot, after the
+/// lanes (MSAA pixels with several fragments).
 const LANE_SLOT: u32 = u32::MAX;
+
+/// Where lane results go: one-sample pixels straight to the band's
+/// colour and depth, the others by slot for their pixels' resolve.
+pub(super) struct Sink<'s> {
+    color: &'s mut [Vec4],
+    depth: &'s mut [f32],
+    shaded: &'s mut Vec<(Vec3, f32)>,
+    inv_n: f32,
+}
+
+impl Sink<'_> {
+    /// The result of slot `slot` for `pixel`: linear colour, view depth.
+    #[inline]
+    pub fn put(&mut self, slot: u32, pixel: u32, c: Vec3, d: f32) {
+        if pixel == LANE_SLOT {
+            let slot = slot as usize;
+            if self.shaded.len() <= slot {
+                self.shaded.resize(slot + 1, (Vec3::ZERO, 0.0));
+            }
+            self.shaded[slot] = (c, d);
+        } else {
+            let i = pixel as usize;
+            (self.color[i], self.depth[i]) =
+                resolve(&[Part::Queued(0, 1.0)], &[(c, d)], self.inv_n);
+        }
+    }
+}
 
 /// One fragment's share of a pixel: shaded already (linear RGBA, view
 /// depth, sample count) or queued for the lanes (slot, sample count).

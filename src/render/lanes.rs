@@ -8,12 +8,16 @@
 // Loops over the four lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
-use super::band::FrameData;
+use super::band::{FrameData, Sink};
 use crate::assets::texture::Footprint;
+use crate::assets::texture::Gradients;
+use crate::raster::interp::Interpolator;
+use crate::raster::setup::Tri;
+use crate::shade::blinn_phong4::LaneMaterial;
 use crate::shade::blinn_phong4::{Lanes, MAX_SIZES};
-use crate::shade::lanes::V3;
+use crate::shade::lanes::{V3, lerp3};
 
 /// A fragment waiting for its lane.
 #[derive(Clone, Copy)]
@@ -31,101 +35,210 @@ pub(super) struct Pending {
     pub ao: f32,
 }
 
-/// A band's queued fragments, and per draw the ones of that draw.
-pub(super) struct LaneQueue {
-    pending: Vec<Pending>,
-    by_draw: Vec<Vec<u32>>,
+/// A band's lane fragments waiting for their group of four: per draw, up
+/// to three of them; the fourth shades the group at once.
+pub(super) struct LaneBatches {
+    waiting: Vec<Waiting>,
+    /// The slot of the next fragment.
+    next: u32,
 }
 
-impl LaneQueue {
-    pub fn new(draws: usize) -> LaneQueue {
-        LaneQueue {
-            pending: Vec::new(),
-            by_draw: vec![Vec::new(); draws],
+/// Up to four fragments of one draw, with their slots.
+#[derive(Clone, Copy)]
+struct Waiting {
+    group: [Pending; 4],
+    slots: [u32; 4],
+    len: usize,
+}
+
+impl Pending {
+    const NONE: Pending = Pending {
+        id: 0,
+        pixel: 0,
+        lambda: Vec3::ZERO,
+        w: 0.0,
+        footprints: [Footprint::Lod(0.0); MAX_SIZES],
+        ao: 1.0,
+    };
+}
+
+impl LaneBatches {
+    pub fn new(draws: usize) -> LaneBatches {
+        LaneBatches {
+            waiting: vec![
+                Waiting {
+                    group: [Pending::NONE; 4],
+                    slots: [0; 4],
+                    len: 0,
+                };
+                draws
+            ],
+            next: 0,
         }
     }
 
-    /// Queues `p` (of draw `draw`) in the next slot.
+    /// Adds `p` (of draw `draw`) as the next slot, which it returns; a
+    /// full group of its draw is shaded into `sink`.
     #[inline]
-    pub fn push(&mut self, draw: u32, p: Pending) {
-        let slot = self.pending.len() as u32;
-        self.pending.push(p);
-        self.by_draw[draw as usize].push(slot);
+    pub fn push(&mut self, data: &FrameData, draw: u32, p: Pending, sink: &mut Sink) -> u32 {
+        let slot = self.next;
+        self.next += 1;
+        let w = &mut self.waiting[draw as usize];
+        w.group[w.len] = p;
+        w.slots[w.len] = slot;
+        w.len += 1;
+        if w.len == 4 {
+            shade_group(data, draw as usize, w, sink);
+            w.len = 0;
+        }
+        slot
     }
 
-    /// Fragments queued so far (the next slot).
-    pub fn len(&self) -> u32 {
-        self.pending.len() as u32
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.pending.is_empty()
-    }
-
-    /// Shades every queued fragment and hands `done(slot, pixel, colour,
-    /// view depth)` each result: linear colour, zero where not finite (as
-    /// the one-fragment path has it).
-    pub fn shade(&self, data: &FrameData, mut done: impl FnMut(u32, u32, Vec3, f32)) {
-        for (draw, slots) in self.by_draw.iter().enumerate() {
-            let Some(lm) = data.lane_material(draw) else {
-                continue;
-            };
-            for group in slots.chunks(4) {
-                // A short last group repeats its last fragment.
-                let at = |k: usize| &self.pending[group[k.min(group.len() - 1)] as usize];
-                let frags = [at(0), at(1), at(2), at(3)];
-                let (lanes, depth) = data.gather(draw, &frags);
-                let c = data.ctx.shade_lanes(lm, &lanes);
-                for (k, &slot) in group.iter().enumerate() {
-                    let c = c.lane(k);
-                    let c = if c.is_finite() { c } else { Vec3::ZERO };
-                    done(slot, frags[k].pixel, c, depth[k]);
+    /// Shades every group that is not full (its last fragment repeated).
+    pub fn finish(&mut self, data: &FrameData, sink: &mut Sink) {
+        for (draw, w) in self.waiting.iter_mut().enumerate() {
+            if w.len > 0 {
+                for k in w.len..4 {
+                    w.group[k] = w.group[w.len - 1];
                 }
+                shade_group(data, draw, w, sink);
+                w.len = 0;
             }
         }
     }
 }
 
-impl FrameData<'_> {
-    /// Four queued fragments of draw `draw` as the lanes take them (each
-    /// lane interpolated as `point` and `surface` interpolate one
-    /// fragment, in the same order), and their view depths.
-    fn gather(&self, draw: usize, frags: &[&Pending; 4]) -> (Lanes, [f32; 4]) {
+/// Shades the four fragments of draw `draw` in `w` and hands those it
+/// holds to `sink` (linear colour, zero where not finite as the
+/// one-fragment path has it).
+fn shade_group(data: &FrameData, draw: usize, w: &Waiting, sink: &mut Sink) {
+    let Some(lm) = data.lane_material(draw) else {
+        return;
+    };
+    let (lanes, depth) = data.gather(draw, &w.group);
+    let c = data.ctx.shade_lanes(lm, &lanes);
+    for k in 0..w.len {
+        let c = c.lane(k);
+        let c = if c.is_finite() { c } else { Vec3::ZERO };
+        sink.put(w.slots[k], w.group[k].pixel, c, depth[k]);
+    }
+}
+
+/// One triangle's corners as the lanes interpolate them.
+#[derive(Clone, Copy)]
+pub(super) struct Corners {
+    world: [Vec3; 3],
+    normal: [Vec3; 3],
+    uv: [Vec2; 3],
+    /// Per corner, with the bitangent sign in w (zero without tangents).
+    tangent: [Vec4; 3],
+    color: [Vec4; 3],
+    /// Counter-clockwise as the camera sees it.
+    front: bool,
+}
+
+/// Corner `j`'s `f` of four triangles, one per lane.
+#[inline(always)]
+fn corner3(c: &[&Corners; 4], j: usize, f: impl Fn(&Corners) -> [Vec3; 3]) -> V3 {
+    V3::from_lanes([f(c[0])[j], f(c[1])[j], f(c[2])[j], f(c[3])[j]])
+}
+
+/// Corner `j`'s `f` (a 4-vector, of which xyz) of four triangles.
+#[inline(always)]
+fn corner4(c: &[&Corners; 4], j: usize, f: impl Fn(&Corners) -> [Vec4; 3]) -> V3 {
+    V3::from_lanes([
+        f(c[0])[j].truncate(),
+        f(c[1])[j].truncate(),
+        f(c[2])[j].truncate(),
+        f(c[3])[j].truncate(),
+    ])
+}
+
+impl<'a> FrameData<'a> {
+    /// The corners of triangle `t` (of draw `draw`).
+    #[inline]
+    pub(super) fn corners(&self, draw: usize, t: &Tri) -> Corners {
         let d = self.draws[draw];
-        let model = &self.fs.scene.models[d.model];
-        let mesh = &model.mesh;
+        let mesh = &self.fs.scene.models[d.model].mesh;
         let mv = &self.verts[d.model];
-        let ctx = &self.ctx;
-        let mut position = [Vec3::ZERO; 4];
-        let mut normal = [Vec3::ZERO; 4];
-        let mut geo_normal = [Vec3::ZERO; 4];
-        let mut depth = [0.0f32; 4];
-        let mut u = [0.0f32; 4];
-        let mut v = [0.0f32; 4];
-        let mut tangent = [Vec3::ZERO; 4];
-        let mut sign = [0.0f32; 4];
-        let mut color = [Vec3::ONE; 4];
-        let mut ao = [1.0f32; 4];
-        let mut footprints = [[Footprint::Lod(0.0); 4]; MAX_SIZES];
-        for (k, f) in frags.iter().enumerate() {
-            let t = &self.tris[f.id as usize];
-            let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
-            let l = f.lambda;
-            let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
-            let p = lerp3(&mv.world);
-            position[k] = p;
-            depth[k] = if ctx.orthographic {
-                (p - ctx.eye).dot(ctx.forward)
+        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let tangent = if mv.tangent.is_empty() {
+            [Vec4::ZERO; 3]
+        } else {
+            let c = t.prim as usize * 3;
+            [mv.tangent[c], mv.tangent[c + 1], mv.tangent[c + 2]]
+        };
+        Corners {
+            world: idx.map(|i| mv.world[i]),
+            normal: idx.map(|i| mv.normal[i]),
+            uv: if mesh.uvs.is_empty() {
+                [Vec2::ZERO; 3]
             } else {
-                f.w
-            };
-            let n = lerp3(&mv.normal).normalize_or(Vec3::Y);
-            let n = if t.front { n } else { -n };
-            normal[k] = n;
+                idx.map(|i| mesh.uvs[i])
+            },
+            tangent,
+            color: if mesh.colors.is_empty() {
+                [Vec4::ONE; 3]
+            } else {
+                idx.map(|i| mesh.colors[i])
+            },
+            front: t.front,
+        }
+    }
+
+    /// Four fragments of draw `draw` as the lanes take them: lane k at
+    /// barycentrics (`lx`, `ly`, `lz`)[k] and w `w`[k] of the triangle
+    /// with `corners[k]`, interpolated as `point` and `surface` interpolate
+    /// one fragment (the same operations in the same order, four at a
+    /// time); and their view depths.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn lanes(
+        &self,
+        draw: usize,
+        corners: &[&Corners; 4],
+        l: V3,
+        w: Vec4,
+        ao: Vec4,
+        footprints: [[Footprint; 4]; MAX_SIZES],
+    ) -> (Lanes, Vec4) {
+        let d = self.draws[draw];
+        let mesh = &self.fs.scene.models[d.model].mesh;
+        let ctx = &self.ctx;
+        let world = |k: &Corners| k.world;
+        let position = lerp3(
+            corner3(corners, 0, world),
+            corner3(corners, 1, world),
+            corner3(corners, 2, world),
+            l,
+        );
+        let depth = if ctx.orthographic {
+            (position - V3::splat(ctx.eye)).dot(V3::splat(ctx.forward))
+        } else {
+            w
+        };
+        let nrm = |k: &Corners| k.normal;
+        let n = lerp3(
+            corner3(corners, 0, nrm),
+            corner3(corners, 1, nrm),
+            corner3(corners, 2, nrm),
+            l,
+        )
+        .normalize_or(V3::splat(Vec3::Y));
+        let front = Vec4::new(
+            corners[0].front as u32 as f32,
+            corners[1].front as u32 as f32,
+            corners[2].front as u32 as f32,
+            corners[3].front as u32 as f32,
+        )
+        .cmpgt(Vec4::ZERO);
+        let normal = V3::select(front, n, -n);
+        let mut geo_normal = [Vec3::ZERO; 4];
+        for k in 0..4 {
+            let n = normal.lane(k);
             geo_normal[k] = if self.geo_normal {
-                let [a, b, c] = idx.map(|i| mv.world[i]);
+                let [a, b, c] = corners[k].world;
                 let g = (b - a).cross(c - a).normalize_or(n);
-                if g.dot(ctx.view_vector(p)) < 0.0 {
+                if g.dot(ctx.view_vector(position.lane(k))) < 0.0 {
                     -g
                 } else {
                     g
@@ -133,38 +246,149 @@ impl FrameData<'_> {
             } else {
                 n
             };
-            let uv = &mesh.uvs;
-            if !uv.is_empty() {
-                let t = uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z;
-                (u[k], v[k]) = (t.x, t.y);
+        }
+        let uv = |j: usize| {
+            let p = [
+                corners[0].uv[j],
+                corners[1].uv[j],
+                corners[2].uv[j],
+                corners[3].uv[j],
+            ];
+            (
+                Vec4::new(p[0].x, p[1].x, p[2].x, p[3].x),
+                Vec4::new(p[0].y, p[1].y, p[2].y, p[3].y),
+            )
+        };
+        let ((u0, v0), (u1, v1), (u2, v2)) = (uv(0), uv(1), uv(2));
+        let tan = |k: &Corners| k.tangent;
+        let tangent = lerp3(
+            corner4(corners, 0, tan),
+            corner4(corners, 1, tan),
+            corner4(corners, 2, tan),
+            l,
+        );
+        let color = (!mesh.colors.is_empty()).then(|| {
+            let col = |k: &Corners| k.color;
+            lerp3(
+                corner4(corners, 0, col),
+                corner4(corners, 1, col),
+                corner4(corners, 2, col),
+                l,
+            )
+        });
+        let sign = Vec4::new(
+            corners[0].tangent[0].w,
+            corners[1].tangent[0].w,
+            corners[2].tangent[0].w,
+            corners[3].tangent[0].w,
+        );
+        let lanes = Lanes {
+            position,
+            normal,
+            u: u0 * l.x + u1 * l.y + u2 * l.z,
+            v: v0 * l.x + v1 * l.y + v2 * l.z,
+            tangent,
+            sign,
+            color,
+            geo_normal,
+            ao,
+            footprints,
+        };
+        (lanes, depth)
+    }
+
+    /// The four pixels of the quad whose top-left pixel is `q0`, all of
+    /// triangle `t` (interpolated by `it`) of lane material `lm`, one
+    /// sample each: per pixel in reading order, the linear colour (zero
+    /// where not finite) and view depth, as `fragment` and the lanes give
+    /// them pixel by pixel. The quad's texture derivatives are its lanes'
+    /// differences (what `gradients0` computes).
+    pub(super) fn shade_quad(
+        &self,
+        t: &Tri,
+        it: &Interpolator,
+        lm: &LaneMaterial<'a>,
+        q0: (i32, i32),
+        ao: [f32; 4],
+    ) -> [(Vec3, f32); 4] {
+        let draw = t.draw as usize;
+        let (x, y) = q0;
+        let f = [
+            it.at_pixel(x, y),
+            it.at_pixel(x + 1, y),
+            it.at_pixel(x, y + 1),
+            it.at_pixel(x + 1, y + 1),
+        ];
+        let corners = self.corners(draw, t);
+        let l = V3::from_lanes([f[0].lambda, f[1].lambda, f[2].lambda, f[3].lambda]);
+        let uv = |k: usize| {
+            let c = &corners.uv;
+            let l = f[k].lambda;
+            c[0] * l.x + c[1] * l.y + c[2] * l.z
+        };
+        let grads = if self.grads {
+            let a = uv(0);
+            Gradients {
+                dx: uv(1) - a,
+                dy: uv(2) - a,
             }
-            if !mesh.colors.is_empty() {
-                let c = &mesh.colors;
-                color[k] = (c[idx[0]] * l.x + c[idx[1]] * l.y + c[idx[2]] * l.z).truncate();
-            }
-            if !mv.tangent.is_empty() {
-                let c = t.prim as usize * 3;
-                let tt = &mv.tangent;
-                tangent[k] = (tt[c] * l.x + tt[c + 1] * l.y + tt[c + 2] * l.z).truncate();
-                sign[k] = tt[c].w;
-            }
-            ao[k] = f.ao;
+        } else {
+            Gradients::default()
+        };
+        let fp = lm.footprints(&self.ctx, grads);
+        let footprints = [[fp[0]; 4], [fp[1]; 4], [fp[2]; 4]];
+        let (lanes, depth) = self.lanes(
+            draw,
+            &[&corners; 4],
+            l,
+            Vec4::new(f[0].w, f[1].w, f[2].w, f[3].w),
+            Vec4::from(ao),
+            footprints,
+        );
+        let c = self.ctx.shade_lanes(lm, &lanes);
+        let out = |k: usize| {
+            let c = c.lane(k);
+            (if c.is_finite() { c } else { Vec3::ZERO }, depth[k])
+        };
+        [out(0), out(1), out(2), out(3)]
+    }
+
+    /// Four queued fragments of draw `draw` as the lanes take them, and
+    /// their view depths.
+    fn gather(&self, draw: usize, frags: &[Pending; 4]) -> (Lanes, [f32; 4]) {
+        let tri = |k: usize| &self.tris[frags[k].id as usize];
+        let c0 = self.corners(draw, tri(0));
+        // Neighbouring fragments mostly share a triangle.
+        let c1 = if frags[1].id == frags[0].id {
+            c0
+        } else {
+            self.corners(draw, tri(1))
+        };
+        let c2 = if frags[2].id == frags[1].id {
+            c1
+        } else {
+            self.corners(draw, tri(2))
+        };
+        let c3 = if frags[3].id == frags[2].id {
+            c2
+        } else {
+            self.corners(draw, tri(3))
+        };
+        let mut footprints = [[Footprint::Lod(0.0); 4]; MAX_SIZES];
+        for (k, f) in frags.iter().enumerate() {
             for (s, fp) in footprints.iter_mut().enumerate() {
                 fp[k] = f.footprints[s];
             }
         }
-        let lanes = Lanes {
-            position: V3::from_lanes(position),
-            normal: V3::from_lanes(normal),
-            u: Vec4::from(u),
-            v: Vec4::from(v),
-            tangent: V3::from_lanes(tangent),
-            sign: Vec4::from(sign),
-            color: (!mesh.colors.is_empty()).then(|| V3::from_lanes(color)),
-            geo_normal,
-            ao: Vec4::from(ao),
+        let f = |k: usize| &frags[k];
+        let (lanes, depth) = self.lanes(
+            draw,
+            &[&c0, &c1, &c2, &c3],
+            V3::from_lanes([f(0).lambda, f(1).lambda, f(2).lambda, f(3).lambda]),
+            Vec4::new(f(0).w, f(1).w, f(2).w, f(3).w),
+            Vec4::new(f(0).ao, f(1).ao, f(2).ao, f(3).ao),
             footprints,
-        };
-        (lanes, depth)
+        );
+        (lanes, depth.to_array())
     }
 }
