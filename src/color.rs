@@ -59,6 +59,23 @@ pub fn encode_srgb(v: f32) -> u8 {
     lut[i.min(LUT_SIZE - 1)]
 }
 
+/// `encode_srgb` of the three channels of `c`, together (the same bytes).
+#[inline]
+pub fn encode_srgb3(c: glam::Vec3) -> [u8; 3] {
+    use glam::Vec4;
+    let lut = srgb_lut();
+    // max(NaN, 0) is 0, as clamp(NaN) gives index 0.
+    let v = Vec4::new(c.x, c.y, c.z, 0.0).max(Vec4::ZERO).min(Vec4::ONE)
+        * Vec4::splat((LUT_SIZE - 1) as f32)
+        + Vec4::splat(0.5);
+    let i = v.as_uvec4();
+    [
+        lut[(i.x as usize).min(LUT_SIZE - 1)],
+        lut[(i.y as usize).min(LUT_SIZE - 1)],
+        lut[(i.z as usize).min(LUT_SIZE - 1)],
+    ]
+}
+
 /// [0,1] -> byte without transfer curve (data: normals, depth, alpha).
 #[inline]
 pub fn encode_linear(v: f32) -> u8 {
@@ -68,6 +85,31 @@ pub fn encode_linear(v: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn three_channels_encode_as_one() {
+        let mut x = 0x1234_5678u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            f32::from_bits(x)
+        };
+        let special = [f32::NAN, -0.0, 0.0, 1.0, -1.0, 2.0, f32::INFINITY, 1e-9, 0.5];
+        for k in 0..100_000 {
+            let v = if k < special.len() { special[k] } else if k % 2 == 0 {
+                (next().to_bits() >> 9) as f32 / (1 << 23) as f32 * 1.2 - 0.1
+            } else {
+                next()
+            };
+            let c = glam::Vec3::new(v, 0.25, -v);
+            assert_eq!(
+                encode_srgb3(c),
+                [encode_srgb(c.x), encode_srgb(c.y), encode_srgb(c.z)],
+                "{v}"
+            );
+        }
+    }
 
     #[test]
     fn srgb_tables_round_trip() {

@@ -5,7 +5,7 @@
 //! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
 //! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
-//! frame by [`batch`]. [`color`], [`error`], [`raster`] and [`raytrace`]
+//! frame by [`batch`]. [`color`], [`error`], [`raster`], [`raytrace`] and [`simd`]
 //! are the ground floor: they import nothing of the layers above.
 //!
 //! The library is the renderer alone with `--no-default-features`; the
@@ -50,6 +50,7 @@ pub mod raytrace;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod simd;
 #[cfg(feature = "tools")]
 pub mod tools;
 

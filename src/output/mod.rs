@@ -14,7 +14,7 @@ use std::path::Path;
 
 use glam::Vec4;
 
-use crate::color::{encode_linear, encode_srgb};
+use crate::color::{encode_linear, encode_srgb3};
 use crate::error::Error;
 use crate::render::Frame;
 use crate::scene::RenderSettings;
@@ -49,10 +49,10 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
         let rgb = if data_view {
             [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
         } else {
-            let t = tonemap(c.truncate(), s.tonemap, scale);
-            [encode_srgb(t.x), encode_srgb(t.y), encode_srgb(t.z)]
+            encode_srgb3(tonemap(c.truncate(), s.tonemap, scale))
         };
-        [rgb[0], rgb[1], rgb[2], encode_linear(c.w)]
+        let a = if alpha { encode_linear(c.w) } else { 255 };
+        [rgb[0], rgb[1], rgb[2], a]
     };
     use rayon::prelude::*;
     let rows = data

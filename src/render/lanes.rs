@@ -17,7 +17,7 @@ use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
 use crate::shade::blinn_phong4::LaneMaterial;
 use crate::shade::blinn_phong4::{Lanes, MAX_SIZES};
-use crate::shade::lanes::{V3, lerp3};
+use crate::simd::{V3, lanes4, lerp3};
 
 /// A fragment waiting for its lane.
 #[derive(Clone, Copy)]
@@ -224,7 +224,7 @@ impl<'a> FrameData<'a> {
             l,
         )
         .normalize_or(V3::splat(Vec3::Y));
-        let front = Vec4::new(
+        let front = lanes4(
             corners[0].front as u32 as f32,
             corners[1].front as u32 as f32,
             corners[2].front as u32 as f32,
@@ -255,8 +255,8 @@ impl<'a> FrameData<'a> {
                 corners[3].uv[j],
             ];
             (
-                Vec4::new(p[0].x, p[1].x, p[2].x, p[3].x),
-                Vec4::new(p[0].y, p[1].y, p[2].y, p[3].y),
+                lanes4(p[0].x, p[1].x, p[2].x, p[3].x),
+                lanes4(p[0].y, p[1].y, p[2].y, p[3].y),
             )
         };
         let ((u0, v0), (u1, v1), (u2, v2)) = (uv(0), uv(1), uv(2));
@@ -276,7 +276,7 @@ impl<'a> FrameData<'a> {
                 l,
             )
         });
-        let sign = Vec4::new(
+        let sign = lanes4(
             corners[0].tangent[0].w,
             corners[1].tangent[0].w,
             corners[2].tangent[0].w,
@@ -341,8 +341,8 @@ impl<'a> FrameData<'a> {
             draw,
             &[&corners; 4],
             l,
-            Vec4::new(f[0].w, f[1].w, f[2].w, f[3].w),
-            Vec4::from(ao),
+            lanes4(f[0].w, f[1].w, f[2].w, f[3].w),
+            lanes4(ao[0], ao[1], ao[2], ao[3]),
             footprints,
         );
         let c = self.ctx.shade_lanes(lm, &lanes);
@@ -385,8 +385,8 @@ impl<'a> FrameData<'a> {
             draw,
             &[&c0, &c1, &c2, &c3],
             V3::from_lanes([f(0).lambda, f(1).lambda, f(2).lambda, f(3).lambda]),
-            Vec4::new(f(0).w, f(1).w, f(2).w, f(3).w),
-            Vec4::new(f(0).ao, f(1).ao, f(2).ao, f(3).ao),
+            lanes4(f(0).w, f(1).w, f(2).w, f(3).w),
+            lanes4(f(0).ao, f(1).ao, f(2).ao, f(3).ao),
             footprints,
         );
         (lanes, depth.to_array())

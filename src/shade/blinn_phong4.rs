@@ -21,7 +21,7 @@ use smallvec::SmallVec;
 
 use super::ShadeContext;
 use super::blinn_phong::SurfaceColor;
-use super::lanes::V3;
+use crate::simd::V3;
 use super::light::incidence;
 use crate::assets::texture::{
     Filtering, Footprint, Gradients, Level, Taps4, Texture, TextureFilter as Filter, TextureRef,

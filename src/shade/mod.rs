@@ -8,7 +8,6 @@ pub mod env;
 pub mod env_sampled;
 pub mod gouraud;
 pub mod iridescence;
-pub mod lanes;
 pub mod light;
 pub mod pbr;
 pub mod shadow;

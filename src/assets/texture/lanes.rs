@@ -21,6 +21,7 @@ use glam::{Vec2, Vec4};
 
 use super::{Footprint, Level, Texture, Wrap};
 use crate::color::srgb_to_linear_table;
+use crate::simd::{lanes4, unit_bytes4, whole4};
 
 /// Red, green and blue of four lookups, one lane each.
 pub type Rgb4 = [Vec4; 3];
@@ -123,7 +124,10 @@ impl Texture {
             u,
             v,
             near: Place4::new(near, near.map(level), u, v),
-            far: two.then(|| (Place4::new(far, far.map(level), u, v), Vec4::from(weight))),
+            far: two.then(|| {
+                let w = lanes4(weight[0], weight[1], weight[2], weight[3]);
+                (Place4::new(far, far.map(level), u, v), w)
+            }),
         }
     }
 
@@ -194,10 +198,10 @@ impl Texture {
         } else {
             for (ch, o) in out.iter_mut().enumerate() {
                 let shift = 8 * ch as u32;
-                let a = data_channel4(&texels[0], shift);
-                let b = data_channel4(&texels[1], shift);
-                let c = data_channel4(&texels[2], shift);
-                let d = data_channel4(&texels[3], shift);
+                let a = unit_bytes4(texels[0], shift);
+                let b = unit_bytes4(texels[1], shift);
+                let c = unit_bytes4(texels[2], shift);
+                let d = unit_bytes4(texels[3], shift);
                 let top = a * gx + b * fx;
                 let bottom = c * gx + d * fx;
                 *o = top * gy + bottom * fy;
@@ -292,13 +296,13 @@ impl Place4 {
     /// `Level::footprint` finds the texels.
     #[inline(always)]
     fn new(level: [usize; 4], levels: [&Level; 4], u: Vec4, v: Vec4) -> Place4 {
-        let w = Vec4::new(
+        let w = lanes4(
             levels[0].width as f32,
             levels[1].width as f32,
             levels[2].width as f32,
             levels[3].width as f32,
         );
-        let h = Vec4::new(
+        let h = lanes4(
             levels[0].height as f32,
             levels[1].height as f32,
             levels[2].height as f32,
@@ -344,56 +348,12 @@ fn blend(a: Rgb4, b: Rgb4, f: Vec4) -> Rgb4 {
     ]
 }
 
-/// Four whole, non-negative floats below 2^31 as integers (lanes outside
-/// that range give unspecified values, which callers do not read).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn whole4(v: Vec4) -> [u32; 4] {
-    use std::arch::x86_64::*;
-    let mut out = [0u32; 4];
-    // SAFETY: SSE2 only (in every x86-64 target's base features); the
-    // store writes the 16 bytes of `out`.
-    unsafe { _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_cvttps_epi32(v.into())) };
-    out
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-fn whole4(v: Vec4) -> [u32; 4] {
-    v.to_array().map(|x| x as u32)
-}
-
 /// Channel `shift / 8` of four stored sRGB texels (one per lane),
 /// linear: the decoding table's values.
 #[inline(always)]
 fn srgb_channel4(lut: &[f32; 256], t: &[u32; 4], shift: u32) -> Vec4 {
     let at = |k: usize| lut[((t[k] >> shift) & 0xff) as usize];
-    Vec4::new(at(0), at(1), at(2), at(3))
-}
-
-/// Channel `shift / 8` of four stored data texels (one per lane), as
-/// `byte as f32 * (1.0 / 255.0)`.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn data_channel4(t: &[u32; 4], shift: u32) -> Vec4 {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 only (in every x86-64 target's base features); the
-    // one memory access reads the 16 bytes of `t`.
-    unsafe {
-        let v = _mm_loadu_si128(t.as_ptr() as *const __m128i);
-        let v = _mm_and_si128(
-            _mm_srl_epi32(v, _mm_cvtsi32_si128(shift as i32)),
-            _mm_set1_epi32(0xff),
-        );
-        Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(v), _mm_set1_ps(1.0 / 255.0)))
-    }
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-fn data_channel4(t: &[u32; 4], shift: u32) -> Vec4 {
-    let at = |k: usize| ((t[k] >> shift) & 0xff) as f32;
-    Vec4::new(at(0), at(1), at(2), at(3)) * Vec4::splat(1.0 / 255.0)
+    lanes4(at(0), at(1), at(2), at(3))
 }
 
 #[cfg(test)]

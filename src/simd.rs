@@ -1,8 +1,13 @@
-//! Four shading points at once: 3-vectors held as a structure of arrays
-//! (x, y and z each a `Vec4` of four lanes), with the operations of glam's
-//! `Vec3` done lane by lane in the same order, so that every lane is bit
-//! for bit what the one-point code computes (IEEE operations on SSE lanes
-//! round as scalar ones do, and Rust never fuses a multiply and an add).
+//! The wide types of the renderer's four-lane code (shading four
+//! fragments at a time, `shade::blinn_phong4`, and its texture lookups):
+//! four f32 lanes are glam's `Vec4` (SSE on x86-64), `V3` is four
+//! 3-vectors as a structure of arrays, and the few operations glam does
+//! not offer (lanes from scalars without a trip through memory, whole
+//! numbers and bytes to and from lanes) are here, with a scalar fallback
+//! elsewhere. Every operation is the scalar one lane by lane, in the same
+//! order (IEEE operations on SSE lanes round as scalar ones do, and Rust
+//! never fuses a multiply and an add), so four-lane code can give the
+//! one-lane code's results bit for bit.
 
 // Loops over the four lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -10,6 +15,68 @@
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::{BVec4A, Vec3, Vec4};
+
+/// Lanes (a, b, c, d). glam's `Vec4::new` goes through memory on SSE
+/// (four scalar stores, then one wide load that waits for them); this
+/// builds the vector in registers.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn lanes4(a: f32, b: f32, c: f32, d: f32) -> Vec4 {
+    use std::arch::x86_64::_mm_set_ps;
+    // SAFETY: SSE only (in every x86-64 target's base features); no
+    // memory is touched.
+    Vec4::from(unsafe { _mm_set_ps(d, c, b, a) })
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub fn lanes4(a: f32, b: f32, c: f32, d: f32) -> Vec4 {
+    Vec4::new(a, b, c, d)
+}
+
+/// The four lanes of `v`, whole and non-negative below 2^31, as integers
+/// (truncated; lanes outside that range give unspecified values).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn whole4(v: Vec4) -> [u32; 4] {
+    use std::arch::x86_64::*;
+    let mut out = [0u32; 4];
+    // SAFETY: SSE2 only (in every x86-64 target's base features); the
+    // store writes the 16 bytes of `out`.
+    unsafe { _mm_storeu_si128(out.as_mut_ptr() as *mut __m128i, _mm_cvttps_epi32(v.into())) };
+    out
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub fn whole4(v: Vec4) -> [u32; 4] {
+    v.to_array().map(|x| x as u32)
+}
+
+/// Byte `shift / 8` of each of four words, as `byte as f32 * (1.0 /
+/// 255.0)` (an RGBA8 texel's channel as a data value).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn unit_bytes4(t: [u32; 4], shift: u32) -> Vec4 {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 only (in every x86-64 target's base features); no
+    // memory is touched.
+    unsafe {
+        let v = _mm_set_epi32(t[3] as i32, t[2] as i32, t[1] as i32, t[0] as i32);
+        let v = _mm_and_si128(
+            _mm_srl_epi32(v, _mm_cvtsi32_si128(shift as i32)),
+            _mm_set1_epi32(0xff),
+        );
+        Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(v), _mm_set1_ps(1.0 / 255.0)))
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub fn unit_bytes4(t: [u32; 4], shift: u32) -> Vec4 {
+    let at = |k: usize| ((t[k] >> shift) & 0xff) as f32;
+    Vec4::new(at(0), at(1), at(2), at(3)) * Vec4::splat(1.0 / 255.0)
+}
 
 /// Four 3-vectors, one per lane.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,9 +105,9 @@ impl V3 {
     #[inline(always)]
     pub fn from_lanes(v: [Vec3; 4]) -> V3 {
         V3 {
-            x: Vec4::new(v[0].x, v[1].x, v[2].x, v[3].x),
-            y: Vec4::new(v[0].y, v[1].y, v[2].y, v[3].y),
-            z: Vec4::new(v[0].z, v[1].z, v[2].z, v[3].z),
+            x: lanes4(v[0].x, v[1].x, v[2].x, v[3].x),
+            y: lanes4(v[0].y, v[1].y, v[2].y, v[3].y),
+            z: lanes4(v[0].z, v[1].z, v[2].z, v[3].z),
         }
     }
 
@@ -188,6 +255,21 @@ pub fn lerp3(a: V3, b: V3, c: V3, l: V3) -> V3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lanes_and_bytes_are_the_scalar_values() {
+        assert_eq!(lanes4(1.0, -2.0, f32::NAN, 4.0).to_array()[..2], [1.0, -2.0]);
+        assert!(lanes4(1.0, -2.0, f32::NAN, 4.0).z.is_nan());
+        assert_eq!(whole4(Vec4::new(0.0, 1.0, 7.0, 16_777_215.0)), [0, 1, 7, 16_777_215]);
+        let t = [0x0403_0201, 0xff00_80fe, 0, u32::MAX];
+        for shift in [0, 8, 16, 24] {
+            let v = unit_bytes4(t, shift);
+            for k in 0..4 {
+                let b = ((t[k] >> shift) & 0xff) as f32;
+                assert_eq!(v[k].to_bits(), (b * (1.0 / 255.0)).to_bits());
+            }
+        }
+    }
 
     #[test]
     fn lanes_are_bit_for_bit_the_scalar_operations() {
