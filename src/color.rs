@@ -95,9 +95,21 @@ mod tests {
             x ^= x << 5;
             f32::from_bits(x)
         };
-        let special = [f32::NAN, -0.0, 0.0, 1.0, -1.0, 2.0, f32::INFINITY, 1e-9, 0.5];
+        let special = [
+            f32::NAN,
+            -0.0,
+            0.0,
+            1.0,
+            -1.0,
+            2.0,
+            f32::INFINITY,
+            1e-9,
+            0.5,
+        ];
         for k in 0..100_000 {
-            let v = if k < special.len() { special[k] } else if k % 2 == 0 {
+            let v = if k < special.len() {
+                special[k]
+            } else if k % 2 == 0 {
                 (next().to_bits() >> 9) as f32 / (1 << 23) as f32 * 1.2 - 0.1
             } else {
                 next()

@@ -258,9 +258,15 @@ mod tests {
 
     #[test]
     fn lanes_and_bytes_are_the_scalar_values() {
-        assert_eq!(lanes4(1.0, -2.0, f32::NAN, 4.0).to_array()[..2], [1.0, -2.0]);
+        assert_eq!(
+            lanes4(1.0, -2.0, f32::NAN, 4.0).to_array()[..2],
+            [1.0, -2.0]
+        );
         assert!(lanes4(1.0, -2.0, f32::NAN, 4.0).z.is_nan());
-        assert_eq!(whole4(Vec4::new(0.0, 1.0, 7.0, 16_777_215.0)), [0, 1, 7, 16_777_215]);
+        assert_eq!(
+            whole4(Vec4::new(0.0, 1.0, 7.0, 16_777_215.0)),
+            [0, 1, 7, 16_777_215]
+        );
         let t = [0x0403_0201, 0xff00_80fe, 0, u32::MAX];
         for shift in [0, 8, 16, 24] {
             let v = unit_bytes4(t, shift);

@@ -471,11 +471,12 @@ impl<'a> FrameData<'a> {
                 }
                 // A quad of one lane-shaded triangle: its four pixels are
                 // the four lanes.
-                if n == 1 && lanes.is_some() && qx + 1 < tw && qy + 1 < th {
+                if lanes.is_some() && qx + 1 < tw && qy + 1 < th {
                     let i0 = qy * tw + qx;
                     let quad = [i0, i0 + 1, i0 + tw, i0 + tw + 1];
-                    let id = vis.id[i0];
-                    if id != NO_TRIANGLE && quad.iter().all(|&i| vis.id[i] == id) {
+                    let id = vis.id[i0 * n];
+                    let one = |i: usize| vis.id[i * n..(i + 1) * n].iter().all(|&s| s == id);
+                    if id != NO_TRIANGLE && quad.iter().all(|&i| one(i)) {
                         let t = &self.tris[id as usize];
                         if let Some(lm) = self.lane_material(t.draw as usize) {
                             let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
@@ -484,7 +485,7 @@ impl<'a> FrameData<'a> {
                             let shaded = self.shade_quad(t, it, lm, q0, ao);
                             for (k, &i) in quad.iter().enumerate() {
                                 (color[i], depth[i]) =
-                                    resolve(&[Part::Queued(0, 1.0)], &shaded[k..k + 1], inv_n);
+                                    resolve(&[Part::Queued(0, n as f32)], &shaded[k..k + 1], inv_n);
                             }
                             continue;
                         }
@@ -536,10 +537,11 @@ impl<'a> FrameData<'a> {
                         cache: &mut cache,
                         quad: &mut quad,
                     };
-                    if n == 1 {
-                        // One fragment, shaded now or by the lanes (which
-                        // write it).
-                        match self.fragment(&mut at, ids[0], 1) {
+                    if ids[1..].iter().all(|&s| s == ids[0]) {
+                        // One fragment over every sample, shaded now or
+                        // by the lanes (which write it).
+                        let all = (1u32 << n) - 1;
+                        match self.fragment(&mut at, ids[0], all) {
                             Shaded::Now(part) => {
                                 (color[i], depth[i]) = resolve(&[part], &[], inv_n);
                             }
@@ -648,6 +650,7 @@ impl<'a> FrameData<'a> {
                 Pending {
                     id,
                     pixel: 0,
+                    count,
                     lambda: frag.lambda,
                     w: frag.w,
                     footprints,
@@ -669,7 +672,7 @@ impl<'a> FrameData<'a> {
     /// is interpolated: the pixel center when it is inside the triangle,
     /// otherwise the centroid of the covered samples.
     #[inline]
-    fn shading_point(&self, it: &Interpolator, px: i32, py: i32, mask: u32) -> Fragment {
+    pub(super) fn shading_point(&self, it: &Interpolator, px: i32, py: i32, mask: u32) -> Fragment {
         if self.pattern.len() == 1 || it.covers_center(px, py) {
             return it.at_pixel(px, py);
         }
@@ -989,7 +992,7 @@ pub(super) struct Sink<'s> {
 impl Sink<'_> {
     /// The result of slot `slot` for `pixel`: linear colour, view depth.
     #[inline]
-    pub fn put(&mut self, slot: u32, pixel: u32, c: Vec3, d: f32) {
+    pub fn put(&mut self, slot: u32, pixel: u32, count: f32, c: Vec3, d: f32) {
         if pixel == LANE_SLOT {
             let slot = slot as usize;
             if self.shaded.len() <= slot {
@@ -999,7 +1002,7 @@ impl Sink<'_> {
         } else {
             let i = pixel as usize;
             (self.color[i], self.depth[i]) =
-                resolve(&[Part::Queued(0, 1.0)], &[(c, d)], self.inv_n);
+                resolve(&[Part::Queued(0, count)], &[(c, d)], self.inv_n);
         }
     }
 }

@@ -27,6 +27,9 @@ pub(super) struct Pending {
     /// The pixel the result goes to (its index in the band), or a marker
     /// the caller chose for results it collects by slot.
     pub pixel: u32,
+    /// The samples of the pixel it covers (all of them, where it goes to
+    /// its pixel).
+    pub count: f32,
     /// Barycentrics at the shading point, and w there.
     pub lambda: Vec3,
     pub w: f32,
@@ -55,6 +58,7 @@ impl Pending {
     const NONE: Pending = Pending {
         id: 0,
         pixel: 0,
+        count: 1.0,
         lambda: Vec3::ZERO,
         w: 0.0,
         footprints: [Footprint::Lod(0.0); MAX_SIZES],
@@ -120,7 +124,7 @@ fn shade_group(data: &FrameData, draw: usize, w: &Waiting, sink: &mut Sink) {
     for k in 0..w.len {
         let c = c.lane(k);
         let c = if c.is_finite() { c } else { Vec3::ZERO };
-        sink.put(w.slots[k], w.group[k].pixel, c, depth[k]);
+        sink.put(w.slots[k], w.group[k].pixel, w.group[k].count, c, depth[k]);
     }
 }
 
@@ -313,17 +317,21 @@ impl<'a> FrameData<'a> {
     ) -> [(Vec3, f32); 4] {
         let draw = t.draw as usize;
         let (x, y) = q0;
-        let f = [
-            it.at_pixel(x, y),
-            it.at_pixel(x + 1, y),
-            it.at_pixel(x, y + 1),
-            it.at_pixel(x + 1, y + 1),
-        ];
+        let px = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+        let centers = px.map(|(x, y)| it.at_pixel(x, y));
+        // With MSAA the shading point leaves a center the triangle does not
+        // cover (`shading_point`); the derivatives stay the centers'.
+        let f = if self.pattern.len() == 1 {
+            centers
+        } else {
+            let all = (1u32 << self.pattern.len()) - 1;
+            [0, 1, 2, 3].map(|k| self.shading_point(it, px[k].0, px[k].1, all))
+        };
         let corners = self.corners(draw, t);
         let l = V3::from_lanes([f[0].lambda, f[1].lambda, f[2].lambda, f[3].lambda]);
         let uv = |k: usize| {
             let c = &corners.uv;
-            let l = f[k].lambda;
+            let l = centers[k].lambda;
             c[0] * l.x + c[1] * l.y + c[2] * l.z
         };
         let grads = if self.grads {

@@ -21,16 +21,16 @@ use smallvec::SmallVec;
 
 use super::ShadeContext;
 use super::blinn_phong::SurfaceColor;
-use crate::simd::V3;
 use super::light::incidence;
 use crate::assets::texture::{
-    Filtering, Footprint, Gradients, Level, Taps4, Texture, TextureFilter as Filter, TextureRef,
+    Chain, Filtering, Footprint, Gradients, Taps4, Texture, TextureFilter as Filter, TextureRef,
     Wrap,
 };
 use crate::scene::Material;
 use crate::scene::light::LightKind;
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
+use crate::simd::V3;
 
 /// At most this many distinct texture sizes (and mip chains) among a lane
 /// material's maps: each fragment carries one filter footprint per size,
@@ -39,12 +39,10 @@ use crate::scene::settings::{ShadingMode, TextureFilter};
 pub const MAX_SIZES: usize = 3;
 
 /// One map of a lane material, ready for four lookups.
-#[derive(Clone, Copy)]
 struct Map<'a> {
-    texture: &'a Texture,
+    /// The texture with the frame's mip chain.
+    chain: Chain<'a>,
     mode: Wrap,
-    /// The frame's mip chain of the texture, or None (level 0 only).
-    mips: Option<&'a [Level]>,
     /// Which of the fragment's footprints (by texture size and chain) it
     /// reads, and whose taps.
     slot: usize,
@@ -57,9 +55,9 @@ pub struct LaneMaterial<'a> {
     ks: Option<Map<'a>>,
     /// Tangent-space normal map and its scale.
     normal: Option<(Map<'a>, f32)>,
-    /// Per slot: the (width, height) of its maps and one of them, whose
-    /// taps the others read.
-    sizes: SmallVec<[((u32, u32), Map<'a>); MAX_SIZES]>,
+    /// Per slot: the (width, height) of its maps and their number of
+    /// levels.
+    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
 }
 
 /// Four fragments of one material, one lane each, as `Surface` holds one.
@@ -130,33 +128,27 @@ impl<'a> ShadeContext<'a> {
         {
             return None;
         }
-        let mut sizes: SmallVec<[((u32, u32), Map<'a>); MAX_SIZES]> = SmallVec::new();
+        let mut sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]> = SmallVec::new();
         let mut map = |t: &'a TextureRef| -> Option<Map<'a>> {
             if !t.is_plain() || t.texcoord != 0 || !uvs {
                 return None;
             }
             let tex = &*t.texture;
             let mips = self.mips.get(tex.id).copied().flatten();
-            let size = (tex.width, tex.height);
-            let chain = mips.map(|m| m.len());
-            let mut map = Map {
-                texture: tex,
-                mode: t.address.unwrap_or(self.address.into()),
-                mips,
-                slot: 0,
-            };
-            map.slot = match sizes
-                .iter()
-                .position(|(s, m)| *s == size && m.mips.map(|m| m.len()) == chain)
-            {
+            let shape = ((tex.width, tex.height), 1 + mips.map_or(0, |m| m.len()));
+            let slot = match sizes.iter().position(|s| *s == shape) {
                 Some(k) => k,
                 None if sizes.len() < MAX_SIZES => {
-                    sizes.push((size, map));
+                    sizes.push(shape);
                     sizes.len() - 1
                 }
                 None => return None,
             };
-            Some(map)
+            Some(Map {
+                chain: tex.chain(mips),
+                mode: t.address.unwrap_or(self.address.into()),
+                slot,
+            })
         };
         let kd = match &m.map_kd {
             Some(t) => Some(map(t)?),
@@ -200,19 +192,24 @@ impl<'a> ShadeContext<'a> {
         let m = lm.material;
         // Where each slot's lookups fall, found once for its maps.
         let mut taps: [Option<Taps4>; MAX_SIZES] = Default::default();
-        for (k, (_, map)) in lm.sizes.iter().enumerate() {
-            taps[k] = map.texture.taps4(f.u, f.v, &f.footprints[k], map.mips);
+        let mut found = [false; MAX_SIZES];
+        let maps = [
+            lm.kd.as_ref(),
+            lm.ks.as_ref(),
+            lm.normal.as_ref().map(|n| &n.0),
+        ];
+        for map in maps.into_iter().flatten() {
+            if !found[map.slot] {
+                found[map.slot] = true;
+                taps[map.slot] = map.chain.taps4(f.u, f.v, &f.footprints[map.slot]);
+            }
         }
         let tex = |map: &Map| {
             let [r, g, b] = match &taps[map.slot] {
-                Some(t) => map.texture.read4(t, map.mode, map.mips),
-                None => map.texture.sample_footprint4(
-                    f.u,
-                    f.v,
-                    &f.footprints[map.slot],
-                    map.mode,
-                    map.mips,
-                ),
+                Some(t) => map.chain.read4(t, map.mode),
+                None => map
+                    .chain
+                    .sample4(f.u, f.v, &f.footprints[map.slot], map.mode),
             };
             V3 { x: r, y: g, z: b }
         };

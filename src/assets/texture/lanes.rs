@@ -20,6 +20,8 @@
 use glam::{Vec2, Vec4};
 
 use super::{Footprint, Level, Texture, Wrap};
+use smallvec::SmallVec;
+
 use crate::color::srgb_to_linear_table;
 use crate::simd::{lanes4, unit_bytes4, whole4};
 
@@ -29,6 +31,9 @@ pub type Rgb4 = [Vec4; 3];
 /// Where four trilinear lookups fall in any texture of one size and mip
 /// chain (`Texture::taps4`).
 pub struct Taps4 {
+    /// The chain's shape (`Chain::shape`) and the lanes' levels of detail.
+    shape: (u32, u32, usize),
+    lod: [f32; 4],
     u: Vec4,
     v: Vec4,
     near: Place4,
@@ -55,7 +60,31 @@ struct Place4 {
     inside: u32,
 }
 
+/// A texture's levels as the four-lane lookups read them: the image and
+/// the frame's mip chain (`Texture::chain`), each level's texels at hand.
+pub struct Chain<'t> {
+    texture: &'t Texture,
+    mips: Option<&'t [Level]>,
+    /// Per level (0: the image), its texels as `Level::texels`.
+    texels: SmallVec<[&'t [u32]; 16]>,
+}
+
 impl Texture {
+    /// This texture with the mip chain `mips` (its levels 1.., or None:
+    /// level 0 only), for four-lane lookups.
+    pub fn chain<'t>(&'t self, mips: Option<&'t [Level]>) -> Chain<'t> {
+        let mut texels: SmallVec<[&[u32]; 16]> = SmallVec::new();
+        texels.push(self.base.texels());
+        for l in mips.unwrap_or(&[]) {
+            texels.push(l.texels());
+        }
+        Chain {
+            texture: self,
+            mips,
+            texels,
+        }
+    }
+
     /// `sample_footprint(uv_k, fps[k], mode, mips)` for the four lanes k
     /// of (`u`, `v`), red, green and blue.
     pub fn sample_footprint4(
@@ -66,23 +95,30 @@ impl Texture {
         mode: Wrap,
         mips: Option<&[Level]>,
     ) -> Rgb4 {
-        match self.taps4(u, v, fps, mips) {
-            Some(taps) => self.read4(&taps, mode, mips),
-            None => self.probes4(u, v, fps, mode, mips),
+        self.chain(mips).sample4(u, v, fps, mode)
+    }
+}
+
+impl<'t> Chain<'t> {
+    /// The texture's size and number of levels: taps found in one chain
+    /// serve every chain of the same shape.
+    fn shape(&self) -> (u32, u32, usize) {
+        (self.texture.width, self.texture.height, self.texels.len())
+    }
+
+    /// `Texture::sample_footprint4` in this chain.
+    pub fn sample4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgb4 {
+        match self.taps4(u, v, fps) {
+            Some(taps) => self.read4(&taps, mode),
+            None => self.probes4(u, v, fps, mode),
         }
     }
 
-    /// Where `sample_footprint4` reads at one trilinear probe per lane
-    /// (`Footprint::Lod`), in this texture or any other of its size and
-    /// chain; None where some lane takes anisotropic probes.
+    /// Where `sample4` reads at one trilinear probe per lane
+    /// (`Footprint::Lod`), in this chain or any other of its shape; None
+    /// where some lane takes anisotropic probes.
     #[inline]
-    pub fn taps4(
-        &self,
-        u: Vec4,
-        v: Vec4,
-        fps: &[Footprint; 4],
-        mips: Option<&[Level]>,
-    ) -> Option<Taps4> {
+    pub fn taps4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4]) -> Option<Taps4> {
         let mut lod = [0.0f32; 4];
         for k in 0..4 {
             match fps[k] {
@@ -90,17 +126,17 @@ impl Texture {
                 Footprint::Probes { .. } => return None,
             }
         }
-        Some(self.lod_taps4(u, v, lod, mips))
+        Some(self.lod_taps4(u, v, lod))
     }
 
     /// The taps of `sample_lod(mips, uv_k, mode, lod[k])` per lane: the
     /// level `lod[k]` selects, and the next one where it blends two.
-    fn lod_taps4(&self, u: Vec4, v: Vec4, lod: [f32; 4], mips: Option<&[Level]>) -> Taps4 {
+    fn lod_taps4(&self, u: Vec4, v: Vec4, lod: [f32; 4]) -> Taps4 {
         let mut near = [0usize; 4];
         let mut far = [0usize; 4];
         let mut weight = [0.0f32; 4];
         let mut two = false;
-        if let Some(mips) = mips {
+        if let Some(mips) = self.mips {
             let top = mips.len() as f32;
             for k in 0..4 {
                 if lod[k] <= 0.0 || lod[k].is_nan() {
@@ -119,8 +155,10 @@ impl Texture {
                 }
             }
         }
-        let level = |i: usize| level_of(&self.base, mips, i);
+        let level = |i: usize| self.level(i);
         Taps4 {
+            shape: self.shape(),
+            lod,
             u,
             v,
             near: Place4::new(near, near.map(level), u, v),
@@ -131,51 +169,55 @@ impl Texture {
         }
     }
 
-    /// The lookups `taps` (found in a texture of this size and chain)
-    /// describe, in this texture: red, green and blue.
+    /// Level `i` (0: the image).
+    #[inline(always)]
+    fn level(&self, i: usize) -> &'t Level {
+        level_of(&self.texture.base, self.mips, i)
+    }
+
+    /// The lookups `taps` (found in a chain of this shape) describe, in
+    /// this texture: red, green and blue.
     #[inline]
-    pub fn read4(&self, taps: &Taps4, mode: Wrap, mips: Option<&[Level]>) -> Rgb4 {
-        let a = self.bilinear4(&taps.near, taps.u, taps.v, mode, mips);
+    pub fn read4(&self, taps: &Taps4, mode: Wrap) -> Rgb4 {
+        if taps.shape != self.shape() {
+            // Taps of another shape: found again here.
+            return self.read4(&self.lod_taps4(taps.u, taps.v, taps.lod), mode);
+        }
+        let a = self.bilinear4(&taps.near, taps.u, taps.v, mode);
         match &taps.far {
             None => a,
-            Some((far, f)) => blend(a, self.bilinear4(far, taps.u, taps.v, mode, mips), *f),
+            Some((far, f)) => blend(a, self.bilinear4(far, taps.u, taps.v, mode), *f),
         }
     }
 
     /// `sample_lod(mips, uv_k, mode, lod[k])` for the four lanes.
-    pub fn sample_lod4(
-        &self,
-        mips: Option<&[Level]>,
-        u: Vec4,
-        v: Vec4,
-        lod: [f32; 4],
-        mode: Wrap,
-    ) -> Rgb4 {
-        self.read4(&self.lod_taps4(u, v, lod, mips), mode, mips)
+    fn sample_lod4(&self, u: Vec4, v: Vec4, lod: [f32; 4], mode: Wrap) -> Rgb4 {
+        self.read4(&self.lod_taps4(u, v, lod), mode)
     }
 
     /// `bilinear(level, uv_k, mode)` for the four lanes, each in its level
     /// of `place`.
     #[inline(always)]
-    fn bilinear4(
-        &self,
-        place: &Place4,
-        u: Vec4,
-        v: Vec4,
-        mode: Wrap,
-        mips: Option<&[Level]>,
-    ) -> Rgb4 {
+    fn bilinear4(&self, place: &Place4, u: Vec4, v: Vec4, mode: Wrap) -> Rgb4 {
         // Corner j (top-left, top-right, bottom-left, bottom-right) of
         // lane k, as stored.
         let mut texels = [[0u32; 4]; 4];
         for k in 0..4 {
             if place.inside & (1 << k) != 0 {
-                let t = level_of(&self.base, mips, place.level[k]).texels();
+                let t = self.texels[place.level[k]];
                 let (i, dx, dy) = (place.at[k], place.dx[k], place.dy[k]);
-                texels[0][k] = u32::from_le(t[i]);
-                texels[1][k] = u32::from_le(t[i + dx]);
-                texels[2][k] = u32::from_le(t[i + dy]);
-                texels[3][k] = u32::from_le(t[i + dx + dy]);
+                debug_assert!(i + dx + dy < t.len());
+                // SAFETY: an inside lane's footprint has x0 + 1 < width and
+                // y0 + 1 < height in its level (`Place4::new`, for a level
+                // of this size: `read4` checks the shape), so its four
+                // texels, the last at i + dx + dy, lie in the level's
+                // blocks (`Level::footprint_steps`).
+                unsafe {
+                    texels[0][k] = u32::from_le(*t.get_unchecked(i));
+                    texels[1][k] = u32::from_le(*t.get_unchecked(i + dx));
+                    texels[2][k] = u32::from_le(*t.get_unchecked(i + dy));
+                    texels[3][k] = u32::from_le(*t.get_unchecked(i + dx + dy));
+                }
             }
         }
         let (fx, fy) = (place.fx, place.fy);
@@ -183,7 +225,7 @@ impl Texture {
         let mut out = [Vec4::ZERO; 3];
         // Channel by channel: its four corners decoded, then blended as
         // `bilinear` blends them.
-        if self.srgb {
+        if self.texture.srgb {
             let lut = srgb_to_linear_table();
             for (ch, o) in out.iter_mut().enumerate() {
                 let shift = 8 * ch as u32;
@@ -210,8 +252,9 @@ impl Texture {
         if place.inside != 0b1111 {
             for k in 0..4 {
                 if place.inside & (1 << k) == 0 {
-                    let level = level_of(&self.base, mips, place.level[k]);
-                    let r = self.bilinear_wrapped(level, Vec2::new(u[k], v[k]), mode);
+                    let level = self.level(place.level[k]);
+                    let uv = Vec2::new(u[k], v[k]);
+                    let r = self.texture.bilinear_wrapped(level, uv, mode);
                     out[0][k] = r.x;
                     out[1][k] = r.y;
                     out[2][k] = r.z;
@@ -225,14 +268,7 @@ impl Texture {
     /// probes: the probes' sum over their count per lane, a lane with
     /// fewer probes adding nothing after its last (x + 0 = x); a `Lod`
     /// lane is one probe at the point itself ((0 + x) / 1 = x).
-    fn probes4(
-        &self,
-        u: Vec4,
-        v: Vec4,
-        fps: &[Footprint; 4],
-        mode: Wrap,
-        mips: Option<&[Level]>,
-    ) -> Rgb4 {
+    fn probes4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgb4 {
         let mut n = [1u32; 4];
         let mut nf = [1.0f32; 4];
         let mut lod = [0.0f32; 4];
@@ -268,7 +304,7 @@ impl Texture {
                     }
                 }
             }
-            let r = self.sample_lod4(mips, pu, pv, lod, mode);
+            let r = self.sample_lod4(pu, pv, lod, mode);
             let live = Vec4::from(live).cmpgt(Vec4::ZERO);
             for c in 0..3 {
                 sum[c] += Vec4::select(live, r[c], Vec4::ZERO);
