@@ -1,6 +1,8 @@
 //! The render path: a tiny scene built from fuzzed geometry (raw f32 bits,
 //! so extreme and tiny magnitudes), a fuzzed light, camera, shadow, AO,
-//! cull and anti-aliasing settings, rendered at 32x32. This is the target
+//! cull and anti-aliasing settings, and half the time fuzzed texture
+//! coordinates on a textured, normal-mapped material with a fuzzed filter
+//! and address mode, rendered at 32x32. This is the target
 //! that finds arithmetic overflow (debug assertions are on).
 
 #![no_main]
@@ -41,28 +43,20 @@ fuzz_target!(|data: &[u8]| {
     let mut b = Bytes(data);
     let n_verts = 3 + b.u8() as usize % 30;
     let n_tris = 1 + b.u8() as usize % 40;
-    let mut obj = String::new();
-    for _ in 0..n_verts {
-        let (x, y, z) = (b.f32(), b.f32(), b.f32());
-        obj += &format!("v {x:?} {y:?} {z:?}\n");
-    }
-    for _ in 0..n_tris {
-        let (i, j, k) = (
-            1 + b.u8() as usize % n_verts,
-            1 + b.u8() as usize % n_verts,
-            1 + b.u8() as usize % n_verts,
-        );
-        obj += &format!("f {i} {j} {k}\n");
-    }
+    let verts: Vec<(f32, f32, f32)> = (0..n_verts).map(|_| (b.f32(), b.f32(), b.f32())).collect();
+    let tris: Vec<(usize, usize, usize)> = (0..n_tris)
+        .map(|_| {
+            (
+                1 + b.u8() as usize % n_verts,
+                1 + b.u8() as usize % n_verts,
+                1 + b.u8() as usize % n_verts,
+            )
+        })
+        .collect();
     // Some points and lines, drawn by their own pass.
-    for _ in 0..b.u8() % 4 {
-        let (i, j) = (1 + b.u8() as usize % n_verts, 1 + b.u8() as usize % n_verts);
-        obj += &format!("l {i} {j}\np {i}\n");
-    }
-    let dir = common::dir();
-    if std::fs::write(dir.join("render.obj"), obj).is_err() {
-        return;
-    }
+    let lines: Vec<(usize, usize)> = (0..b.u8() % 4)
+        .map(|_| (1 + b.u8() as usize % n_verts, 1 + b.u8() as usize % n_verts))
+        .collect();
     let light = b.pick(&["point", "directional", "spot"]);
     let (lx, ly, lz) = (b.f32(), b.f32(), b.f32());
     let shadows = b.pick(&["\"hard\"", "\"pcf\"", "\"raytraced\""]);
@@ -96,11 +90,43 @@ fuzz_target!(|data: &[u8]| {
     // Small maps: a 2048^2 map per input held the target at about 15
     // inputs a second; the arithmetic is the same at any size.
     let map_size = b.pick(&["16", "64", "256"]);
+    // Textured (the common library's material: a colour map and a normal
+    // map) with fuzzed texture coordinates, filter and address mode: the
+    // four-lane texture lookups.
+    let textured = b.u8() % 2 == 1;
+    let filter = b.pick(&["nearest", "bilinear", "trilinear", "anisotropic"]);
+    let address = b.pick(&["repeat", "mirror", "clamp", "border"]);
+    let mut obj = String::new();
+    if textured {
+        obj += "mtllib lib.mtl\nusemtl m\n";
+    }
+    for (x, y, z) in &verts {
+        obj += &format!("v {x:?} {y:?} {z:?}\n");
+    }
+    if textured {
+        for _ in 0..n_verts {
+            obj += &format!("vt {:?} {:?}\n", b.f32(), b.f32());
+        }
+    }
+    for (i, j, k) in &tris {
+        obj += &if textured {
+            format!("f {i}/{i} {j}/{j} {k}/{k}\n")
+        } else {
+            format!("f {i} {j} {k}\n")
+        };
+    }
+    for (i, j) in &lines {
+        obj += &format!("l {i} {j}\np {i}\n");
+    }
+    let dir = common::dir();
+    if std::fs::write(dir.join("render.obj"), obj).is_err() {
+        return;
+    }
     let scene = format!(
         "[output]\nwidth = 32\nheight = 32\n\
          [render]\nshadows = {shadows}\ncull = \"{cull}\"\nmsaa = {msaa}\nssaa = {ssaa}\n\
          point_size = {point_size:?}\nline_width = {line_width:?}\n\
-         shadow_map_size = {map_size}\n{ao}\
+         shadow_map_size = {map_size}\ntexture_filter = \"{filter}\"\naddress = \"{address}\"\n{ao}\
          [ground]\nshadow = {ground}\n\
          [[model]]\npath = \"render.obj\"\nscale = {scale}\n\
          [[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\ndirection = [{}, {}, {}]\nshadows = true\n{camera}",

@@ -79,7 +79,7 @@ pub(super) fn shadows<'a>(
     };
     if s.shadows == ShadowMethod::Raytraced {
         out.tracer = tracer;
-        out.lights = light_shadows(fs, mv).into();
+        out.lights = light_shadows(fs, mv, &mut Vec::new()).into();
         return out;
     }
     let key = MapKey {
@@ -100,7 +100,24 @@ pub(super) fn shadows<'a>(
     out.lights = match cached {
         Some(maps) => maps,
         None => {
-            let maps: Arc<[LightShadow]> = light_shadows(fs, mv).into();
+            // The last maps' depth buffers, where no other frame holds
+            // them, are drawn into again (a fresh 16 MB buffer per 2048
+            // map costs its page faults, which the threads take in turn).
+            let mut spare = Vec::new();
+            if let Some((_, mut old)) = cache.last.lock().unwrap_or_else(|e| e.into_inner()).take()
+                && let Some(old) = Arc::get_mut(&mut old)
+            {
+                for ls in old.iter_mut() {
+                    match ls {
+                        LightShadow::Map(m) => spare.push(std::mem::take(&mut m.depth)),
+                        LightShadow::Cube { faces, .. } => {
+                            spare.extend(faces.iter_mut().map(|m| std::mem::take(&mut m.depth)))
+                        }
+                        LightShadow::None | LightShadow::Ray { .. } => {}
+                    }
+                }
+            }
+            let maps: Arc<[LightShadow]> = light_shadows(fs, mv, &mut spare).into();
             *cache.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, maps.clone()));
             maps
         }
@@ -108,8 +125,13 @@ pub(super) fn shadows<'a>(
     out
 }
 
-/// Each light's shadow: its map(s), rays, or none.
-fn light_shadows(fs: &FrameSetup, mv: &[ModelVertices]) -> Vec<LightShadow> {
+/// Each light's shadow: its map(s), rays, or none. Maps draw into the
+/// buffers of `spare` where they fit.
+fn light_shadows(
+    fs: &FrameSetup,
+    mv: &[ModelVertices],
+    spare: &mut Vec<Vec<f32>>,
+) -> Vec<LightShadow> {
     let s = &fs.scene.settings;
     let mut out = Vec::with_capacity(fs.lights.len());
     let size = s.shadow_map_size;
@@ -136,14 +158,16 @@ fn light_shadows(fs: &FrameSetup, mv: &[ModelVertices]) -> Vec<LightShadow> {
             }
         } else {
             match light.kind {
-                LightKind::Directional { direction, .. } => directional(verts, direction, size),
+                LightKind::Directional { direction, .. } => {
+                    directional(verts, direction, size, spare)
+                }
                 LightKind::Spot {
                     position,
                     direction,
                     cos_outer,
                     ..
-                } => spot(verts, position, direction, cos_outer, size),
-                LightKind::Point { position, .. } => point(verts, position, size),
+                } => spot(verts, position, direction, cos_outer, size, spare),
+                LightKind::Point { position, .. } => point(verts, position, size, spare),
             }
         };
         out.push(ls);
@@ -164,7 +188,12 @@ fn look(eye: Vec3, dir: Vec3) -> Mat4 {
     )
 }
 
-fn directional(verts: &[Geo], direction: Vec3, size: u32) -> LightShadow {
+fn directional(
+    verts: &[Geo],
+    direction: Vec3,
+    size: u32,
+    spare: &mut Vec<Vec<f32>>,
+) -> LightShadow {
     let view = look(Vec3::ZERO, direction);
     let (lo, hi) = verts
         .par_iter()
@@ -195,7 +224,7 @@ fn directional(verts: &[Geo], direction: Vec3, size: u32) -> LightShadow {
         near: -hi.z - dz,
         far: -lo.z + dz,
     };
-    LightShadow::Map(render_map(verts, view, projection, size))
+    LightShadow::Map(render_map(verts, view, projection, size, spare))
 }
 
 /// Nearest and farthest distance of any vertex from `position`.
@@ -219,7 +248,14 @@ fn near_plane(verts: &[Geo], position: Vec3) -> Option<f32> {
     (hi > 0.0 && hi.is_finite()).then(|| (lo * 0.25).max(hi * 1e-5))
 }
 
-fn spot(verts: &[Geo], position: Vec3, direction: Vec3, cos_outer: f32, size: u32) -> LightShadow {
+fn spot(
+    verts: &[Geo],
+    position: Vec3,
+    direction: Vec3,
+    cos_outer: f32,
+    size: u32,
+    spare: &mut Vec<Vec<f32>>,
+) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
     };
@@ -231,10 +267,11 @@ fn spot(verts: &[Geo], position: Vec3, direction: Vec3, cos_outer: f32, size: u3
         look(position, direction),
         projection,
         size,
+        spare,
     ))
 }
 
-fn point(verts: &[Geo], position: Vec3, size: u32) -> LightShadow {
+fn point(verts: &[Geo], position: Vec3, size: u32, spare: &mut Vec<Vec<f32>>) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
     };
@@ -244,7 +281,7 @@ fn point(verts: &[Geo], position: Vec3, size: u32) -> LightShadow {
         near,
     };
     let faces = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z]
-        .map(|d| render_map(verts, look(position, d), projection, size));
+        .map(|d| render_map(verts, look(position, d), projection, size, spare));
     LightShadow::Cube {
         position,
         faces: Box::new(faces),
@@ -253,12 +290,14 @@ fn point(verts: &[Geo], position: Vec3, size: u32) -> LightShadow {
 
 /// Rasterizes every triangle's depth (reverse-Z, nearest wins) into a
 /// `size` x `size` map: clip, set up and bin in parallel chunks, then each
-/// band of rows depth-tests its triangles in submission order.
+/// band of rows clears its rows and depth-tests its triangles in
+/// submission order. The map's buffer is one of `spare` when one fits.
 fn render_map(
     verts: &[Geo],
     view_from_world: Mat4,
     projection: MapProjection,
     size: u32,
+    spare: &mut Vec<Vec<f32>>,
 ) -> ShadowMap {
     let clip_from_world = projection.clip_from_view() * view_from_world;
     let vp = Viewport {
@@ -312,9 +351,14 @@ fn render_map(
             (tris, bins)
         })
         .collect();
-    let mut depth = vec![0.0f32; size as usize * size as usize];
+    let texels = size as usize * size as usize;
+    let mut depth = match spare.iter().position(|d| d.len() == texels) {
+        Some(k) => spare.swap_remove(k),
+        None => vec![0.0f32; texels],
+    };
     let band = (grid.tile_w * grid.tile_h) as usize;
     depth.par_chunks_mut(band).enumerate().for_each(|(ti, d)| {
+        d.fill(0.0);
         let rect = grid.rect(ti);
         let stride = rect.width();
         for (tris, bins) in &per_chunk {
