@@ -437,6 +437,24 @@ mod tests {
                             // Mostly inside, some lanes across an edge.
                             let spread = if round % 3 == 0 { 1.6 } else { 1.0 };
                             uv[k] = Vec2::new(rnd() * spread - 0.3 * (spread - 1.0), rnd());
+                            if round % 7 == 6 {
+                                // Coordinates from the wild: the unchecked
+                                // loads must never see them as inside.
+                                const ODD: [f32; 8] = [
+                                    f32::NAN,
+                                    f32::INFINITY,
+                                    f32::NEG_INFINITY,
+                                    -1e30,
+                                    3e9,
+                                    -0.0,
+                                    1.0,
+                                    -1e-39,
+                                ];
+                                uv[k].x = ODD[(round / 7 + k) % ODD.len()];
+                                if k % 2 == 1 {
+                                    uv[k].y = ODD[(round / 7 + 3 * k) % ODD.len()];
+                                }
+                            }
                             let g = Gradients {
                                 dx: Vec2::new(rnd() - 0.5, rnd() - 0.5) * (0.3 * rnd()),
                                 dy: Vec2::new(rnd() - 0.5, rnd() - 0.5) * (0.05 * rnd()),
