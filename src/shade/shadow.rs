@@ -20,7 +20,9 @@
 //! (so 4x4 texels are read, the outer ones partially); "hard" reads the one
 //! texel under the point.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
+
+use crate::simd::lanes4;
 
 use crate::raytrace::Tracer;
 use crate::scene::ShadowBias;
@@ -251,38 +253,59 @@ impl Shadows<'_> {
         };
         match self.filter {
             Filter::Hard => lit(fx as i32, fy as i32),
-            Filter::Pcf => {
-                // Box [f - 1.5, f + 1.5] per axis; texel i covers [i, i+1].
-                let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
-                let w = |i: i32, f: f32| {
-                    let lo = (i as f32).max(f - 1.5);
-                    let hi = (i as f32 + 1.0).min(f + 1.5);
-                    (hi - lo).max(0.0) / 3.0
-                };
-                let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
-                let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
-                // `lit` over the 4x4 texels, its terms hoisted: the
-                // receiver's depth at texel (i, j) is z + tx[i] + ty[j]
-                // (the same sums, in the same order). A zero weight adds
-                // nothing, so every texel is read (clamped to the map).
-                let tx = [0, 1, 2, 3].map(|i| gx * ((bx + i) as f32 + 0.5 - fx));
-                let ty = [0, 1, 2, 3].map(|j| gy * ((by + j) as f32 + 0.5 - fy));
-                let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
-                let mut sum = 0.0;
-                for j in 0..4 {
-                    let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
-                    let mut row = 0.0;
-                    for i in 0..4 {
-                        let stored = m.depth[base + cols[i]];
-                        let zr = z + tx[i] + ty[j];
-                        row += wx[i] * if stored <= zr { 1.0 } else { 0.0 };
-                    }
-                    sum += wy[j] * row;
-                }
-                sum
-            }
+            Filter::Pcf => pcf(m, fx, fy, z, gx, gy),
         }
     }
+}
+
+/// The PCF kernel at texel coordinates (`fx`, `fy`) inside the map: the
+/// lit fraction of a 3x3-texel box, each texel compared with the
+/// receiver's plane (depth `z` at the point, `gx`, `gy` per texel).
+#[inline]
+fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+    let n = m.size as i32;
+    // Box [f - 1.5, f + 1.5] per axis; texel i covers [i, i+1].
+    let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
+    let w = |i: i32, f: f32| {
+        let lo = (i as f32).max(f - 1.5);
+        let hi = (i as f32 + 1.0).min(f + 1.5);
+        (hi - lo).max(0.0) / 3.0
+    };
+    let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
+    let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
+    // `lit` over the 4x4 texels, its terms hoisted: the
+    // receiver's depth at texel (i, j) is (z + tx[i]) + ty[j]
+    // (the same sums, in the same order). A zero weight adds
+    // nothing, so every texel is read (clamped to the map).
+    // Four columns at once: per row the products
+    // wx[i] * (0 or 1) (= wx[i] or +0), summed along the row
+    // from 0 in column order, then the rows weighted and
+    // summed from 0 in row order, as one texel at a time.
+    let xs = lanes4(bx as f32, (bx + 1) as f32, (bx + 2) as f32, (bx + 3) as f32);
+    let ztx = Vec4::splat(z) + Vec4::splat(gx) * (xs + Vec4::splat(0.5) - Vec4::splat(fx));
+    let wxv = Vec4::from(wx);
+    let inside = bx >= 0 && bx + 3 < n;
+    let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
+    let mut p = [Vec4::ZERO; 4];
+    for (j, pj) in p.iter_mut().enumerate() {
+        let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
+        let stored = if inside {
+            let at = base + bx as usize;
+            Vec4::from_slice(&m.depth[at..at + 4])
+        } else {
+            let d = |i: usize| m.depth[base + cols[i]];
+            lanes4(d(0), d(1), d(2), d(3))
+        };
+        let ty = gy * ((by + j as i32) as f32 + 0.5 - fy);
+        let zr = ztx + Vec4::splat(ty);
+        *pj = Vec4::select(stored.cmple(zr), wxv, Vec4::ZERO);
+    }
+    // Columns of the rows' products: lane j of c[i] is row j's
+    // term i.
+    let c = glam::Mat4::from_cols(p[0], p[1], p[2], p[3]).transpose();
+    let rows = (((Vec4::ZERO + c.x_axis) + c.y_axis) + c.z_axis) + c.w_axis;
+    let t = Vec4::from(wy) * rows;
+    (((0.0 + t.x) + t.y) + t.z) + t.w
 }
 
 /// The cube face (+X, -X, +Y, -Y, +Z, -Z) a direction falls on.
@@ -367,6 +390,70 @@ mod tests {
         // Two texels away the box sees one side only.
         assert_eq!(s.visibility(0, Vec3::new(-0.6, 0.0, 0.1), up, up), 0.0);
         assert_eq!(s.visibility(0, Vec3::new(0.6, 0.0, 0.1), up, up), 1.0);
+    }
+
+    /// `pcf` one texel at a time, as it was written before its four-column
+    /// form.
+    fn pcf_one_by_one(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+        let n = m.size as i32;
+        let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
+        let w = |i: i32, f: f32| {
+            let lo = (i as f32).max(f - 1.5);
+            let hi = (i as f32 + 1.0).min(f + 1.5);
+            (hi - lo).max(0.0) / 3.0
+        };
+        let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
+        let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
+        let tx = [0, 1, 2, 3].map(|i| gx * ((bx + i) as f32 + 0.5 - fx));
+        let ty = [0, 1, 2, 3].map(|j| gy * ((by + j) as f32 + 0.5 - fy));
+        let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
+        let mut sum = 0.0;
+        for j in 0..4 {
+            let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
+            let mut row = 0.0;
+            for i in 0..4 {
+                let stored = m.depth[base + cols[i]];
+                let zr = z + tx[i] + ty[j];
+                row += wx[i] * if stored <= zr { 1.0 } else { 0.0 };
+            }
+            sum += wy[j] * row;
+        }
+        sum
+    }
+
+    #[test]
+    fn four_column_pcf_equals_texel_by_texel() {
+        let mut x = 0x9e37_79b9u32;
+        let mut rnd = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let size = 13u32;
+        let mut m = map();
+        m.size = size;
+        m.depth = (0..size * size).map(|_| rnd()).collect();
+        for round in 0..20_000 {
+            // Mostly inside, often along the edges (clamped columns/rows).
+            let fx = (rnd() * size as f32).min(size as f32 - 1e-3);
+            let fy = if round % 4 == 0 {
+                rnd() * 2.0
+            } else {
+                rnd() * size as f32
+            };
+            let fy = fy.min(size as f32 - 1e-3);
+            let z = rnd();
+            let (gx, gy) = ((rnd() - 0.5) * 0.2, (rnd() - 0.5) * 0.2);
+            let (gx, gy) = if round % 9 == 0 {
+                (0.0, -0.0)
+            } else {
+                (gx, gy)
+            };
+            let want = pcf_one_by_one(&m, fx, fy, z, gx, gy);
+            let got = pcf(&m, fx, fy, z, gx, gy);
+            assert_eq!(got.to_bits(), want.to_bits(), "{fx} {fy} {z} {gx} {gy}");
+        }
     }
 
     #[test]
