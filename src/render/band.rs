@@ -16,13 +16,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use super::fragment::{FrameData, LANE_SLOT, Part, Point, Sink, resolve};
 use super::frame::AovPixel;
-use super::geometry::{Draw, Geometry};
-use super::ground::Ground;
 use super::lanes::{LaneBatches, Pending};
-use super::rays::CameraRays;
-use super::setup::FrameSetup;
-use super::vertex::ModelVertices;
 use crate::assets::texture::{Footprint, Gradients};
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
@@ -30,103 +26,13 @@ use crate::raster::coverage::{
 };
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
-use crate::raytrace::Tracer;
 use crate::scene::material::AlphaMode;
-use crate::scene::settings::Background;
-use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
+use crate::scene::settings::ShadingMode;
 use crate::shade::ao::GPixel;
-use crate::shade::blinn_phong4::{LaneMaterial, MAX_SIZES};
-use crate::shade::env::EnvLight;
-use crate::shade::{ShadeContext, SizedFootprint, Surface, TexCoords, background};
-
-/// What every band of one frame reads.
-pub(super) struct FrameData<'a> {
-    pub fs: &'a FrameSetup<'a>,
-    pub ctx: ShadeContext<'a>,
-    pub verts: &'a [ModelVertices],
-    pub draws: &'a [Draw],
-    /// Per draw.
-    pub alpha: Vec<AlphaMode>,
-    pub tris: &'a [Tri],
-    /// Sample offsets in 1/16 pixel; one entry without MSAA.
-    pub pattern: &'static [(i8, i8)],
-    pub reverse: bool,
-    pub bg: Vec4,
-    /// The environment seen through the camera, where the background
-    /// shows it.
-    pub env_bg: Option<EnvBackground<'a>>,
-    /// The ground shadow catcher, over the background.
-    pub ground: Option<Ground<'a>>,
-    /// Texture filtering needs derivatives (trilinear, anisotropic).
-    pub grads: bool,
-    /// Shading reads the triangle's plane normal (flat shading, shadows,
-    /// AO); otherwise it is not computed.
-    pub geo_normal: bool,
-    /// Per draw: its material prepared for shading four fragments at a
-    /// time, or None (the one-fragment path).
-    lanes: Vec<Option<LaneMaterial<'a>>>,
-}
+use crate::shade::blinn_phong4::MAX_SIZES;
+use crate::shade::{SizedFootprint, Surface, TexCoords};
 
 impl<'a> FrameData<'a> {
-    /// `grads`: the texture filter reads derivatives (trilinear,
-    /// anisotropic). `lanes`: shade the materials that allow it four
-    /// fragments at a time (`shade::blinn_phong4`; the same pixels).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        fs: &'a FrameSetup<'a>,
-        ctx: ShadeContext<'a>,
-        verts: &'a [ModelVertices],
-        geo: &'a Geometry,
-        pattern: &'static [(i8, i8)],
-        grads: bool,
-        tracer: Option<&'a Tracer<'a>>,
-        lanes: bool,
-    ) -> FrameData<'a> {
-        let s = &fs.scene.settings;
-        let alpha = geo
-            .draws
-            .iter()
-            .map(|d| fs.scene.models[d.model].materials[d.material].alpha)
-            .collect();
-        let geo_normal = s.shading == ShadingMode::Flat
-            || !ctx.shadows.lights.is_empty()
-            || s.ao.method != AoMethod::Off
-            || ctx.env_sampled.is_some();
-        let lanes = geo
-            .draws
-            .iter()
-            .map(|d| {
-                let model = &fs.scene.models[d.model];
-                let uvs = !model.mesh.uvs.is_empty();
-                let tangents = !verts[d.model].tangent.is_empty();
-                let m = &model.materials[d.material];
-                lanes.then(|| ctx.lane_material(m, uvs, tangents)).flatten()
-            })
-            .collect();
-        FrameData {
-            fs,
-            verts,
-            draws: &geo.draws,
-            alpha,
-            tris: &geo.tris,
-            pattern,
-            reverse: s.depth == DepthMode::ReverseZ,
-            bg: background(s.background),
-            env_bg: EnvBackground::new(fs, &ctx, geo.grid.width, geo.grid.height),
-            ground: Ground::new(fs, &ctx, tracer, geo.grid.width, geo.grid.height),
-            grads,
-            geo_normal,
-            lanes,
-            ctx,
-        }
-    }
-
-    /// Draw `draw`'s material prepared for the lanes, if it is.
-    #[inline]
-    pub(super) fn lane_material(&self, draw: usize) -> Option<&LaneMaterial<'a>> {
-        self.lanes.get(draw).and_then(|l| l.as_ref())
-    }
-
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
     /// alpha-tested triangle per pixel, and the blended triangles to
     /// composite over them. `bins`: per setup chunk, its per-band triangle
@@ -884,49 +790,6 @@ impl<'a> FrameData<'a> {
     }
 }
 
-/// The environment behind the models: the radiance along each pixel's
-/// view ray (the pixel center's), sharp or prefiltered.
-pub(super) struct EnvBackground<'a> {
-    env: &'a EnvLight,
-    /// Prefiltering roughness; 0: the image itself.
-    blur: f32,
-    rays: CameraRays,
-}
-
-impl<'a> EnvBackground<'a> {
-    fn new(
-        fs: &FrameSetup,
-        ctx: &ShadeContext<'a>,
-        width: u32,
-        height: u32,
-    ) -> Option<EnvBackground<'a>> {
-        let blur = match fs.scene.settings.background {
-            Background::Environment => 0.0,
-            Background::Blurred(b) => b,
-            _ => return None,
-        };
-        // The data views show values, not radiance: no environment there.
-        if fs.scene.settings.shading.is_data_view() {
-            return None;
-        }
-        Some(EnvBackground {
-            env: ctx.env?,
-            blur,
-            rays: CameraRays::new(&fs.camera, width, height),
-        })
-    }
-
-    fn at(&self, px: i32, py: i32) -> Vec4 {
-        let (_, d) = self.rays.ray(px, py);
-        let c = if self.blur > 0.0 {
-            self.env.prefiltered(d, self.blur)
-        } else {
-            self.env.radiance(d)
-        };
-        c.extend(1.0)
-    }
-}
-
 /// The interpolator of the last triangle asked for: consecutive pixels
 /// mostly belong to one triangle.
 #[derive(Default)]
@@ -974,75 +837,6 @@ struct FragmentAt<'c> {
 enum Shaded {
     Now(Part),
     Later(u32, Pending),
-}
-
-/// The pixel of a lane result that is resolved from its slot, after the
-/// lanes (MSAA pixels with several fragments).
-const LANE_SLOT: u32 = u32::MAX;
-
-/// Where lane results go: one-sample pixels straight to the band's
-/// colour and depth, the others by slot for their pixels' resolve.
-pub(super) struct Sink<'s> {
-    color: &'s mut [Vec4],
-    depth: &'s mut [f32],
-    shaded: &'s mut Vec<(Vec3, f32)>,
-    inv_n: f32,
-}
-
-impl Sink<'_> {
-    /// The result of slot `slot` for `pixel`: linear colour, view depth.
-    #[inline]
-    pub fn put(&mut self, slot: u32, pixel: u32, count: f32, c: Vec3, d: f32) {
-        if pixel == LANE_SLOT {
-            let slot = slot as usize;
-            if self.shaded.len() <= slot {
-                self.shaded.resize(slot + 1, (Vec3::ZERO, 0.0));
-            }
-            self.shaded[slot] = (c, d);
-        } else {
-            let i = pixel as usize;
-            (self.color[i], self.depth[i]) =
-                resolve(&[Part::Queued(0, count)], &[(c, d)], self.inv_n);
-        }
-    }
-}
-
-/// One fragment's share of a pixel: shaded already (linear RGBA, view
-/// depth, sample count) or queued for the lanes (slot, sample count).
-enum Part {
-    Shaded(Vec4, f32, f32),
-    Queued(u32, f32),
-}
-
-/// A pixel's colour and depth from its fragments in order: their colours
-/// weighted by sample counts over `1 / inv_n` samples, the nearest depth.
-/// `shaded`: the lane results by slot.
-fn resolve(parts: &[Part], shaded: &[(Vec3, f32)], inv_n: f32) -> (Vec4, f32) {
-    let mut acc = Vec4::ZERO;
-    let mut nearest = f32::INFINITY;
-    for p in parts {
-        let (c, d, count) = match *p {
-            Part::Shaded(c, d, count) => (c, d, count),
-            Part::Queued(slot, count) => {
-                let (c, d) = shaded[slot as usize];
-                (c.extend(1.0), d, count)
-            }
-        };
-        acc += c * count;
-        nearest = nearest.min(d);
-    }
-    (acc * inv_n, nearest)
-}
-
-/// A surface point as the rasterizer sees it.
-pub(super) struct Point {
-    pub position: Vec3,
-    pub raw_normal: Vec3,
-    /// Interpolated unit normal, on the side the camera sees.
-    pub normal: Vec3,
-    /// The triangle's plane normal, on the side the camera sees.
-    pub geo_normal: Vec3,
-    pub view_depth: f32,
 }
 
 /// The distinct triangle ids among one pixel's samples, each with the mask

@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::band::{FrameData, Sink};
+use super::fragment::{FrameData, Sink};
 use crate::assets::texture::Footprint;
 use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;

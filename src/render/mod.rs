@@ -9,7 +9,9 @@
 //! 5. textures: the mip chains of the textures this frame minifies;
 //! 6. per band of rows (`band`): visibility with the depth test, then
 //!    (with AO on) the geometry buffer of every band, `ao_pass` over the
-//!    whole frame, and shading of each visible pixel once;
+//!    whole frame, and shading of each visible pixel once (`lanes`: four
+//!    fragments at a time; `fragment`: the data every band reads and the
+//!    sink that takes shaded fragments to their pixels);
 //! 7. `frame`: with supersampling, the box filter down to the output size.
 //!
 //! Each band owns its rows: no locks, no shared writes, and the same frame
@@ -23,6 +25,7 @@
 mod ao_pass;
 mod band;
 mod exposure;
+mod fragment;
 mod frame;
 mod geometry;
 mod ground;
@@ -326,7 +329,7 @@ impl Renderer {
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
-        let data = band::FrameData::new(
+        let data = fragment::FrameData::new(
             fs,
             ctx,
             &verts,
@@ -345,7 +348,7 @@ impl Renderer {
     /// Visibility, AO and shading, band by band, into `out`.
     fn bands(
         &self,
-        data: &band::FrameData,
+        data: &fragment::FrameData,
         geo: &Geometry,
         tracer: Option<&Tracer>,
         out: &mut Frame,
