@@ -198,4 +198,13 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
     for srgb in [false, true] {
         assert!(Texture::from_cache_bytes(&bytes, srgb).is_none());
     }
+    // The texture target, 2026-11-25 (CI's fuzzing smoke): a Basis
+    // Universal KTX2 file whose Zstandard level claims 432 PB uncompressed;
+    // the transcoder allocated it (the process aborted).
+    let path = dir.join("fuzz_ktx2_zstd_huge_level.ktx2");
+    let err = match Texture::from_bytes(&std::fs::read(&path).unwrap(), &path, true) {
+        Ok(_) => panic!("{} was read", path.display()),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("uncompressed"), "{err}");
 }

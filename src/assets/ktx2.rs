@@ -142,6 +142,33 @@ fn inflate_limited(r: impl std::io::Read, limit: u64) -> std::io::Result<Vec<u8>
 /// young crate: a panic inside it on a damaged file is caught and reported
 /// as an error like any other.
 fn basis(b: &[u8], width: u32, height: u32) -> Result<Decoded, String> {
+    // The transcoder allocates a Zstandard level's uncompressed length as
+    // the file states it before inflating (an absurd one aborts the
+    // process): every level of a 2D texture needs at most level 0's UASTC
+    // size (16 bytes a 4x4 block; BasisLZ states 0).
+    let levels = u32_at(b, 40).ok_or("the KTX2 header is cut short")?.max(1);
+    let most = (width as u64).div_ceil(4) * (height as u64).div_ceil(4) * 16;
+    for i in 0..levels as usize {
+        let entry = 80 + 24 * i;
+        let (Some(at), Some(len), Some(raw)) = (
+            u64_at(b, entry),
+            u64_at(b, entry + 8),
+            u64_at(b, entry + 16),
+        ) else {
+            return Err("the KTX2 level index is cut short".into());
+        };
+        if raw > most {
+            return Err(format!(
+                "KTX2 level {i} claims {raw} bytes uncompressed; a {width}x{height} Basis Universal texture has at most {most}"
+            ));
+        }
+        if at.checked_add(len).is_none_or(|end| end > b.len() as u64) {
+            return Err(format!(
+                "KTX2 level {i} ({len} bytes at {at}) lies outside the file ({} bytes)",
+                b.len()
+            ));
+        }
+    }
     let run = || -> Result<Vec<u8>, String> {
         let t = basisu::Transcoder::new(b).map_err(|e| {
             format!(
