@@ -78,6 +78,41 @@ pub fn unit_bytes4(t: [u32; 4], shift: u32) -> Vec4 {
     Vec4::new(at(0), at(1), at(2), at(3)) * Vec4::splat(1.0 / 255.0)
 }
 
+/// Whole numbers below which `ramp4` holds (2^51).
+pub const RAMP_LIMIT: i64 = 1 << 51;
+
+/// `[s, s + step, s + 2 step, s + 3 step]`, each as `v as f32` gives it
+/// (rounded once, to nearest), for values of magnitude below
+/// `RAMP_LIMIT`: each becomes an f64 exactly (its bits added to those of
+/// 2^52 + 2^51, which is then taken away), then one f32 rounding.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn ramp4(s: i64, step: i64) -> Vec4 {
+    use std::arch::x86_64::*;
+    const MAGIC: f64 = 6_755_399_441_055_744.0; // 2^52 + 2^51
+    debug_assert!([s, s + 3 * step].iter().all(|v| v.abs() < RAMP_LIMIT));
+    // SAFETY: SSE2 only (in every x86-64 target's base features); no
+    // memory is touched.
+    unsafe {
+        let m = _mm_set1_pd(MAGIC);
+        let mi = _mm_castpd_si128(m);
+        let exact = |a: i64, b: i64| {
+            let v = _mm_add_epi64(_mm_set_epi64x(b, a), mi);
+            _mm_cvtpd_ps(_mm_sub_pd(_mm_castsi128_pd(v), m))
+        };
+        let lo = exact(s, s + step);
+        let hi = exact(s + 2 * step, s + 3 * step);
+        Vec4::from(_mm_movelh_ps(lo, hi))
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub fn ramp4(s: i64, step: i64) -> Vec4 {
+    let at = |k: i64| (s + k * step) as f32;
+    Vec4::new(at(0), at(1), at(2), at(3))
+}
+
 /// Four 3-vectors, one per lane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct V3 {
@@ -255,6 +290,37 @@ pub fn lerp3(a: V3, b: V3, c: V3, l: V3) -> V3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ramps_round_as_one_conversion() {
+        let mut x = 0x1234_5678_9abc_def0u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for round in 0..200_000 {
+            // Every magnitude up to the limit, and around powers of two
+            // where f32 rounding ties.
+            let bits = 1 + round % 50;
+            let s = (next() >> (64 - bits)) as i64 * if round % 2 == 0 { 1 } else { -1 };
+            let s = if round % 5 == 0 {
+                (1i64 << (round % 49)) + (round as i64 % 3) - 1
+            } else {
+                s
+            };
+            let step = (next() >> (64 - (1 + round % 40))) as i64 - (1i64 << (round % 40)) / 2;
+            if [s, s + 3 * step].iter().any(|v| v.abs() >= RAMP_LIMIT) {
+                continue;
+            }
+            let got = ramp4(s, step);
+            for k in 0..4 {
+                let want = (s + k as i64 * step) as f32;
+                assert_eq!(got[k].to_bits(), want.to_bits(), "{s} {step} {k}");
+            }
+        }
+    }
 
     #[test]
     fn lanes_and_bytes_are_the_scalar_values() {

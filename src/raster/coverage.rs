@@ -5,7 +5,10 @@
 //! exactly once afterwards.
 
 use super::bin::TileRect;
+use glam::Vec4;
+
 use super::setup::{Edge, SUBPIXEL, Tri};
+use crate::simd::{RAMP_LIMIT, ramp4};
 
 /// The standard Direct3D sample positions for 1, 2, 4, 8 and 16 samples:
 /// offsets from the pixel center in 1/16 pixel, x right and y down (the
@@ -267,6 +270,69 @@ pub fn raster_triangle<F: FnMut(i32, i32, f32)>(t: &Tri, rect: TileRect, mut vis
     });
 }
 
+/// `raster_triangle` into a reverse-Z depth map `d` (rows of `stride`
+/// texels from `rect`'s top-left) that keeps the greatest depth up to 1
+/// (`z <= 1 && z > d`): the same texels and depths, four texels of a run
+/// at a time where its edge values allow (`simd::ramp4`).
+pub fn raster_depth_max(t: &Tri, rect: TileRect, d: &mut [f32], stride: usize) {
+    let e = t.edges();
+    let plane = DepthPlane::new(t, &e);
+    let keep = |d: &mut f32, z: f32| {
+        if z <= 1.0 && z > *d {
+            *d = z;
+        }
+    };
+    let at = |px: i32, py: i32| (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
+    if t.max_x.min(rect.x1 - 1) - t.min_x.max(rect.x0) < SPAN_WIDTH {
+        walk_tested(t, &e, rect, [0; 3], |px, py, w| {
+            keep(&mut d[at(px, py)], plane.at(w[1], w[2]))
+        });
+        return;
+    }
+    let Some((x0, x1, y0, y1, mut row)) = start(t, &e, rect) else {
+        return;
+    };
+    let (x0l, a1, a2) = (x0 as i64, e[1].a, e[2].a);
+    let (z0, dz1, dz2) = (
+        Vec4::splat(plane.z0),
+        Vec4::splat(plane.dz1),
+        Vec4::splat(plane.dz2),
+    );
+    for py in y0..=y1 {
+        if let Some((lo, hi)) = span(&e, row, [0; 3], x0l, x1 as i64) {
+            let n = (hi - lo + 1) as usize;
+            // Biased edge values at the run's first texel (`walk_runs`).
+            let w1 = row[1] + a1 * (lo - x0l);
+            let w2 = row[2] + a2 * (lo - x0l);
+            let line = &mut d[at(lo as i32, py)..][..n];
+            let last = n as i64 - 1;
+            let (u1, u2) = (w1 - plane.bias1, w2 - plane.bias2);
+            let fits = [u1, u1 + a1 * last, u2, u2 + a2 * last]
+                .iter()
+                .all(|v| v.abs() < RAMP_LIMIT);
+            let mut k = 0;
+            if fits {
+                while k + 4 <= n {
+                    let (k1, k2) = (u1 + a1 * k as i64, u2 + a2 * k as i64);
+                    // `plane.at`: z0 + t1 * dz1 + t2 * dz2, lane by lane.
+                    let z = z0 + ramp4(k1, a1) * dz1 + ramp4(k2, a2) * dz2;
+                    let old = Vec4::from_slice(&line[k..k + 4]);
+                    let m = z.cmple(Vec4::ONE) & z.cmpgt(old);
+                    Vec4::select(m, z, old).write_to_slice(&mut line[k..k + 4]);
+                    k += 4;
+                }
+            }
+            for (j, dk) in line.iter_mut().enumerate().skip(k) {
+                let j = j as i64;
+                keep(dk, plane.at(w1 + a1 * j, w2 + a2 * j));
+            }
+        }
+        row[0] += e[0].b;
+        row[1] += e[1].b;
+        row[2] += e[2].b;
+    }
+}
+
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
 /// Depth and triangle id per sample of one tile: `samples` consecutive
@@ -411,5 +477,57 @@ mod tests {
             }
         }
         assert!(checked > 100_000, "{checked}");
+    }
+
+    #[test]
+    fn depth_max_runs_equal_texel_by_texel() {
+        // Triangles of every size, some crossing the near and far
+        // depths, into a map seeded with depths.
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let vp = Viewport {
+            width: 300,
+            height: 200,
+            msaa: false,
+        };
+        let rect = TileRect {
+            x0: 20,
+            y0: 10,
+            x1: 280,
+            y1: 150,
+        };
+        let stride = rect.width();
+        let start: Vec<f32> = (0..stride * rect.height()).map(|_| rnd() * 0.5).collect();
+        let (mut a, mut b) = (start.clone(), start);
+        let mut drawn = 0;
+        for i in 0..4000 {
+            let scale = [0.02f32, 0.2, 1.0, 6.0][i % 4];
+            let (cx, cy) = (rnd() * 2.0 - 1.0, rnd() * 2.0 - 1.0);
+            let p = [(); 3].map(|_| (rnd() - 0.5, rnd() - 0.5, rnd() * 1.4 - 0.2));
+            let v = |(dx, dy, z): (f32, f32, f32)| ClipVertex {
+                pos: Vec4::new(cx + dx * scale, cy + dy * scale, z, 1.0),
+                bary: Vec3::ZERO,
+            };
+            let Some(t) = setup([v(p[0]), v(p[1]), v(p[2])], vp, CullMode::None, 0, 0) else {
+                continue;
+            };
+            raster_triangle(&t, rect, |px, py, z| {
+                let k = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
+                if z <= 1.0 && z > a[k] {
+                    a[k] = z;
+                }
+                drawn += 1;
+            });
+            raster_depth_max(&t, rect, &mut b, stride);
+            for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+                assert_eq!(x.to_bits(), y.to_bits(), "triangle {i}, texel {k}");
+            }
+        }
+        assert!(drawn > 1_000_000, "{drawn}");
     }
 }

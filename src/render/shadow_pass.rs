@@ -19,7 +19,7 @@ use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::raster::coverage::raster_triangle;
+use crate::raster::coverage::raster_depth_max;
 use crate::raster::setup::{Tri, Viewport, setup};
 use crate::raytrace::Tracer;
 use crate::scene::light::{Light, LightKind};
@@ -363,12 +363,7 @@ fn render_map(
         let stride = rect.width();
         for (tris, bins) in &per_chunk {
             for &i in &bins[ti] {
-                raster_triangle(&tris[i as usize], rect, |px, py, z| {
-                    let k = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
-                    if z <= 1.0 && z > d[k] {
-                        d[k] = z;
-                    }
-                });
+                raster_depth_max(&tris[i as usize], rect, d, stride);
             }
         }
     });
