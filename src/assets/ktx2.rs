@@ -159,12 +159,12 @@ fn basis(b: &[u8], width: u32, height: u32) -> Result<Decoded, String> {
         };
         if raw > most {
             return Err(format!(
-                "KTX2 level {i} claims {raw} bytes uncompressed; a {width}x{height} Basis Universal texture has at most {most}"
+                "KTX2 Basis Universal data is damaged: level {i} claims {raw} bytes uncompressed, a {width}x{height} texture has at most {most}"
             ));
         }
         if at.checked_add(len).is_none_or(|end| end > b.len() as u64) {
             return Err(format!(
-                "KTX2 level {i} ({len} bytes at {at}) lies outside the file ({} bytes)",
+                "KTX2 Basis Universal data is cut short: level {i} ({len} bytes at {at}) lies outside the file ({} bytes)",
                 b.len()
             ));
         }
