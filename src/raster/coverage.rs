@@ -4,9 +4,9 @@
 //! depth per pixel (per sample), and every visible fragment is shaded
 //! exactly once afterwards.
 
-use super::bin::TileRect;
 use glam::Vec4;
 
+use super::bin::TileRect;
 use super::setup::{Edge, SUBPIXEL, Tri};
 use crate::simd::{RAMP_LIMIT, ramp4};
 

@@ -22,10 +22,9 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::simd::lanes4;
-
 use crate::raytrace::Tracer;
 use crate::scene::ShadowBias;
+use crate::simd::lanes4;
 
 /// How a map projects light-view space (looking down -Z) to texels.
 #[derive(Debug, Clone, Copy)]
@@ -302,7 +301,7 @@ fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     }
     // Columns of the rows' products: lane j of c[i] is row j's
     // term i.
-    let c = glam::Mat4::from_cols(p[0], p[1], p[2], p[3]).transpose();
+    let c = Mat4::from_cols(p[0], p[1], p[2], p[3]).transpose();
     let rows = (((Vec4::ZERO + c.x_axis) + c.y_axis) + c.z_axis) + c.w_axis;
     let t = Vec4::from(wy) * rows;
     (((0.0 + t.x) + t.y) + t.z) + t.w
