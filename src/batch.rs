@@ -695,8 +695,13 @@ impl Videos {
 mod tests {
     use super::*;
 
+    /// A scene in a directory of its own: the tests run in parallel, and
+    /// one writing `t.obj` while another reads it made the reader see an
+    /// empty file (a CI failure of 2026-11-25).
     fn scene(extra: &str) -> Scene {
-        let dir = std::env::temp_dir().join(format!("softraster-plan-{}", std::process::id()));
+        static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("softraster-plan-{}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
         let text = format!("[[model]]\npath = \"t.obj\"\n[animation]\nframes = 12\n{extra}");
