@@ -57,6 +57,7 @@ use crate::raytrace::{Placed, Tracer};
 use crate::scene::Scene;
 use crate::scene::camera::Projection;
 use crate::scene::environment::EnvMethod;
+use crate::scene::material::{Native, roughness_from_ns};
 use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
@@ -171,6 +172,12 @@ impl Renderer {
         });
     }
 
+    /// Prefilters `scene`'s environment now rather than at the first
+    /// frame (for timing it apart from frames); nothing without one.
+    pub fn build_environment(&self, scene: &Scene) {
+        let _ = self.env_light(scene);
+    }
+
     /// Whether texture `id`'s mip chain has been built.
     pub fn has_mips(&self, id: usize) -> bool {
         self.mips.get(id).is_some_and(|m| m.get().is_some())
@@ -208,12 +215,18 @@ impl Renderer {
         self.env
             .get_or_init(|| {
                 let e = scene.environment.as_ref()?;
-                Some(EnvLight::with_size(
-                    &e.image,
-                    e.intensity,
-                    e.rotation,
-                    e.prefilter_size,
-                ))
+                // The Blinn-Phong exponents that may meet the environment.
+                let all = scene.settings.shading == ShadingMode::BlinnPhong;
+                let phong = scene
+                    .models
+                    .iter()
+                    .flat_map(|m| &m.materials)
+                    .filter(|m| (all || m.native == Native::BlinnPhong) && m.illum > 0)
+                    .map(|m| roughness_from_ns(m.ns));
+                Some(
+                    EnvLight::with_size(&e.image, e.intensity, e.rotation, e.prefilter_size)
+                        .with_phong_roughness(phong),
+                )
             })
             .as_ref()
     }

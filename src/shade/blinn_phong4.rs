@@ -20,7 +20,6 @@ use glam::{Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::ShadeContext;
-use super::blinn_phong::SurfaceColor;
 use super::light::incidence;
 use crate::assets::texture::{
     Chain, Filtering, Footprint, Gradients, Taps4, Texture, TextureFilter as Filter, TextureRef,
@@ -30,6 +29,7 @@ use crate::scene::Material;
 use crate::scene::light::LightKind;
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
+use crate::shade::env::{EnvLight, dominant_direction4};
 use crate::simd::V3;
 
 /// At most this many distinct texture sizes (and mip chains) among a lane
@@ -325,22 +325,26 @@ impl<'a> ShadeContext<'a> {
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let spec_term = if specular { ks * spec } else { V3::ZERO };
         let mut out = V3::splat(m.ke) + ka * ambient + kd * diffuse + spec_term;
-        if self.env.is_some() {
-            let mut env = [Vec3::ZERO; 4];
-            for (k, e) in env.iter_mut().enumerate() {
-                let c = SurfaceColor {
-                    ka: ka.lane(k),
-                    kd: kd.lane(k),
-                    ks: ks.lane(k),
-                    ke: m.ke,
-                    ns: m.ns,
-                    illum: m.illum,
-                };
-                *e = self.env_blinn_phong(p.lane(k), n.lane(k), f.geo_normal[k], f.ao[k], &c);
-            }
-            out = out + V3::from_lanes(env);
+        if let Some(env) = self.env {
+            out = out + self.env_lanes(env, n, v, kd, ks, f.ao, m.ns);
         }
         out
+    }
+
+    /// `ShadeContext::env_blinn_phong` on four lanes (illum > 0, and
+    /// not the sampled environment: those never reach the lanes).
+    #[allow(clippy::too_many_arguments)]
+    fn env_lanes(&self, env: &EnvLight, n: V3, v: V3, kd: V3, ks: V3, ao: Vec4, ns: f32) -> V3 {
+        let roughness = crate::scene::material::roughness_from_ns(ns);
+        let diffuse = (kd * env.irradiance4(n)).scale(ao / Vec4::splat(std::f32::consts::PI));
+        let no_ks = ks.x.cmpeq(Vec4::ZERO) & ks.y.cmpeq(Vec4::ZERO) & ks.z.cmpeq(Vec4::ZERO);
+        if no_ks.all() {
+            return diffuse;
+        }
+        let r = n.scale(Vec4::splat(2.0) * n.dot(v)) - v;
+        let r = dominant_direction4(n, r, roughness);
+        let lit = diffuse + ks * env.prefiltered_phong4(r, roughness);
+        V3::select(no_ks, diffuse, lit)
     }
 
     /// `apply_normal_map` of a tangent-space map whose four texels are

@@ -284,7 +284,7 @@ impl ShadeContext<'_> {
             return diffuse;
         }
         let r = env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, roughness);
-        diffuse + c.ks * env.prefiltered(r, roughness)
+        diffuse + c.ks * env.prefiltered_phong(r, roughness)
     }
 
     /// Light `i`'s shadow at the surface point, towards unit `l`.

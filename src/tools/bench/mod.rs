@@ -31,7 +31,10 @@ pub struct BenchArgs {
     /// diablo3-matched, diablo3-matched-shadow (a floor and a 2048 shadow
     /// map, like `--shadow 1 --floor 1`), diablo3-4k-matched and
     /// nefertiti-matched (diablo3's maps on spherical UVs, like the
-    /// harness's nefertiti); tris-5k, tris-20k, tris-80k, tris-320k,
+    /// harness's nefertiti); diablo3-sun and diablo3-studio (the matched
+    /// model under its directional light alone, or under the built-in
+    /// studio environment alone: the cost of environment lighting);
+    /// tris-5k, tris-20k, tris-80k, tris-320k,
     /// tris-1m (diablo3-matched subdivided 0 to 4 times: same pixels, more
     /// triangles); filters, shadows, ao, edges (time and error
     /// of each method, CSV; edges at --size x 3/4 --size), or all (the
@@ -75,6 +78,9 @@ pub struct BenchResult {
     pub load_ms: f64,
     /// The mip chains' share of `load_ms`.
     pub mips_ms: f64,
+    /// The environment's prefiltering (once per scene), apart from
+    /// `load_ms`; 0 without an environment.
+    pub env_ms: f64,
     /// Median of frames 1..n (frame 0 warms caches).
     pub steady_ms: f64,
     pub min_ms: f64,
@@ -147,6 +153,8 @@ fn scene_text(
         | "diablo3-matched-shadow"
         | "diablo3-4k-matched"
         | "nefertiti-matched"
+        | "diablo3-sun"
+        | "diablo3-studio"
         | "tris-5k"
         | "tris-20k"
         | "tris-80k"
@@ -154,7 +162,7 @@ fn scene_text(
         | "tris-1m" => matched_scene(case, assets, &d3, &common, &p)?,
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, tris-5k .. tris-1m, filters, shadows, ao, edges or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, diablo3-sun, diablo3-studio, tris-5k .. tris-1m, filters, shadows, ao, edges or all"
             )));
         }
     })
@@ -200,6 +208,10 @@ fn matched_scene(
     let map = |m: &str| p(maps.join(format!("diablo3_pose_{m}.tga")));
     let mut render = "texture_filter = \"trilinear\"\ncull = \"back\"".to_string();
     let mut floor = String::new();
+    if case == "diablo3-studio" {
+        // Lit by the built-in studio alone (no lights: see `anchor_lights`).
+        floor.push_str("[environment]\npreset = \"studio\"\n");
+    }
     if case.ends_with("-shadow") {
         render.push_str("\nshadows = \"pcf\"\nshadow_map_size = 2048");
         let (lo, hi) = obj_bounds(Path::new(&p(obj.clone())?))?;
@@ -240,7 +252,19 @@ fn subject_bounds(scene: &Scene) -> (Vec3, f32) {
 
 /// The llvmpipe harness's two lights, placed relative to the model's
 /// bounding sphere; the directional one casts shadows in the `-shadow`
-/// cases.
+/// cases. `diablo3-sun` keeps the directional one alone and
+/// `diablo3-studio` none (the environment lights it): the pair measures
+/// what an environment costs over one directional light.
+fn case_lights(case: &str, scene: &Scene) -> Vec<Light> {
+    let mut lights = anchor_lights(scene, case.ends_with("-shadow"));
+    match case {
+        "diablo3-sun" => lights.truncate(1),
+        "diablo3-studio" => lights.clear(),
+        _ => {}
+    }
+    lights
+}
+
 fn anchor_lights(scene: &Scene, shadows: bool) -> Vec<Light> {
     let (center, r) = subject_bounds(scene);
     let dir_l = Vec3::new(-0.5, 0.75, 0.45).normalize();
@@ -292,7 +316,10 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     }
     let mips_ms = t_mips.elapsed().as_secs_f64() * 1e3;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    scene.lights = anchor_lights(&scene, case.ends_with("-shadow"));
+    let t_env = Instant::now();
+    renderer.build_environment(&scene);
+    let env_ms = t_env.elapsed().as_secs_f64() * 1e3;
+    scene.lights = case_lights(case, &scene);
     // The anchor's camera: the model's bounding sphere from +Z at fov 45
     // (the version 1 default; fitted cameras frame tighter).
     let (center, radius) = subject_bounds(&scene);
@@ -329,6 +356,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         triangles: scene.triangle_count(),
         load_ms,
         mips_ms,
+        env_ms,
         steady_ms: steady[steady.len() / 2],
         min_ms: steady[0],
         total_ms: times.iter().sum(),
@@ -391,7 +419,7 @@ fn write_scene(args: &BenchArgs, path: &Path) -> Result<(), Error> {
         let (center, radius) = subject_bounds(&scene);
         let cam = crate::scene::Camera::framing("camera".into(), center, radius, 45.0);
         let v = |v: Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
-        text + &lights_toml(&anchor_lights(&scene, args.case.ends_with("-shadow")))
+        text + &lights_toml(&case_lights(&args.case, &scene))
             + &format!(
                 "\n[[camera]]\neye = {}\ntarget = {}\nfov = 45.0\nnear = {}\nfar = {}\n",
                 v(cam.eye),
@@ -453,9 +481,9 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
         pool.current_num_threads()
     );
     println!(
-        "| case | triangles | load ms (of which mip chains) | steady ms/frame (median 1..n) | min ms | render total ms | png ms/frame |"
+        "| case | triangles | load ms (of which mip chains) | environment prefilter ms | steady ms/frame (median 1..n) | min ms | render total ms | png ms/frame |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for c in cases {
         let r = pool.install(|| run_case(c, args))?;
         if let Some(path) = &args.json {
@@ -468,6 +496,7 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
                 "threads": pool.current_num_threads(),
                 "load_ms": r.load_ms,
                 "mips_ms": r.mips_ms,
+                "env_prefilter_ms": r.env_ms,
                 "frame_median_ms": r.steady_ms,
                 "frame_min_ms": r.min_ms,
                 "render_total_ms": r.total_ms,
@@ -482,8 +511,16 @@ pub fn run(args: &BenchArgs) -> Result<(), Error> {
             writeln!(f, "{line}").map_err(|e| Error::io(path, e))?;
         }
         println!(
-            "| {} | {} | {:.1} ({:.1}) | {:.2} | {:.2} | {:.0} | {:.2} |",
-            r.name, r.triangles, r.load_ms, r.mips_ms, r.steady_ms, r.min_ms, r.total_ms, r.png_ms
+            "| {} | {} | {:.1} ({:.1}) | {:.1} | {:.2} | {:.2} | {:.0} | {:.2} |",
+            r.name,
+            r.triangles,
+            r.load_ms,
+            r.mips_ms,
+            r.env_ms,
+            r.steady_ms,
+            r.min_ms,
+            r.total_ms,
+            r.png_ms
         );
     }
     Ok(())

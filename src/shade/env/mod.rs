@@ -22,6 +22,10 @@ use rayon::prelude::*;
 
 use crate::assets::environment::EnvImage;
 
+mod lanes;
+
+pub use lanes::dominant_direction4;
+
 /// Prefiltered roughness levels: 0, 0.2, ..., 1.
 const LEVELS: usize = 6;
 /// Widest mirror level (roughness 0 and the sharp background).
@@ -126,21 +130,23 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
     )
 }
 
+/// The atan polynomial's coefficients (`atan2`).
+const ATAN_C: [f32; 7] = [
+    0.999_996_1,
+    -0.333_173_7,
+    0.198_078_17,
+    -0.132_333_43,
+    0.079_623_66,
+    -0.033_604_197,
+    0.006_811_782,
+];
+
 /// atan2(y, x) to within 6e-7 radians (f32 rounding included) (libm's is a call and several times
 /// slower; a thousandth of a texel of a 2048-wide image is 3e-6 rad).
 /// Odd polynomial of degree 13 for atan on [0, 1], fitted to minimize the
 /// largest error, then folded into the four quadrants.
 #[inline]
 fn atan2(y: f32, x: f32) -> f32 {
-    const C: [f32; 7] = [
-        0.999_996_1,
-        -0.333_173_7,
-        0.198_078_17,
-        -0.132_333_43,
-        0.079_623_66,
-        -0.033_604_197,
-        0.006_811_782,
-    ];
     if x.is_nan() || y.is_nan() {
         return f32::NAN;
     }
@@ -151,8 +157,8 @@ fn atan2(y: f32, x: f32) -> f32 {
     }
     let a = lo / hi;
     let s = a * a;
-    let mut p = C[6];
-    for &c in C[..6].iter().rev() {
+    let mut p = ATAN_C[6];
+    for &c in ATAN_C[..6].iter().rev() {
         p = p * s + c;
     }
     let mut r = p * a;
@@ -186,10 +192,20 @@ pub struct EnvLight {
     levels: Vec<Equirect>,
     /// (scale, bias) of f0, by n.v (columns) and roughness (rows).
     lut: Vec<Vec2>,
-    /// Environment from world: the inverse of the environment's rotation.
-    env_from_world: Mat3,
+    /// Environment from world: the inverse of the environment's rotation
+    /// (None: not turned, the common case, which skips the product).
+    env_from_world: Option<Mat3>,
     intensity: f32,
+    /// Per Blinn-Phong roughness the scene uses (`with_phong_roughness`):
+    /// the two prefiltered levels around it blended texel by texel, so a
+    /// lookup reads one level instead of two.
+    phong: Vec<(u32, Equirect)>,
 }
+
+/// At most this many blended levels (distinct Blinn-Phong exponents) per
+/// scene; materials beyond them blend two lookups (the same values to
+/// within rounding).
+const MAX_PHONG_LEVELS: usize = 16;
 
 impl EnvLight {
     /// Prefilters `image`, seen turned by `rotation_deg` about +Y
@@ -234,14 +250,75 @@ impl EnvLight {
             sh,
             levels,
             lut: brdf_lut(),
-            env_from_world: Mat3::from_rotation_y(-rotation_deg.to_radians()),
+            env_from_world: (rotation_deg != 0.0)
+                .then(|| Mat3::from_rotation_y(-rotation_deg.to_radians())),
             intensity,
+            phong: Vec::new(),
+        }
+    }
+
+    /// Adds blended levels for these perceptual roughnesses (those of the
+    /// scene's Blinn-Phong materials), for `prefiltered_phong`.
+    pub fn with_phong_roughness(mut self, roughness: impl IntoIterator<Item = f32>) -> EnvLight {
+        for r in roughness {
+            if self.phong.len() == MAX_PHONG_LEVELS {
+                break;
+            }
+            let (k, f) = level_of(r);
+            if f <= 0.0 || self.phong.iter().any(|(bits, _)| *bits == r.to_bits()) {
+                continue;
+            }
+            let (a, b) = (&self.levels[k], &self.levels[k + 1]);
+            // Levels 2.. share one size; level 1 may be twice as wide as
+            // level 2: blend only where the sizes agree.
+            if (a.width, a.height) != (b.width, b.height) {
+                continue;
+            }
+            let texels = a
+                .texels
+                .iter()
+                .zip(&b.texels)
+                .map(|(a, b)| a.lerp(*b, f))
+                .collect();
+            let level = Equirect {
+                width: a.width,
+                height: a.height,
+                texels,
+            };
+            self.phong.push((r.to_bits(), level));
+        }
+        self
+    }
+
+    /// `prefiltered` for a Blinn-Phong material of perceptual `roughness`:
+    /// from its blended level where `with_phong_roughness` made one.
+    pub fn prefiltered_phong(&self, r: Vec3, roughness: f32) -> Vec3 {
+        match self.phong_level(roughness) {
+            Some(level) => {
+                let uv = direction_to_uv(self.to_env(r));
+                Vec3::from(level.sample_uv(uv) * self.intensity)
+            }
+            None => self.prefiltered(r, roughness),
+        }
+    }
+
+    fn phong_level(&self, roughness: f32) -> Option<&Equirect> {
+        let bits = roughness.to_bits();
+        self.phong.iter().find(|(b, _)| *b == bits).map(|(_, l)| l)
+    }
+
+    /// World direction `d` in the environment's frame.
+    #[inline]
+    fn to_env(&self, d: Vec3) -> Vec3 {
+        match &self.env_from_world {
+            Some(m) => *m * d,
+            None => d,
         }
     }
 
     /// Irradiance on a surface with unit normal `n` (world space).
     pub fn irradiance(&self, n: Vec3) -> Vec3 {
-        let y = sh_basis(self.env_from_world * n);
+        let y = sh_basis(self.to_env(n));
         let mut e = Vec3::ZERO;
         for (c, b) in self.sh.iter().zip(y) {
             e += *c * b;
@@ -251,17 +328,14 @@ impl EnvLight {
 
     /// Radiance arriving from direction `d` (world space), unfiltered.
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        self.levels[0].sample(self.env_from_world * d) * self.intensity
+        self.levels[0].sample(self.to_env(d)) * self.intensity
     }
 
     /// Radiance along reflection direction `r` (world space), prefiltered
     /// for perceptual `roughness`.
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
-        let uv = direction_to_uv(self.env_from_world * r);
-        let x = roughness.clamp(0.0, 1.0) * (LEVELS - 1) as f32;
-        // x >= 0: truncation is floor.
-        let k = (x as usize).min(LEVELS - 2);
-        let f = x - k as f32;
+        let uv = direction_to_uv(self.to_env(r));
+        let (k, f) = level_of(roughness);
         let a = self.levels[k].sample_uv(uv);
         if f <= 0.0 {
             return Vec3::from(a * self.intensity);
@@ -282,6 +356,15 @@ impl EnvLight {
         let top = at(x0, y0).lerp(at(x1, y0), tx);
         top.lerp(at(x0, y1).lerp(at(x1, y1), tx), ty)
     }
+}
+
+/// The prefiltered level below `roughness` and the weight of the next.
+#[inline]
+fn level_of(roughness: f32) -> (usize, f32) {
+    let x = roughness.clamp(0.0, 1.0) * (LEVELS - 1) as f32;
+    // x >= 0: truncation is floor.
+    let k = (x as usize).min(LEVELS - 2);
+    (k, x - k as f32)
 }
 
 /// Where to look up the prefiltered radiance for a lobe of `roughness`
