@@ -149,8 +149,7 @@ impl EnvLight {
     pub fn prefiltered_phong4(&self, r: V3, roughness: f32) -> V3 {
         match self.phong_level(roughness) {
             Some(level) => {
-                let (u, v) = direction_to_uv(self.to_env4(r));
-                let t = level.sample_uv4(u, v);
+                let t = level.sample4(self.to_env4(r));
                 V3::from_lanes(t.map(|t| Vec3::from(t * self.intensity)))
             }
             None => self.prefiltered4(r, roughness),
@@ -288,22 +287,29 @@ mod tests {
     }
 
     #[test]
-    fn a_blended_level_reads_as_the_two_levels_it_blends() {
-        let env = EnvLight::with_size(&studio(), 1.0, 0.0, 16).with_phong_roughness([0.55, 0.15]);
-        // 0.55 lies between levels 5 and 6 (one size): blended. 0.15 lies
-        // between levels 1 and 2 (two sizes): not blended.
-        assert!(env.phong_level(0.55).is_some() && env.phong_level(0.15).is_none());
-        for d in directions().into_iter().take(5000) {
-            let d = d.normalize_or(Vec3::Y);
-            let (a, b) = (env.prefiltered_phong(d, 0.55), env.prefiltered(d, 0.55));
+    fn a_phong_level_reads_as_the_two_levels_it_blends() {
+        let env = EnvLight::with_size(&studio(), 1.0, 0.0, 128).with_phong_roughness([0.55, 0.15]);
+        assert!(env.phong_level(0.55).is_some() && env.phong_level(0.3).is_none());
+        // The octahedral map resamples the blended levels: the same light
+        // to within a small part of its range (the test sky has a patch 20
+        // times brighter than the rest, blurred by the lobe).
+        for rough in [0.55, 0.15] {
+            let (mut sum, mut worst, mut n) = (0.0f32, 0.0f32, 0);
+            let mut top = 0.0f32;
+            for d in directions().into_iter().take(5000) {
+                let Some(d) = d.try_normalize() else { continue };
+                let (a, b) = (env.prefiltered_phong(d, rough), env.prefiltered(d, rough));
+                let e = (a - b).abs().max_element();
+                sum += e;
+                worst = worst.max(e);
+                top = top.max(b.max_element());
+                n += 1;
+            }
+            let mean = sum / n as f32;
             assert!(
-                (a - b).abs().max_element() <= 1e-5 * b.max_element().max(1.0),
-                "{a} {b}"
+                mean < 0.01 * top && worst < 0.1 * top,
+                "roughness {rough}: mean {mean}, worst {worst}, top {top}"
             );
-            assert!(same(
-                env.prefiltered_phong(d, 0.15),
-                env.prefiltered(d, 0.15)
-            ));
         }
     }
 }

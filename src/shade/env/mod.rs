@@ -23,6 +23,9 @@ use rayon::prelude::*;
 use crate::assets::environment::EnvImage;
 
 mod lanes;
+mod octahedral;
+
+use octahedral::Octahedral;
 
 pub use lanes::dominant_direction4;
 
@@ -210,9 +213,10 @@ pub struct EnvLight {
     env_from_world: Option<Mat3>,
     intensity: f32,
     /// Per Blinn-Phong roughness the scene uses (`with_phong_roughness`):
-    /// the two prefiltered levels around it blended texel by texel, so a
-    /// lookup reads one level instead of two.
-    phong: Vec<(u32, Equirect)>,
+    /// the two prefiltered levels around it blended into one octahedral
+    /// map, so a lookup reads one level instead of two and needs no arc
+    /// tangents.
+    phong: Vec<(u32, Octahedral)>,
 }
 
 /// At most this many blended levels (distinct Blinn-Phong exponents) per
@@ -282,27 +286,14 @@ impl EnvLight {
             if self.phong.len() == MAX_PHONG_LEVELS {
                 break;
             }
-            let (k, f) = level_of(r);
-            if f <= 0.0 || self.phong.iter().any(|(bits, _)| *bits == r.to_bits()) {
+            if self.phong.iter().any(|(bits, _)| *bits == r.to_bits()) {
                 continue;
             }
-            let (a, b) = (&self.levels[k], &self.levels[k + 1]);
-            // Levels 2.. share one size; level 1 may be twice as wide as
-            // level 2: blend only where the sizes agree.
-            if (a.width, a.height) != (b.width, b.height) {
-                continue;
-            }
-            let texels = a
-                .texels
-                .iter()
-                .zip(&b.texels)
-                .map(|(a, b)| a.lerp(*b, f))
-                .collect();
-            let level = Equirect {
-                width: a.width,
-                height: a.height,
-                texels,
-            };
+            // A little more than the sharper level's texels along the
+            // equator (about 2.8 n for an n x n map).
+            let (k, _) = level_of(r);
+            let size = (self.levels[k].width / 2).max(16);
+            let level = Octahedral::from_fn(size, |d| self.level_blend(d, r));
             self.phong.push((r.to_bits(), level));
         }
         self
@@ -312,15 +303,24 @@ impl EnvLight {
     /// from its blended level where `with_phong_roughness` made one.
     pub fn prefiltered_phong(&self, r: Vec3, roughness: f32) -> Vec3 {
         match self.phong_level(roughness) {
-            Some(level) => {
-                let uv = direction_to_uv(self.to_env(r));
-                Vec3::from(level.sample_uv(uv) * self.intensity)
-            }
+            Some(level) => Vec3::from(level.sample(self.to_env(r)) * self.intensity),
             None => self.prefiltered(r, roughness),
         }
     }
 
-    fn phong_level(&self, roughness: f32) -> Option<&Equirect> {
+    /// The two prefiltered levels around `roughness`, blended, along
+    /// environment direction `d` (without the intensity).
+    fn level_blend(&self, d: Vec3, roughness: f32) -> Vec3A {
+        let uv = direction_to_uv(d);
+        let (k, f) = level_of(roughness);
+        let a = self.levels[k].sample_uv(uv);
+        if f <= 0.0 {
+            return a;
+        }
+        a.lerp(self.levels[k + 1].sample_uv(uv), f)
+    }
+
+    fn phong_level(&self, roughness: f32) -> Option<&Octahedral> {
         let bits = roughness.to_bits();
         self.phong.iter().find(|(b, _)| *b == bits).map(|(_, l)| l)
     }
