@@ -67,27 +67,9 @@ impl Equirect {
             .min(Vec4::splat((self.height - 1) as f32));
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let w = self.width as i64;
-        let wrap = |k: i64| -> usize {
-            if (0..w).contains(&k) {
-                k as usize
-            } else {
-                k.rem_euclid(w) as usize
-            }
-        };
-        std::array::from_fn(|k| {
-            // Finite: u and v come from `direction_to_uv` (in [0, 1]) and
-            // y is clamped; `as` saturates in any case.
-            let x0 = x0[k] as i64;
-            let y0 = y0[k] as usize;
-            let (xa, xb) = (wrap(x0), wrap(x0 + 1));
-            let y1 = (y0 + 1).min(self.height - 1);
-            let row0 = &self.texels[y0 * self.width..(y0 + 1) * self.width];
-            let row1 = &self.texels[y1 * self.width..(y1 + 1) * self.width];
-            let top = row0[xa].lerp(row0[xb], fx[k]);
-            let bottom = row1[xa].lerp(row1[xb], fx[k]);
-            top.lerp(bottom, fy[k])
-        })
+        // Finite: u and v come from `direction_to_uv` (in [0, 1]) and y
+        // is clamped; `as` saturates in any case.
+        std::array::from_fn(|k| self.blend(x0[k] as i64, y0[k] as usize, fx[k], fy[k]))
     }
 }
 

@@ -79,6 +79,14 @@ impl Equirect {
         let x0 = if (xt as f32) > x { xt - 1 } else { xt };
         let y0 = y as usize; // y >= 0: truncation is floor
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        self.blend(x0, y0, fx, fy)
+    }
+
+    /// The bilinear blend of the texels at column `x0` (any: it wraps) and
+    /// row `y0` (< height) and their next neighbours, with weights `fx`,
+    /// `fy` toward the neighbours.
+    #[inline(always)]
+    fn blend(&self, x0: i64, y0: usize, fx: f32, fy: f32) -> Vec3A {
         let w = self.width as i64;
         // x0 lies in [-1, w - 1] for u in [0, 1]: one step wraps it.
         let wrap = |k: i64| -> usize {
