@@ -1,5 +1,5 @@
 //! The wide types of the renderer's four-lane code (shading four
-//! fragments at a time, `shade::blinn_phong4`, and its texture lookups):
+//! fragments at a time, `shade::lanes`, and its texture lookups):
 //! four f32 lanes are glam's `Vec4` (SSE on x86-64), `V3` is four
 //! 3-vectors as a structure of arrays, and the few operations glam does
 //! not offer (lanes from scalars without a trip through memory, whole

@@ -1,9 +1,11 @@
-//! Shading four fragments at a time (`shade::blinn_phong4`) gives the
-//! frames of the one-fragment path bit for bit: colour and depth of every
-//! pixel, over scenes that reach each of its branches (maps, normal maps,
-//! vertex colours, every light kind with ranges and shadows, the
-//! environment, AO, MSAA, anisotropic and trilinear filtering, address
-//! modes, orthographic cameras, illum 0 and 1).
+//! Shading four fragments at a time (`shade::lanes`: `blinn_phong4` and
+//! `pbr4`) gives the frames of the one-fragment path bit for bit: colour
+//! and depth of every pixel, over scenes that reach each of its branches
+//! (maps, normal maps, vertex colours, every light kind with ranges and
+//! shadows, the environment, AO, MSAA, anisotropic and trilinear
+//! filtering, address modes, orthographic cameras, illum 0 and 1; pbr
+//! with packed occlusion-roughness-metallic maps, emission, ambient and
+//! the environment).
 
 mod common;
 
@@ -220,4 +222,80 @@ irradiance = 0.7
         );
         same_both_ways(&scene, &[0], &format!("quad, illum {illum}"));
     }
+}
+
+#[test]
+fn pbr_models_are_the_same_with_and_without_lanes() {
+    // The walker: pbr factors without maps under the default look (studio
+    // environment, its ground shadow), MSAA 4.
+    let walker = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/walker.toml");
+    let small = ["output.width=120", "output.height=120"];
+    same_both_ways(&with(&walker, &small), &[0, 30], "walker");
+    // The showcase's OBJ materials shaded as pbr (map_Kd as the base
+    // colour, its normal maps), with lights, shadows, SSAO and ambient.
+    let showcase = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
+    let mut sets = small.to_vec();
+    sets.extend([
+        "render.shading=\"pbr\"",
+        "render.msaa=1",
+        "render.shadows=\"pcf\"",
+        "ambient.color=[0.2, 0.15, 0.1]",
+    ]);
+    same_both_ways(&with(&showcase, &sets), &[2], "showcase as pbr");
+
+    let Some(assets) = shared_assets() else {
+        return;
+    };
+    let helmet = assets.join("gltf/FlightHelmet/FlightHelmet.gltf");
+    let dir = scratch("lanes_helmet");
+    let scene = format!(
+        r#"
+[output]
+width = 160
+height = 160
+[render]
+texture_filter = "trilinear"
+[ambient]
+color = [0.06, 0.06, 0.07]
+[animation]
+frames = 72
+turntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360 }}
+[[model]]
+path = "{helmet}"
+[[light]]
+kind = "directional"
+direction = [0.5, -0.74, -0.45]
+irradiance = 1
+color = [0.9, 0.88, 0.85]
+[[light]]
+kind = "point"
+position = [0.5, 0.6, 0.7]
+intensity = 0.5
+[[light]]
+kind = "spot"
+position = [-0.5, 0.8, 0.6]
+direction = [0.5, -0.6, -0.5]
+intensity = 2.0
+inner_angle = 15
+outer_angle = 30
+"#,
+        helmet = helmet.display()
+    );
+    let file = dir.join("helmet.toml");
+    std::fs::write(&file, scene).unwrap();
+    same_both_ways(&with(&file, &[]), &[0, 25], "FlightHelmet, three lights");
+    same_both_ways(
+        &with(
+            &file,
+            &[
+                "environment.preset=\"studio\"",
+                "render.ao.method=\"ssao\"",
+                "light.0.shadows=true",
+                "render.texture_filter=\"anisotropic\"",
+                "render.msaa=4",
+            ],
+        ),
+        &[40],
+        "FlightHelmet, environment, SSAO, shadow map, anisotropic, MSAA 4",
+    );
 }

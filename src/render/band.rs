@@ -29,7 +29,7 @@ use crate::raster::setup::Tri;
 use crate::scene::material::AlphaMode;
 use crate::scene::settings::ShadingMode;
 use crate::shade::ao::GPixel;
-use crate::shade::blinn_phong4::MAX_SIZES;
+use crate::shade::lanes::MAX_SIZES;
 use crate::shade::{SizedFootprint, Surface, TexCoords};
 
 impl<'a> FrameData<'a> {

@@ -17,8 +17,8 @@ use crate::raytrace::Tracer;
 use crate::scene::material::AlphaMode;
 use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
-use crate::shade::blinn_phong4::LaneMaterial;
 use crate::shade::env::EnvLight;
+use crate::shade::lanes::LaneMaterial;
 use crate::shade::{ShadeContext, background};
 
 /// What every band of one frame reads.
@@ -52,7 +52,7 @@ pub(super) struct FrameData<'a> {
 impl<'a> FrameData<'a> {
     /// `grads`: the texture filter reads derivatives (trilinear,
     /// anisotropic). `lanes`: shade the materials that allow it four
-    /// fragments at a time (`shade::blinn_phong4`; the same pixels).
+    /// fragments at a time (`shade::lanes`; the same pixels).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         fs: &'a FrameSetup<'a>,

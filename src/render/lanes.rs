@@ -15,8 +15,8 @@ use crate::assets::texture::Footprint;
 use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
-use crate::shade::blinn_phong4::LaneMaterial;
-use crate::shade::blinn_phong4::{Lanes, MAX_SIZES};
+use crate::shade::lanes::LaneMaterial;
+use crate::shade::lanes::{Lanes, MAX_SIZES};
 use crate::simd::{V3, lanes4, lerp3};
 
 /// A fragment waiting for its lane.

@@ -92,7 +92,7 @@ pub struct Renderer {
     /// moves).
     shadow_maps: shadow_pass::MapCache,
     /// Shade the materials that allow it four fragments at a time
-    /// (`shade::blinn_phong4`); off only to compare the two paths.
+    /// (`shade::lanes`); off only to compare the two paths.
     lanes: bool,
 }
 

@@ -8,8 +8,10 @@ pub mod env;
 pub mod env_sampled;
 pub mod gouraud;
 pub mod iridescence;
+pub mod lanes;
 pub mod light;
 pub mod pbr;
+mod pbr4;
 pub mod shadow;
 pub mod sheen;
 

@@ -115,7 +115,7 @@ impl Coat {
 
 /// Smallest alpha: a perfect mirror would make D a delta that point lights
 /// never hit; this keeps a tiny, finite highlight.
-const MIN_ALPHA: f32 = 2e-3;
+pub(super) const MIN_ALPHA: f32 = 2e-3;
 
 impl PbrColor {
     #[inline]
@@ -311,7 +311,7 @@ pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> V
 
 /// Lagarde's specular occlusion from ambient occlusion `ao`.
 #[inline]
-fn specular_occlusion(ndv: f32, ao: f32, roughness: f32) -> f32 {
+pub(super) fn specular_occlusion(ndv: f32, ao: f32, roughness: f32) -> f32 {
     if ao >= 1.0 {
         1.0
     } else {

@@ -1,5 +1,5 @@
 //! Four lookups of one texture at once, for shading that runs four
-//! fragments side by side (`shade::blinn_phong4`): the coordinates and
+//! fragments side by side (`shade::lanes`): the coordinates and
 //! results are held per channel with one lane per lookup (a structure of
 //! arrays), and every lane is bit for bit what the one-lookup functions
 //! give for it (`Texture::sample_footprint`).

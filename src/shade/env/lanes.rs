@@ -1,5 +1,5 @@
 //! The environment's lookups for four fragments at once (the Blinn-Phong
-//! lanes, `shade::blinn_phong4`): the operations of the one-direction
+//! lanes, `shade::lanes`): the operations of the one-direction
 //! functions of the parent module in the same order on four lanes, so
 //! each lane is bit for bit their answer. Texel loads and their bilinear
 //! blends stay per lane; the direction arithmetic (rotation, spherical
@@ -139,13 +139,13 @@ impl EnvLight {
     }
 }
 
-/// `super::dominant_direction` on four lanes, for one roughness.
+/// `super::dominant_direction` on four lanes, each with its roughness.
 #[inline(always)]
-pub fn dominant_direction4(n: V3, r: V3, roughness: f32) -> V3 {
+pub fn dominant_direction4(n: V3, r: V3, roughness: Vec4) -> V3 {
     let a = roughness * roughness;
-    let f = (1.0 - a) * ((1.0 - a).sqrt() + a);
+    let f = (Vec4::ONE - a) * ((Vec4::ONE - a).sqrt() + a);
     // `Vec3::lerp`: n (1 - f) + r f.
-    let l = n.scale(Vec4::splat(1.0 - f)) + r.scale(Vec4::splat(f));
+    let l = n.scale(Vec4::ONE - f) + r.scale(f);
     l.normalize_or(r)
 }
 
@@ -246,7 +246,7 @@ mod tests {
             let roughness = (i % 13) as f32 / 12.0;
             let pre = env.prefiltered4(unit, roughness);
             let n = V3::from_lanes([q[1], q[2], q[3], q[0]]).normalize_or(V3::splat(Vec3::Z));
-            let dom = dominant_direction4(n, unit, roughness);
+            let dom = dominant_direction4(n, unit, Vec4::splat(roughness));
             let ph = phong[i % 3];
             let pre_phong = env.prefiltered_phong4(unit, ph);
             for k in 0..4 {

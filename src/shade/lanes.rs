@@ -1,0 +1,500 @@
+//! Shading four fragments at once: what `ShadeContext::shade` gives a
+//! material, computed on four lanes with the operations of the
+//! one-fragment code in the same order, so each lane is bit for bit that
+//! code's answer.
+//!
+//! The renderer shades the visible fragments of a band this way wherever
+//! `ShadeContext::lane_material` accepts the material: Blinn-Phong
+//! (`blinn_phong4`, textured OBJ models) and metallic-roughness without
+//! the KHR layers (`pbr4`, most glTF models). Everything else (the data
+//! views, flat and Gouraud shading, unlit, clearcoat, sheen,
+//! transmission, iridescence, bump and object-space normal maps, texture
+//! transforms, the sampled environment) takes the one-fragment path. The
+//! lanes of one call share a material but not a triangle: texture
+//! lookups, interpolation and lighting run four-wide; texel loads,
+//! shadow lookups, powers and some environment lookups per lane.
+//!
+//! This module holds what both kinds share: the material's maps prepared
+//! for four lookups, the interpolated fragments (`Lanes`), the lights'
+//! incidence and the tangent-space normal map.
+
+// Loops over the four lanes index several per-lane arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+use glam::{Vec3, Vec4};
+use smallvec::SmallVec;
+
+use super::ShadeContext;
+use super::light::incidence;
+use crate::assets::texture::{
+    Chain, Filtering, Footprint, Gradients, Taps4, Texture, TextureFilter as Filter, TextureRef,
+    Wrap,
+};
+use crate::scene::Material;
+use crate::scene::light::{Light, LightKind};
+use crate::scene::material::{Native, NormalMap, NormalSpace};
+use crate::scene::settings::{ShadingMode, TextureFilter};
+use crate::simd::V3;
+
+/// At most this many distinct texture sizes (and mip chains) among a lane
+/// material's maps: each fragment carries one filter footprint per size,
+/// and the maps of one size share where their lookups fall
+/// (`Texture::taps4`).
+pub const MAX_SIZES: usize = 3;
+
+/// One map of a lane material, ready for four lookups.
+pub(super) struct Map<'a> {
+    /// The texture with the frame's mip chain.
+    pub chain: Chain<'a>,
+    pub mode: Wrap,
+    /// Which of the fragment's footprints (by texture size and chain) it
+    /// reads, and whose taps.
+    pub slot: usize,
+    /// The material reference it came from (to find maps that are the
+    /// same lookup).
+    pub source: &'a TextureRef,
+}
+
+/// A material the lanes can shade, prepared for one frame.
+pub struct LaneMaterial<'a> {
+    pub(super) material: &'a Material,
+    pub(super) kind: Kind<'a>,
+    /// Per slot: the (width, height) of its maps and their number of
+    /// levels.
+    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
+}
+
+/// The shading model of a lane material and its maps. (One per draw and
+/// frame, held in place: the variants' sizes differ by two maps.)
+#[allow(clippy::large_enum_variant)]
+pub(super) enum Kind<'a> {
+    BlinnPhong {
+        kd: Option<Map<'a>>,
+        ks: Option<Map<'a>>,
+        /// Tangent-space normal map and its scale.
+        normal: Option<(Map<'a>, f32)>,
+    },
+    Pbr(PbrMaps<'a>),
+}
+
+/// The maps of a metallic-roughness lane material.
+pub(super) struct PbrMaps<'a> {
+    pub base: Option<Map<'a>>,
+    pub metallic_roughness: Option<Map<'a>>,
+    pub occlusion: Option<Map<'a>>,
+    /// Looked up only where the emissive factor is not zero.
+    pub emissive: Option<Map<'a>>,
+    pub normal: Option<(Map<'a>, f32)>,
+}
+
+/// Four fragments of one material, one lane each, as `Surface` holds one.
+pub struct Lanes {
+    pub position: V3,
+    /// Unit interpolated normal, on the side the camera sees.
+    pub normal: V3,
+    /// Texture coordinates (set 0).
+    pub u: Vec4,
+    pub v: Vec4,
+    /// Interpolated tangent and its bitangent sign (when the material has
+    /// a normal map).
+    pub tangent: V3,
+    pub sign: Vec4,
+    /// Vertex colour (RGB), where the mesh has one.
+    pub color: Option<V3>,
+    /// The triangles' plane normals (shadow lookups).
+    pub geo_normal: [Vec3; 4],
+    pub ao: Vec4,
+    /// Per texture size of the material (`LaneMaterial::footprints`).
+    pub footprints: [[Footprint; 4]; MAX_SIZES],
+}
+
+impl LaneMaterial<'_> {
+    /// The footprints of a fragment whose texture coordinates change by
+    /// `g` across its quad: one per texture size the maps have, in the
+    /// order `Lanes::footprints` takes them (as `ShadeContext::sample`
+    /// derives them).
+    pub fn footprints(&self, ctx: &ShadeContext, g: Gradients) -> [Footprint; MAX_SIZES] {
+        let mut out = [Footprint::Lod(0.0); MAX_SIZES];
+        if !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
+            return out;
+        }
+        let f = Filtering {
+            filter: ctx.filter,
+            max_anisotropy: ctx.max_anisotropy,
+            mips: None,
+        };
+        for (k, &((w, h), _)) in self.sizes.iter().enumerate() {
+            out[k] = Texture::footprint_of_size(w, h, g, &f);
+        }
+        out
+    }
+}
+
+/// Collects a lane material's maps, assigning each a footprint slot by
+/// its texture's size and chain.
+pub(super) struct MapSet<'c, 'a> {
+    ctx: &'c ShadeContext<'a>,
+    uvs: bool,
+    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
+}
+
+impl<'a> MapSet<'_, 'a> {
+    /// `t` ready for four lookups, or None where the lanes cannot look it
+    /// up as `ShadeContext::sample` does (a transform, a sampler of its
+    /// own, set 1, a mesh without coordinates, a fourth texture size).
+    pub fn map(&mut self, t: &'a TextureRef) -> Option<Map<'a>> {
+        if !t.is_plain() || t.texcoord != 0 || !self.uvs {
+            return None;
+        }
+        let tex = &*t.texture;
+        let mips = self.ctx.mips.get(tex.id).copied().flatten();
+        let shape = ((tex.width, tex.height), 1 + mips.map_or(0, |m| m.len()));
+        let slot = match self.sizes.iter().position(|s| *s == shape) {
+            Some(k) => k,
+            None if self.sizes.len() < MAX_SIZES => {
+                self.sizes.push(shape);
+                self.sizes.len() - 1
+            }
+            None => return None,
+        };
+        Some(Map {
+            chain: tex.chain(mips),
+            mode: t.address.unwrap_or(self.ctx.address.into()),
+            slot,
+            source: t,
+        })
+    }
+
+    /// An optional map: Some(None) without one, None where the lanes
+    /// cannot look it up.
+    pub fn optional(&mut self, t: &'a Option<TextureRef>) -> Option<Option<Map<'a>>> {
+        match t {
+            Some(t) => Some(Some(self.map(t)?)),
+            None => Some(None),
+        }
+    }
+
+    /// The material's tangent-space normal map and its scale: Some(None)
+    /// without one (or without tangents, where the map leaves the normal
+    /// as it is), None for the kinds the lanes do not take.
+    pub fn normal(&mut self, m: &'a Material, tangents: bool) -> Option<Option<(Map<'a>, f32)>> {
+        match &m.normal_map {
+            None => Some(None),
+            Some(NormalMap::Normals {
+                map: t,
+                space: NormalSpace::Tangent,
+                scale,
+            }) => {
+                if !self.uvs {
+                    return None;
+                }
+                if tangents {
+                    Some(Some((self.map(t)?, *scale)))
+                } else {
+                    Some(None)
+                }
+            }
+            Some(_) => None,
+        }
+    }
+}
+
+impl<'a> ShadeContext<'a> {
+    /// `m` prepared for the lanes, or None where it needs the one-fragment
+    /// path. `uvs` and `tangents`: whether the mesh drawn with it has
+    /// texture coordinates and tangents.
+    pub fn lane_material(
+        &self,
+        m: &'a Material,
+        uvs: bool,
+        tangents: bool,
+    ) -> Option<LaneMaterial<'a>> {
+        if m.unlit || self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
+            return None;
+        }
+        let mut maps = MapSet {
+            ctx: self,
+            uvs,
+            sizes: SmallVec::new(),
+        };
+        let kind = match self.mode {
+            ShadingMode::BlinnPhong => Kind::blinn_phong(m, &mut maps, tangents)?,
+            ShadingMode::Pbr => Kind::pbr(m, &mut maps, tangents)?,
+            ShadingMode::Auto if m.native == Native::BlinnPhong => {
+                Kind::blinn_phong(m, &mut maps, tangents)?
+            }
+            ShadingMode::Auto => Kind::pbr(m, &mut maps, tangents)?,
+            _ => return None,
+        };
+        Some(LaneMaterial {
+            material: m,
+            kind,
+            sizes: maps.sizes,
+        })
+    }
+
+    /// Linear RGB of four fragments of `lm`'s material, lane by lane
+    /// `shade` of each (before its non-finite guard).
+    pub fn shade_lanes(&self, lm: &LaneMaterial<'a>, f: &Lanes) -> V3 {
+        let mut lookups = Lookups::new(f);
+        match &lm.kind {
+            Kind::BlinnPhong { kd, ks, normal } => {
+                self.blinn_phong_lanes(lm.material, [kd, ks], normal, &mut lookups, f)
+            }
+            Kind::Pbr(maps) => self.pbr_lanes(lm.material, maps, &mut lookups, f),
+        }
+    }
+
+    /// `apply_normal_map` of a tangent-space map whose four texels are
+    /// `c` (RGB).
+    pub(super) fn normal_map_lanes(&self, f: &Lanes, c: V3, scale: f32) -> V3 {
+        let n = f.normal;
+        let c = V3 {
+            x: c.x * Vec4::splat(2.0) - Vec4::ONE,
+            y: c.y * Vec4::splat(2.0) - Vec4::ONE,
+            z: c.z * Vec4::splat(2.0) - Vec4::ONE,
+        };
+        let t = f.tangent;
+        let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
+        let tt = if ok.all() {
+            tt
+        } else {
+            let mut fallback = [Vec3::ZERO; 4];
+            for (k, o) in fallback.iter_mut().enumerate() {
+                *o = n.lane(k).any_orthonormal_vector();
+            }
+            V3::select(ok, tt, V3::from_lanes(fallback))
+        };
+        let sign = Vec4::select(f.sign.cmplt(Vec4::ZERO), -Vec4::ONE, Vec4::ONE);
+        let b = n.cross(tt).scale(sign);
+        let scale = Vec4::splat(scale);
+        let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
+        mapped.normalize_or(n)
+    }
+
+    /// The unit view vectors of four points (`view_vector`).
+    #[inline(always)]
+    pub(super) fn view_lanes(&self, p: V3) -> V3 {
+        if self.orthographic {
+            V3::splat(-self.forward)
+        } else {
+            (V3::splat(self.eye) - p).normalize_or(V3::splat(-self.forward))
+        }
+    }
+
+    /// Light `i`'s light on four points with unit normals `n`, as
+    /// `for_each_lit` hands it on: the unit directions towards it, the
+    /// irradiance times n.l times the shadow, and the lanes it lights.
+    #[inline(always)]
+    pub(super) fn lit_lanes(&self, i: usize, light: &Light, f: &Lanes, n: V3) -> Lit {
+        let p = f.position;
+        let (l, e, reaches) = incidence4(light, p);
+        let ndl = n.dot(l);
+        let mut lit = reaches & ndl.cmpgt(Vec4::ZERO);
+        let mut s = Vec4::ONE;
+        if light.shadows {
+            let bits = lit.bitmask();
+            for k in 0..4 {
+                if bits & (1 << k) != 0 {
+                    s[k] = self
+                        .shadows
+                        .visibility(i, p.lane(k), f.geo_normal[k], l.lane(k));
+                }
+            }
+            lit &= s.cmpgt(Vec4::ZERO);
+        }
+        Lit {
+            l,
+            ndl,
+            e: e.scale(ndl * s),
+            lit,
+        }
+    }
+}
+
+/// A light's contribution at four points (`ShadeContext::lit_lanes`).
+pub(super) struct Lit {
+    pub l: V3,
+    pub ndl: Vec4,
+    /// Irradiance times n.l times the shadow.
+    pub e: V3,
+    pub lit: glam::BVec4A,
+}
+
+/// `incidence(light, p)` at four points: direction, irradiance (before
+/// n.l) and the lanes it reaches.
+#[inline(always)]
+fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
+    match light.kind {
+        LightKind::Directional {
+            direction,
+            irradiance,
+        } => (
+            V3::splat(-direction),
+            V3::splat(light.color * irradiance),
+            Vec4::ONE.cmpgt(Vec4::ZERO),
+        ),
+        LightKind::Point {
+            position,
+            intensity,
+        } if light.range.is_none() => {
+            let d = V3::splat(position) - p;
+            let r2 = d.dot(d);
+            let k = Vec4::splat(intensity * 1.0) / r2;
+            (
+                d / r2.sqrt(),
+                V3::splat(light.color).scale(k),
+                // As `towards`: only r2 <= 0 misses.
+                !r2.cmple(Vec4::ZERO),
+            )
+        }
+        _ => {
+            // Spot cones and range windows: lane by lane.
+            let mut l = [Vec3::ZERO; 4];
+            let mut e = [Vec3::ZERO; 4];
+            let mut ok = [0.0f32; 4];
+            for k in 0..4 {
+                if let Some(inc) = incidence(light, p.lane(k)) {
+                    (l[k], e[k], ok[k]) = (inc.l, inc.e, 1.0);
+                }
+            }
+            (
+                V3::from_lanes(l),
+                V3::from_lanes(e),
+                Vec4::from(ok).cmpgt(Vec4::ZERO),
+            )
+        }
+    }
+}
+
+/// The texture lookups of one lane call: where each footprint slot's
+/// lookups fall, found once for all its maps (`Texture::taps4`).
+pub(super) struct Lookups<'f> {
+    f: &'f Lanes,
+    taps: [Option<Option<Taps4>>; MAX_SIZES],
+}
+
+impl<'f> Lookups<'f> {
+    fn new(f: &'f Lanes) -> Lookups<'f> {
+        Lookups {
+            f,
+            taps: Default::default(),
+        }
+    }
+
+    /// `map`'s red, green and blue at the four lanes.
+    #[inline]
+    pub fn read(&mut self, map: &Map) -> V3 {
+        let f = self.f;
+        let taps = self.taps[map.slot]
+            .get_or_insert_with(|| map.chain.taps4(f.u, f.v, &f.footprints[map.slot]));
+        let [r, g, b] = match taps {
+            Some(t) => map.chain.read4(t, map.mode),
+            None => map
+                .chain
+                .sample4(f.u, f.v, &f.footprints[map.slot], map.mode),
+        };
+        V3 { x: r, y: g, z: b }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::scene::material::{Clearcoat, Native};
+    use crate::scene::settings::AddressMode;
+    use crate::shade::shadow::Shadows;
+
+    fn context<'a>(shadows: &'a Shadows<'a>, mode: ShadingMode) -> ShadeContext<'a> {
+        ShadeContext {
+            mode,
+            lights: &[],
+            ambient: Vec3::ZERO,
+            eye: Vec3::Z,
+            forward: -Vec3::Z,
+            orthographic: false,
+            filter: TextureFilter::Trilinear,
+            max_anisotropy: 16.0,
+            address: AddressMode::Repeat,
+            mips: &[],
+            depth_range: (0.0, 1.0),
+            shadows,
+            env: None,
+            env_sampled: None,
+            pixel_scale: 1.0,
+        }
+    }
+
+    fn map(size: u32) -> TextureRef {
+        let texels = vec![[200, 100, 50, 255]; (size * size) as usize];
+        TextureRef::new(Arc::new(Texture::from_rgba8(size, size, texels, false)))
+    }
+
+    /// The lane materials the e2e tests (tests/lanes.rs) count on: glTF's
+    /// packed pbr maps and MTL maps go to the lanes; layers, unlit,
+    /// texture transforms and a fourth texture size do not.
+    #[test]
+    fn which_materials_the_lanes_take() {
+        let shadows = Shadows::none();
+        let auto = context(&shadows, ShadingMode::Auto);
+        let orm = map(8);
+        let mut gltf = Material::default_named("helmet");
+        gltf.native = Native::Pbr;
+        gltf.pbr.base_color_map = Some(map(16));
+        gltf.pbr.metallic_roughness_map = Some(orm.clone());
+        gltf.pbr.occlusion_map = Some(orm);
+        gltf.normal_map = Some(NormalMap::Normals {
+            map: map(16),
+            space: NormalSpace::Tangent,
+            scale: 1.0,
+        });
+        let kind = |ctx: &ShadeContext, m| match ctx.lane_material(m, true, true) {
+            Some(LaneMaterial {
+                kind: Kind::Pbr(p), ..
+            }) => Some(("pbr", p.occlusion.is_some() && p.normal.is_some())),
+            Some(LaneMaterial {
+                kind: Kind::BlinnPhong { kd, .. },
+                ..
+            }) => Some(("blinn-phong", kd.is_some())),
+            None => None,
+        };
+        assert_eq!(kind(&auto, &gltf), Some(("pbr", true)));
+        // Without coordinates its maps cannot be looked up.
+        assert!(auto.lane_material(&gltf, false, true).is_none());
+        let mut obj = Material::default_named("obj");
+        obj.map_kd = Some(map(16));
+        assert_eq!(kind(&auto, &obj), Some(("blinn-phong", true)));
+        // Forced pbr shading takes the OBJ material's pbr view.
+        let pbr = context(&shadows, ShadingMode::Pbr);
+        assert_eq!(kind(&pbr, &obj), Some(("pbr", false)));
+        let flat = context(&shadows, ShadingMode::Flat);
+        assert_eq!(kind(&flat, &obj), None);
+
+        let mut coat = gltf.clone();
+        coat.pbr.clearcoat = Some(Clearcoat {
+            factor: 1.0,
+            map: None,
+            roughness: 0.1,
+            roughness_map: None,
+            normal_map: None,
+        });
+        assert_eq!(kind(&auto, &coat), None);
+        let mut unlit = gltf.clone();
+        unlit.unlit = true;
+        assert_eq!(kind(&auto, &unlit), None);
+        let mut moved = gltf.clone();
+        if let Some(t) = &mut moved.pbr.base_color_map {
+            t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
+        }
+        assert_eq!(kind(&auto, &moved), None);
+        let mut sizes = gltf.clone();
+        sizes.pbr.emissive = Vec3::ONE;
+        sizes.pbr.emissive_map = Some(map(32));
+        assert_eq!(kind(&auto, &sizes), Some(("pbr", true)));
+        let mut four = sizes.clone();
+        four.pbr.base_color_map = Some(map(4));
+        assert_eq!(kind(&auto, &four), None);
+    }
+}

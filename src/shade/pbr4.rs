@@ -1,0 +1,377 @@
+//! Metallic-roughness shading of four fragments at once (see
+//! `shade::lanes`): what `ShadeContext::shade` gives a pbr material
+//! without the KHR layers (base colour, metallic-roughness, occlusion,
+//! emissive and tangent-space normal maps, every light kind and shadow,
+//! ambient, the prefiltered environment), each lane bit for bit the
+//! one-fragment code's answer (`pbr::radiance`, `pbr::environment`).
+//! Exponentials, the environment's BRDF table and its prefiltered levels
+//! (whose roughness differs from lane to lane) are looked up per lane.
+
+// Loops over the four lanes index several per-lane arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+use std::f32::consts::PI;
+
+use glam::{Vec3, Vec4};
+
+use super::ShadeContext;
+use super::env::{EnvLight, dominant_direction4};
+use super::lanes::{Kind, Lanes, Lit, Lookups, Map, MapSet, PbrMaps};
+use super::pbr::{MIN_ALPHA, specular_occlusion};
+use crate::scene::Material;
+use crate::simd::V3;
+
+impl<'a> Kind<'a> {
+    /// A metallic-roughness material's maps, or None where the lanes do
+    /// not take it (separate roughness or metallic maps, a specular,
+    /// clearcoat, transmission, sheen or iridescence layer).
+    pub(super) fn pbr(
+        m: &'a Material,
+        maps: &mut MapSet<'_, 'a>,
+        tangents: bool,
+    ) -> Option<Kind<'a>> {
+        let p = &m.pbr;
+        if p.roughness_map.is_some()
+            || p.metallic_map.is_some()
+            || p.specular.is_some()
+            || p.clearcoat.is_some()
+            || p.transmission.is_some()
+            || p.sheen.is_some()
+            || p.iridescence.is_some()
+        {
+            return None;
+        }
+        let base = maps.optional(&p.base_color_map)?;
+        let metallic_roughness = maps.optional(&p.metallic_roughness_map)?;
+        let occlusion = maps.optional(&p.occlusion_map)?;
+        let emissive = if p.emissive == Vec3::ZERO {
+            None
+        } else {
+            maps.optional(&p.emissive_map)?
+        };
+        let normal = maps.normal(m, tangents)?;
+        Some(Kind::Pbr(PbrMaps {
+            base,
+            metallic_roughness,
+            occlusion,
+            emissive,
+            normal,
+        }))
+    }
+}
+
+/// Whether two maps are the same lookup (glTF's packed occlusion,
+/// roughness and metallic texture, referred to twice).
+fn same_lookup(a: &Map, b: &Map) -> bool {
+    std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
+}
+
+/// `f32::clamp(x, 0.0, 1.0)` per lane (signed zeros and NaN included).
+#[inline(always)]
+fn clamp01(x: Vec4) -> Vec4 {
+    let x = Vec4::select(x.cmplt(Vec4::ZERO), Vec4::ZERO, x);
+    Vec4::select(x.cmpgt(Vec4::ONE), Vec4::ONE, x)
+}
+
+/// `x.powi(5)` per lane: x (x^2 x^2), the products LLVM makes of it.
+#[inline(always)]
+fn pow5(x: Vec4) -> Vec4 {
+    let x2 = x * x;
+    x * (x2 * x2)
+}
+
+/// Four metallic-roughness points, as `PbrColor` holds one (without the
+/// layers the lanes do not take).
+struct Color4 {
+    roughness: Vec4,
+    occlusion: Vec4,
+    /// `PbrColor::f0` and `c_diff`.
+    f0: V3,
+    c_diff: V3,
+    /// alpha^2 of the GGX lobe.
+    a2: Vec4,
+}
+
+impl<'a> ShadeContext<'a> {
+    /// `shade` of four fragments of pbr material `m` with maps `maps`.
+    pub(super) fn pbr_lanes(
+        &self,
+        m: &Material,
+        maps: &PbrMaps<'a>,
+        lookups: &mut Lookups,
+        f: &Lanes,
+    ) -> V3 {
+        let p = &m.pbr;
+        // `pbr_color`.
+        let mut base = V3::splat(p.base_color.truncate());
+        if let Some(map) = &maps.base {
+            base = base * lookups.read(map);
+        }
+        if let Some(c) = f.color {
+            base = base * c;
+        }
+        let mr = maps
+            .metallic_roughness
+            .as_ref()
+            .map(|map| lookups.read(map));
+        let (roughness, metallic) = match mr {
+            Some(mr) => (
+                Vec4::splat(p.roughness) * mr.y,
+                Vec4::splat(p.metallic) * mr.z,
+            ),
+            None => (Vec4::splat(p.roughness), Vec4::splat(p.metallic)),
+        };
+        let occlusion = match &maps.occlusion {
+            Some(map) => {
+                let o = match (&maps.metallic_roughness, mr) {
+                    (Some(other), Some(mr)) if same_lookup(map, other) => mr,
+                    _ => lookups.read(map),
+                };
+                Vec4::ONE + Vec4::splat(p.occlusion_strength) * (o.x - Vec4::ONE)
+            }
+            None => Vec4::ONE,
+        };
+        let emissive = if p.emissive == Vec3::ZERO {
+            V3::ZERO
+        } else {
+            let e = V3::splat(p.emissive);
+            match &maps.emissive {
+                Some(map) => e * lookups.read(map),
+                None => e,
+            }
+        };
+        let (metallic, roughness) = (clamp01(metallic), clamp01(roughness));
+        let alpha = (roughness * roughness).max(Vec4::splat(MIN_ALPHA));
+        let keep = Vec4::ONE - metallic;
+        let c = Color4 {
+            roughness,
+            occlusion,
+            // `Vec3::lerp`: 0.04 (1 - metallic) + base metallic.
+            f0: V3::splat(Vec3::splat(0.04)).scale(keep) + base.scale(metallic),
+            c_diff: base.scale(keep),
+            a2: alpha * alpha,
+        };
+
+        let v = self.view_lanes(f.position);
+        let n = match &maps.normal {
+            Some((map, scale)) => self.normal_map_lanes(f, lookups.read(map), *scale),
+            None => f.normal,
+        };
+        // `pbr::radiance`.
+        let mut out = emissive;
+        for (i, light) in self.lights.iter().enumerate() {
+            let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
+            if lit.any() {
+                let added = out + e * brdf4(n, v, l, ndl, &c);
+                out = V3::select(lit, added, out);
+            }
+        }
+        let ambient = V3::splat(self.ambient).scale(f.ao);
+        let some_ambient = !(ambient.x.cmpeq(Vec4::ZERO)
+            & ambient.y.cmpeq(Vec4::ZERO)
+            & ambient.z.cmpeq(Vec4::ZERO));
+        if some_ambient.any() {
+            let (a, b) = env_brdf4(c.roughness, n.dot(v).abs());
+            let spec = split_sum(&c, a, b);
+            let spec = V3 {
+                x: clamp01(spec.x),
+                y: clamp01(spec.y),
+                z: clamp01(spec.z),
+            };
+            let one = V3::splat(Vec3::ONE);
+            let added = out + ambient.scale(c.occlusion) * (c.c_diff * (one - spec) + spec);
+            out = V3::select(some_ambient, added, out);
+        }
+        match self.env {
+            Some(env) => out + environment4(env, n, v, &c, f.ao),
+            None => out,
+        }
+    }
+}
+
+/// `pbr::brdf` at four points, for unit light directions `l` with
+/// n.l = `ndl` > 0.
+#[inline(always)]
+fn brdf4(n: V3, v: V3, l: V3, ndl: Vec4, c: &Color4) -> V3 {
+    let h = (l + v).normalize_or(V3::ZERO);
+    let vdh = v.dot(h).abs();
+    let one = V3::splat(Vec3::ONE);
+    // F90 = 1 without a dielectric specular.
+    let fresnel = c.f0 + (one - c.f0).scale(pow5(Vec4::ONE - vdh));
+    (one - fresnel) * c.c_diff / Vec4::splat(PI) + fresnel.scale(d_vis4(n, v, h, ndl, c.a2))
+}
+
+/// `pbr::d_vis`, with the half vector `h` it computes.
+#[inline(always)]
+fn d_vis4(n: V3, v: V3, h: V3, ndl: Vec4, a2: Vec4) -> Vec4 {
+    let one = Vec4::ONE;
+    let ndv = n.dot(v).abs().max(Vec4::splat(1e-4));
+    let ndh = n.dot(h);
+    let t = ndh * ndh * (a2 - one) + one;
+    let d = Vec4::select(
+        ndh.cmpgt(Vec4::ZERO),
+        a2 / (Vec4::splat(PI) * t * t),
+        Vec4::ZERO,
+    );
+    let vis = one
+        / ((ndl + (a2 + (one - a2) * ndl * ndl).sqrt())
+            * (ndv + (a2 + (one - a2) * ndv * ndv).sqrt()));
+    d * vis
+}
+
+/// `PbrColor::split_sum` without a film: f0 a + b (F90 1).
+#[inline(always)]
+fn split_sum(c: &Color4, a: Vec4, b: Vec4) -> V3 {
+    let b = b * Vec4::ONE;
+    c.f0.scale(a) + V3 { x: b, y: b, z: b }
+}
+
+/// `pbr::env_brdf` (the analytic fit) at four points.
+#[inline(always)]
+fn env_brdf4(roughness: Vec4, ndv: Vec4) -> (Vec4, Vec4) {
+    let r = clamp01(roughness);
+    let k = Vec4::splat;
+    let (x, y, z, w) = (
+        -r + k(1.0),
+        k(-0.0275) * r + k(0.0425),
+        k(-0.572) * r + k(1.04),
+        k(0.022) * r - k(0.04),
+    );
+    let mut e = [0.0f32; 4];
+    for j in 0..4 {
+        e[j] = (-9.28 * ndv[j].max(0.0)).exp2();
+    }
+    let a004 = (x * x).min(Vec4::from(e)) * x + y;
+    (k(-1.04) * a004 + z, k(1.04) * a004 + w)
+}
+
+/// `pbr::environment` at four points (no sheen, clearcoat or
+/// transmission: the lanes never see them).
+fn environment4(env: &EnvLight, n: V3, v: V3, c: &Color4, ao: Vec4) -> V3 {
+    let ndv = n.dot(v).abs().max(Vec4::splat(1e-4));
+    let (mut a, mut b) = ([0.0f32; 4], [0.0f32; 4]);
+    for k in 0..4 {
+        let ab = env.brdf(ndv[k], c.roughness[k]);
+        (a[k], b[k]) = (ab.x, ab.y);
+    }
+    let spec = split_sum(c, Vec4::from(a), Vec4::from(b));
+    let one = V3::splat(Vec3::ONE);
+    let diffuse = (c.c_diff * (one - spec) * env.irradiance4(n)).scale(ao / Vec4::splat(PI));
+    let r = n.scale(Vec4::splat(2.0) * n.dot(v)) - v;
+    let r = dominant_direction4(n, r, c.roughness);
+    let mut light = [Vec3::ZERO; 4];
+    let mut so = [0.0f32; 4];
+    for k in 0..4 {
+        light[k] = env.prefiltered(r.lane(k), c.roughness[k]);
+        so[k] = specular_occlusion(ndv[k], ao[k], c.roughness[k]);
+    }
+    let specular = (V3::from_lanes(light) * spec).scale(Vec4::from(so));
+    (diffuse + specular).scale(c.occlusion)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shade::pbr::{self, PbrColor};
+
+    fn xorshift(seed: u64) -> impl FnMut() -> f32 {
+        let mut s = seed;
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    #[test]
+    fn pow5_is_powi_bit_for_bit() {
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
+        let mut xs: Vec<f32> = (0..100_000).map(|_| next() * 2.0 - 0.5).collect();
+        xs.extend([0.0, -0.0, 1.0, 1e-30, 1e30, f32::MIN_POSITIVE, 0.999_999_9]);
+        for x in xs {
+            let got = pow5(Vec4::splat(x)).x;
+            assert_eq!(got.to_bits(), x.powi(5).to_bits(), "{x}");
+        }
+    }
+
+    #[test]
+    fn clamp01_is_f32_clamp() {
+        for x in [-1.0f32, -0.0, 0.0, 0.3, 1.0, 1.5, f32::INFINITY, f32::NAN] {
+            let got = clamp01(Vec4::splat(x)).x;
+            let want = x.clamp(0.0, 1.0);
+            assert!(got.to_bits() == want.to_bits(), "{x}: {got} {want}");
+        }
+    }
+
+    /// Random unit vectors in the upper hemisphere of +Z.
+    fn hemisphere(next: &mut impl FnMut() -> f32) -> Vec3 {
+        loop {
+            let d = Vec3::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next());
+            if d.length_squared() > 1e-4 && d.length_squared() <= 1.0 {
+                return d.normalize();
+            }
+        }
+    }
+
+    #[test]
+    fn brdf_and_ambient_fit_are_the_scalar_ones_bit_for_bit() {
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..5_000 {
+            let mut lanes = Vec::new();
+            for _ in 0..4 {
+                let n = hemisphere(&mut next);
+                let (v, l) = (hemisphere(&mut next), hemisphere(&mut next));
+                let color = PbrColor {
+                    base: Vec3::new(next(), next(), next()),
+                    metallic: next(),
+                    roughness: next(),
+                    occlusion: 1.0,
+                    emissive: Vec3::ZERO,
+                    dielectric: None,
+                    coat: None,
+                    sheen: None,
+                    transmission: 0.0,
+                    attenuation: Vec3::ONE,
+                    iridescence: None,
+                };
+                lanes.push((n, v, l, color));
+            }
+            let at = |f: fn(&(Vec3, Vec3, Vec3, PbrColor)) -> Vec3| {
+                V3::from_lanes([0, 1, 2, 3].map(|k| f(&lanes[k])))
+            };
+            let per = |f: fn(&(Vec3, Vec3, Vec3, PbrColor)) -> f32| {
+                Vec4::from([0, 1, 2, 3].map(|k| f(&lanes[k])))
+            };
+            let (n, v, l) = (at(|x| x.0), at(|x| x.1), at(|x| x.2));
+            let metallic = per(|x| x.3.metallic);
+            let roughness = per(|x| x.3.roughness);
+            let base = at(|x| x.3.base);
+            let alpha = (roughness * roughness).max(Vec4::splat(MIN_ALPHA));
+            let keep = Vec4::ONE - metallic;
+            let c = Color4 {
+                roughness,
+                occlusion: Vec4::ONE,
+                f0: V3::splat(Vec3::splat(0.04)).scale(keep) + base.scale(metallic),
+                c_diff: base.scale(keep),
+                a2: alpha * alpha,
+            };
+            let ndl = n.dot(l);
+            let got = brdf4(n, v, l, ndl, &c);
+            let (a, b) = env_brdf4(roughness, n.dot(v).abs());
+            let albedo = split_sum(&c, a, b);
+            for k in 0..4 {
+                let (n, v, l, color) = &lanes[k];
+                if n.dot(*l) <= 0.0 {
+                    continue;
+                }
+                let want = pbr::brdf(*n, *v, *l, color);
+                let bits = |x: Vec3| x.to_array().map(f32::to_bits);
+                assert_eq!(bits(got.lane(k)), bits(want), "{got:?} lane {k}: {want}");
+                let fit = color.specular_albedo(n.dot(*v).abs());
+                let lane = albedo.lane(k).clamp(Vec3::ZERO, Vec3::ONE);
+                assert_eq!(bits(lane), bits(fit), "{lane} against {fit}");
+            }
+        }
+    }
+}
