@@ -41,6 +41,7 @@
 
 pub mod assets;
 pub mod batch;
+pub mod bigbuf;
 pub mod color;
 pub mod error;
 pub mod output;

@@ -10,6 +10,7 @@
 //! draw both faces of every triangle, with opaque depth (alpha-tested and
 //! blended materials cast full shadows).
 
+use crate::bigbuf::BigBuf;
 use std::sync::{Arc, Mutex};
 
 use glam::{Mat4, Vec3, Vec4};
@@ -130,7 +131,7 @@ pub(super) fn shadows<'a>(
 fn light_shadows(
     fs: &FrameSetup,
     mv: &[ModelVertices],
-    spare: &mut Vec<Vec<f32>>,
+    spare: &mut Vec<BigBuf<f32>>,
 ) -> Vec<LightShadow> {
     let s = &fs.scene.settings;
     let mut out = Vec::with_capacity(fs.lights.len());
@@ -192,7 +193,7 @@ fn directional(
     verts: &[Geo],
     direction: Vec3,
     size: u32,
-    spare: &mut Vec<Vec<f32>>,
+    spare: &mut Vec<BigBuf<f32>>,
 ) -> LightShadow {
     let view = look(Vec3::ZERO, direction);
     let (lo, hi) = verts
@@ -254,7 +255,7 @@ fn spot(
     direction: Vec3,
     cos_outer: f32,
     size: u32,
-    spare: &mut Vec<Vec<f32>>,
+    spare: &mut Vec<BigBuf<f32>>,
 ) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
@@ -271,7 +272,7 @@ fn spot(
     ))
 }
 
-fn point(verts: &[Geo], position: Vec3, size: u32, spare: &mut Vec<Vec<f32>>) -> LightShadow {
+fn point(verts: &[Geo], position: Vec3, size: u32, spare: &mut Vec<BigBuf<f32>>) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
     };
@@ -297,7 +298,7 @@ fn render_map(
     view_from_world: Mat4,
     projection: MapProjection,
     size: u32,
-    spare: &mut Vec<Vec<f32>>,
+    spare: &mut Vec<BigBuf<f32>>,
 ) -> ShadowMap {
     let clip_from_world = projection.clip_from_view() * view_from_world;
     let vp = Viewport {
@@ -354,7 +355,7 @@ fn render_map(
     let texels = size as usize * size as usize;
     let mut depth = match spare.iter().position(|d| d.len() == texels) {
         Some(k) => spare.swap_remove(k),
-        None => vec![0.0f32; texels],
+        None => BigBuf::zeroed(texels),
     };
     let band = (grid.tile_w * grid.tile_h) as usize;
     depth.par_chunks_mut(band).enumerate().for_each(|(ti, d)| {

@@ -87,7 +87,7 @@ pub struct ShadowMap {
     pub projection: MapProjection,
     /// Reverse-Z depth per texel, rows from the top; 0 where nothing was
     /// drawn.
-    pub depth: Vec<f32>,
+    pub depth: crate::bigbuf::BigBuf<f32>,
 }
 
 /// What a light with `shadows = true` is tested against this frame.

@@ -55,7 +55,7 @@ pub enum AddressMode {
 pub struct Level {
     pub width: u32,
     pub height: u32,
-    blocks: Vec<Block>,
+    blocks: crate::bigbuf::BigBuf<Block>,
     /// Blocks per row of blocks.
     blocks_x: u32,
 }
@@ -235,7 +235,7 @@ impl Level {
         Level {
             width,
             height,
-            blocks: vec![Block([[0; 4]; 16]); (blocks_x * blocks_y) as usize],
+            blocks: crate::bigbuf::BigBuf::zeroed((blocks_x * blocks_y) as usize),
             blocks_x,
         }
     }
