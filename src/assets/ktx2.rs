@@ -147,6 +147,34 @@ fn basis(b: &[u8], width: u32, height: u32) -> Result<Decoded, String> {
     // process): every level of a 2D texture needs at most level 0's UASTC
     // size (16 bytes a 4x4 block; BasisLZ states 0).
     let levels = u32_at(b, 40).ok_or("the KTX2 header is cut short")?.max(1);
+    // The index's other ranges (data format descriptor, key/value data,
+    // supercompression global data) lie inside the file: the transcoder
+    // adds to an offset before comparing it with the file's length, which
+    // overflows on an offset near 2^64 (found by fuzzing).
+    let ranges = [
+        (
+            "data format descriptor",
+            u32_at(b, 48).map(u64::from),
+            u32_at(b, 52).map(u64::from),
+        ),
+        (
+            "key/value data",
+            u32_at(b, 56).map(u64::from),
+            u32_at(b, 60).map(u64::from),
+        ),
+        ("supercompression global data", u64_at(b, 64), u64_at(b, 72)),
+    ];
+    for (what, at, len) in ranges {
+        let (Some(at), Some(len)) = (at, len) else {
+            return Err("the KTX2 index is cut short".into());
+        };
+        if len > 0 && at.checked_add(len).is_none_or(|end| end > b.len() as u64) {
+            return Err(format!(
+                "KTX2 Basis Universal data is cut short: its {what} ({len} bytes at {at}) lies outside the file ({} bytes)",
+                b.len()
+            ));
+        }
+    }
     let most = (width as u64).div_ceil(4) * (height as u64).div_ceil(4) * 16;
     for i in 0..levels as usize {
         let entry = 80 + 24 * i;
@@ -315,6 +343,18 @@ mod tests {
         let mut far = file(37, 4, 4, 0, &px);
         far[80..88].copy_from_slice(&u64::MAX.to_le_bytes());
         assert!(decode(&far).unwrap_err().contains("outside the file"));
+        // Found by fuzzing (the texture target): a Basis file whose global
+        // data starts at 2^64 - 1 made the transcoder overflow an addition
+        // (a panic it must not reach; its key/value range is refused
+        // first).
+        let fuzzed = include_bytes!("../../tests/wild/ktx2_sgd_offset_overflow.ktx2");
+        let e = decode(fuzzed).unwrap_err();
+        assert!(e.contains("lies outside the file"), "{e}");
+        let mut sgd = file(0, 4, 4, 0, &px);
+        sgd[64..72].copy_from_slice(&(u64::MAX - 3).to_le_bytes());
+        sgd[72..80].copy_from_slice(&8u64.to_le_bytes());
+        let e = decode(&sgd).unwrap_err();
+        assert!(e.contains("supercompression global data"), "{e}");
         let short = file(37, 4, 4, 0, &px[..10]);
         assert!(decode(&short).unwrap_err().contains("needs 64"));
         // Every truncation of a valid file is an error, never a panic.
