@@ -52,6 +52,8 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod simd;
+#[cfg(test)]
+mod testing;
 #[cfg(feature = "tools")]
 pub mod tools;
 

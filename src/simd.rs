@@ -280,6 +280,13 @@ impl Neg for V3 {
     }
 }
 
+/// `f32::clamp(x, 0.0, 1.0)` per lane (signed zeros and NaN included).
+#[inline(always)]
+pub fn clamp01(x: Vec4) -> Vec4 {
+    let x = Vec4::select(x.cmplt(Vec4::ZERO), Vec4::ZERO, x);
+    Vec4::select(x.cmpgt(Vec4::ONE), Vec4::ONE, x)
+}
+
 /// `a x + b y + c z` lane by lane, in that order (barycentric weights
 /// (x, y, z) of a triangle's corners, as `Vec3 * f32` sums).
 #[inline(always)]
@@ -290,6 +297,15 @@ pub fn lerp3(a: V3, b: V3, c: V3, l: V3) -> V3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clamp01_is_f32_clamp() {
+        for x in [-1.0f32, -0.0, 0.0, 0.3, 1.0, 1.5, f32::INFINITY, f32::NAN] {
+            let got = clamp01(Vec4::splat(x)).x;
+            let want = x.clamp(0.0, 1.0);
+            assert!(got.to_bits() == want.to_bits(), "{x}: {got} {want}");
+        }
+    }
 
     #[test]
     fn ramps_round_as_one_conversion() {

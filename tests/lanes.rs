@@ -9,36 +9,16 @@
 
 mod common;
 
-use common::{scene_in, scratch, shared_assets};
-use softraster::render::{Frame, Renderer};
+use common::{same_frames, scene_in, scratch, shared_assets};
+use softraster::render::Renderer;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
 
 /// Frames `frames` of camera 0 with and without the lanes; panics at the
 /// first pixel that differs in any bit.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
-    let lanes = Renderer::new(scene);
     let single = Renderer::new(scene).with_lanes(false);
-    for &f in frames {
-        let (mut a, mut b) = (Frame::new(0, 0), Frame::new(0, 0));
-        lanes.render(scene, 0, f, &mut a);
-        single.render(scene, 0, f, &mut b);
-        assert_eq!(a.color.len(), b.color.len());
-        let mut covered = 0;
-        for (i, (x, y)) in a.color.iter().zip(&b.color).enumerate() {
-            let bits = |v: glam::Vec4| v.to_array().map(f32::to_bits);
-            assert!(
-                bits(*x) == bits(*y) && a.depth[i].to_bits() == b.depth[i].to_bits(),
-                "{what}, frame {f}, pixel {} {}: lanes {x} depth {} against {y} depth {}",
-                i as u32 % a.width,
-                i as u32 / a.width,
-                a.depth[i],
-                b.depth[i]
-            );
-            covered += a.depth[i].is_finite() as usize;
-        }
-        assert!(covered > 100, "{what}: only {covered} pixels covered");
-    }
+    same_frames(scene, &Renderer::new(scene), &single, frames, what);
 }
 
 fn with(scene: &Path, sets: &[&str]) -> Scene {
@@ -116,6 +96,13 @@ intensity = 8.0
 inner_angle = 15
 outer_angle = 30
 shadows = {shadows}
+range = 4.0
+[[light]]
+kind = "point"
+position = [-0.6, 0.2, 1.0]
+intensity = 1.5
+color = [0.4, 0.6, 1.0]
+range = 1.2
 [[camera]]
 eye = [0, 0, 3.9]
 target = [0, 0, 0]

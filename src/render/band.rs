@@ -30,6 +30,7 @@ use crate::scene::material::AlphaMode;
 use crate::scene::settings::ShadingMode;
 use crate::shade::ao::GPixel;
 use crate::shade::lanes::MAX_SIZES;
+use crate::shade::light::LightMask;
 use crate::shade::{SizedFootprint, Surface, TexCoords};
 
 impl<'a> FrameData<'a> {
@@ -186,7 +187,7 @@ impl<'a> FrameData<'a> {
             } else {
                 [Gradients::default(); 2]
             };
-            let s = self.surface(t, it, frag, (px, py), grads, [None; 2], 1.0);
+            let s = self.surface(t, it, frag, (px, py), grads, [None; 2], Reach::FULL);
             let (normal, albedo) = self.ctx.aov(&s);
             let d = self.draws[t.draw as usize];
             *a = AovPixel {
@@ -299,7 +300,9 @@ impl<'a> FrameData<'a> {
         px: (i32, i32),
         grads: [Gradients; 2],
     ) -> Option<(Vec3, Vec3, f32)> {
-        let surface = self.surface(t, it, frag, px, grads, [None; 2], 1.0);
+        // Blended fragments may lie in front of the tile's visible depths:
+        // every light.
+        let surface = self.surface(t, it, frag, px, grads, [None; 2], Reach::FULL);
         let (add, through, a) = self.ctx.layer(&surface);
         (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
@@ -323,6 +326,12 @@ impl<'a> FrameData<'a> {
         let mut cache = InterpolatorCache::default();
         // One background color for the band (none of the per-pixel kinds).
         let flat_bg = (self.env_bg.is_none() && self.ground.is_none()).then_some(self.bg);
+        // The lights that may reach each tile of the band.
+        let tiles = self
+            .culling
+            .as_ref()
+            .map(|c| c.tiles(self.ctx.lights, vis, self.tris));
+        let lights_at = |x: usize| tiles.as_ref().map_or(LightMask::ALL, |t| t.at(x));
         // Over a flat background: the empty pixels first, in one pass, and
         // quads without a triangle skipped below.
         let filled = flat_bg.is_some();
@@ -388,7 +397,7 @@ impl<'a> FrameData<'a> {
                             let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
                             let it = cache.get(id, t);
                             let ao = ao.map_or([1.0; 4], |a| quad.map(|i| a[i]));
-                            let shaded = self.shade_quad(t, it, lm, q0, ao);
+                            let shaded = self.shade_quad(t, it, lm, q0, ao, lights_at(qx));
                             for (k, &i) in quad.iter().enumerate() {
                                 (color[i], depth[i]) =
                                     resolve(&[Part::Queued(0, n as f32)], &shaded[k..k + 1], inv_n);
@@ -438,7 +447,10 @@ impl<'a> FrameData<'a> {
                     let mut at = FragmentAt {
                         px: (px, py),
                         q0,
-                        ao: occlusion,
+                        reach: Reach {
+                            ao: occlusion,
+                            lights: lights_at(x),
+                        },
                         lanes: lanes.is_some(),
                         cache: &mut cache,
                         quad: &mut quad,
@@ -560,13 +572,14 @@ impl<'a> FrameData<'a> {
                     lambda: frag.lambda,
                     w: frag.w,
                     footprints,
-                    ao: at.ao,
+                    ao: at.reach.ao,
+                    lights: at.reach.lights,
                 },
             );
         }
         let q = &quad[k];
         let (grads, fps) = (q.grads, q.footprints);
-        let (c, d, fps) = self.shade_with(t, it, frag, (px, py), grads, fps, at.ao);
+        let (c, d, fps) = self.shade_with(t, it, frag, (px, py), grads, fps, at.reach);
         quad[k].footprints = fps;
         // A NaN from degenerate input must not poison the frame: such a
         // fragment is black.
@@ -670,9 +683,9 @@ impl<'a> FrameData<'a> {
         (px, py): (i32, i32),
         grads: [Gradients; 2],
         footprints: [Option<SizedFootprint>; 2],
-        ao: f32,
+        reach: Reach,
     ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
-        let surface = self.surface(t, it, frag, (px, py), grads, footprints, ao);
+        let surface = self.surface(t, it, frag, (px, py), grads, footprints, reach);
         (
             self.ctx.shade(&surface),
             surface.view_depth,
@@ -690,7 +703,7 @@ impl<'a> FrameData<'a> {
         (px, py): (i32, i32),
         grads: [Gradients; 2],
         footprints: [Option<SizedFootprint>; 2],
-        ao: f32,
+        reach: Reach,
     ) -> Surface<'_> {
         let ctx = &self.ctx;
         let mode = ctx.mode;
@@ -745,7 +758,8 @@ impl<'a> FrameData<'a> {
             vertex_light,
             edge_distance,
             geo_normal,
-            ao,
+            ao: reach.ao,
+            lights: reach.lights,
         }
     }
 
@@ -821,13 +835,29 @@ struct QuadEntry {
     lane_footprints: Option<[Footprint; MAX_SIZES]>,
 }
 
+/// What reaches a fragment besides its triangle: its ambient occlusion
+/// (1: none) and the lights that may reach its tile.
+#[derive(Debug, Clone, Copy)]
+struct Reach {
+    ao: f32,
+    lights: LightMask,
+}
+
+impl Reach {
+    /// No occlusion, every light.
+    const FULL: Reach = Reach {
+        ao: 1.0,
+        lights: LightMask::ALL,
+    };
+}
+
 /// Where `FrameData::fragment` shades: the pixel's position and its
-/// quad's top-left pixel, its AO, whether lane materials go to the lanes,
-/// and the band's state.
+/// quad's top-left pixel, its AO and lights, whether lane materials go to
+/// the lanes, and the band's state.
 struct FragmentAt<'c> {
     px: (i32, i32),
     q0: (i32, i32),
-    ao: f32,
+    reach: Reach,
     lanes: bool,
     cache: &'c mut InterpolatorCache,
     quad: &'c mut smallvec::SmallVec<[QuadEntry; 4]>,

@@ -9,6 +9,7 @@ use glam::{Vec3, Vec4};
 
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
+use super::light_tiles::Culling;
 use super::rays::CameraRays;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
@@ -47,12 +48,25 @@ pub(super) struct FrameData<'a> {
     /// Per draw: its material prepared for shading four fragments at a
     /// time, or None (the one-fragment path).
     pub lanes: Vec<Option<LaneMaterial<'a>>>,
+    /// Per-tile light culling, where some light can be culled.
+    pub culling: Option<Culling>,
+}
+
+/// Which of the equivalent shading paths a frame takes (both default on;
+/// off only to compare).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Paths {
+    /// Shade the materials that allow it four fragments at a time.
+    pub lanes: bool,
+    /// Skip per tile the lights that cannot reach it.
+    pub light_culling: bool,
 }
 
 impl<'a> FrameData<'a> {
     /// `grads`: the texture filter reads derivatives (trilinear,
-    /// anisotropic). `lanes`: shade the materials that allow it four
-    /// fragments at a time (`shade::lanes`; the same pixels).
+    /// anisotropic). `paths`: shade the materials that allow it four
+    /// fragments at a time (`shade::lanes`), skip lights per tile
+    /// (`light_tiles`); the same pixels either way.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         fs: &'a FrameSetup<'a>,
@@ -62,7 +76,7 @@ impl<'a> FrameData<'a> {
         pattern: &'static [(i8, i8)],
         grads: bool,
         tracer: Option<&'a Tracer<'a>>,
-        lanes: bool,
+        paths: Paths,
     ) -> FrameData<'a> {
         let s = &fs.scene.settings;
         let alpha = geo
@@ -82,9 +96,23 @@ impl<'a> FrameData<'a> {
                 let uvs = !model.mesh.uvs.is_empty();
                 let tangents = !verts[d.model].tangent.is_empty();
                 let m = &model.materials[d.material];
-                lanes.then(|| ctx.lane_material(m, uvs, tangents)).flatten()
+                paths
+                    .lanes
+                    .then(|| ctx.lane_material(m, uvs, tangents))
+                    .flatten()
             })
             .collect();
+        let culling = paths
+            .light_culling
+            .then(|| {
+                Culling::new(
+                    ctx.lights,
+                    fs.clip_from_world,
+                    geo.grid.width,
+                    geo.grid.height,
+                )
+            })
+            .flatten();
         FrameData {
             fs,
             verts,
@@ -99,6 +127,7 @@ impl<'a> FrameData<'a> {
             grads,
             geo_normal,
             lanes,
+            culling,
             ctx,
         }
     }

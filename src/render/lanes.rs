@@ -17,6 +17,7 @@ use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
 use crate::shade::lanes::LaneMaterial;
 use crate::shade::lanes::{Lanes, MAX_SIZES};
+use crate::shade::light::LightMask;
 use crate::simd::{V3, lanes4, lerp3};
 
 /// A fragment waiting for its lane.
@@ -36,6 +37,8 @@ pub(super) struct Pending {
     /// Filter footprints per texture size (`LaneMaterial::footprints`).
     pub footprints: [Footprint; MAX_SIZES],
     pub ao: f32,
+    /// The lights that may reach its tile.
+    pub lights: LightMask,
 }
 
 /// A band's lane fragments waiting for their group of four: per draw, up
@@ -63,6 +66,7 @@ impl Pending {
         w: 0.0,
         footprints: [Footprint::Lod(0.0); MAX_SIZES],
         ao: 1.0,
+        lights: LightMask::NONE,
     };
 }
 
@@ -204,6 +208,7 @@ impl<'a> FrameData<'a> {
         w: Vec4,
         ao: Vec4,
         footprints: [[Footprint; 4]; MAX_SIZES],
+        lights: LightMask,
     ) -> (Lanes, Vec4) {
         let d = self.draws[draw];
         let mesh = &self.fs.scene.models[d.model].mesh;
@@ -297,6 +302,7 @@ impl<'a> FrameData<'a> {
             geo_normal,
             ao,
             footprints,
+            lights,
         };
         (lanes, depth)
     }
@@ -314,6 +320,7 @@ impl<'a> FrameData<'a> {
         lm: &LaneMaterial<'a>,
         q0: (i32, i32),
         ao: [f32; 4],
+        lights: LightMask,
     ) -> [(Vec3, f32); 4] {
         let draw = t.draw as usize;
         let (x, y) = q0;
@@ -352,6 +359,7 @@ impl<'a> FrameData<'a> {
             lanes4(f[0].w, f[1].w, f[2].w, f[3].w),
             lanes4(ao[0], ao[1], ao[2], ao[3]),
             footprints,
+            lights,
         );
         let c = self.ctx.shade_lanes(lm, &lanes);
         let out = |k: usize| {
@@ -396,6 +404,7 @@ impl<'a> FrameData<'a> {
             lanes4(f(0).w, f(1).w, f(2).w, f(3).w),
             lanes4(f(0).ao, f(1).ao, f(2).ao, f(3).ao),
             footprints,
+            frags.iter().fold(LightMask::NONE, |m, f| m.union(f.lights)),
         );
         (lanes, depth.to_array())
     }

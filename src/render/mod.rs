@@ -30,6 +30,7 @@ mod frame;
 mod geometry;
 mod ground;
 mod lanes;
+mod light_tiles;
 mod lines;
 pub mod memory;
 mod rays;
@@ -94,6 +95,9 @@ pub struct Renderer {
     /// Shade the materials that allow it four fragments at a time
     /// (`shade::lanes`); off only to compare the two paths.
     lanes: bool,
+    /// Skip, per tile, the lights that cannot reach it (`light_tiles`);
+    /// off only to compare.
+    light_culling: bool,
 }
 
 impl Renderer {
@@ -127,6 +131,7 @@ impl Renderer {
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
             lanes: true,
+            light_culling: true,
         }
     }
 
@@ -135,6 +140,14 @@ impl Renderer {
     /// byte for byte); the switch is for those tests and for measuring.
     pub fn with_lanes(mut self, on: bool) -> Renderer {
         self.lanes = on;
+        self
+    }
+
+    /// With `on = false`, every fragment is shaded with every light, not
+    /// only those that can reach its tile. The frames are the same either
+    /// way (tests compare them bit for bit).
+    pub fn with_light_culling(mut self, on: bool) -> Renderer {
+        self.light_culling = on;
         self
     }
 
@@ -151,6 +164,7 @@ impl Renderer {
         if !self.serves(scene) {
             return Renderer::new(scene)
                 .with_lanes(self.lanes)
+                .with_light_culling(self.light_culling)
                 .render(scene, camera, frame, out);
         }
         let fs = FrameSetup::new(scene, camera, frame);
@@ -350,7 +364,10 @@ impl Renderer {
             pattern,
             filtered,
             tracer.as_ref(),
-            self.lanes,
+            fragment::Paths {
+                lanes: self.lanes,
+                light_culling: self.light_culling,
+            },
         );
         self.bands(&data, &geo, tracer.as_ref(), out);
         if !s.shading.is_data_view() {

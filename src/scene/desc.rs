@@ -386,6 +386,9 @@ pub struct LightDesc {
     pub shadows: Option<S<bool>>,
     pub inner_angle: Option<S<f32>>,
     pub outer_angle: Option<S<f32>>,
+    /// Point and spot: the distance where the light ends (the
+    /// KHR_lights_punctual window); none: unlimited.
+    pub range: Option<S<f32>>,
 }
 
 /// The file's spelling of [`super::camera::Projection`].
@@ -867,6 +870,21 @@ fn validate_light(c: &Ctx, l: &LightDesc) -> Result<(), Error> {
     }
     c.float_range(&l.inner_angle, "light.inner_angle", 0.0, 90.0)?;
     c.float_range(&l.outer_angle, "light.outer_angle", 0.0, 90.0)?;
+    if let Some(r) = &l.range {
+        let x = *r.get_ref();
+        if l.kind.as_ref().map(|k| *k.get_ref()) == Some(LightKind::Directional) {
+            return Err(c.err(
+                r.span(),
+                "light.range applies to point and spot lights, not directional ones",
+            ));
+        }
+        if !(x.is_finite() && x > 0.0 && x <= 1e30) {
+            return Err(c.err(
+                r.span(),
+                format!("light.range = {x}: expected a distance above 0 (up to 1e30)"),
+            ));
+        }
+    }
     let inner = l.inner_angle.as_ref().map(|v| *v.get_ref()).unwrap_or(20.0);
     let outer = l.outer_angle.as_ref().map(|v| *v.get_ref()).unwrap_or(30.0);
     if inner > outer {
@@ -1192,5 +1210,26 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("inner_angle"), "{e}");
+    }
+
+    #[test]
+    fn a_light_range_is_a_positive_distance_of_a_point_or_spot() {
+        let light =
+            |body: &str| parse(&format!("[[model]]\npath = \"a.obj\"\n[[light]]\n{body}\n"));
+        let d = light("kind = \"spot\"\nrange = 2.5").unwrap();
+        let r = d.lights[0].get_ref().range.as_ref().map(|r| *r.get_ref());
+        assert_eq!(r, Some(2.5));
+        assert!(light("range = 3").is_ok(), "a point light by default");
+        for (body, says) in [
+            ("range = 0", "light.range = 0"),
+            ("range = -1", "light.range = -1"),
+            ("range = inf", "light.range = inf"),
+            ("kind = \"directional\"\nrange = 2", "not directional"),
+        ] {
+            let e = light(body).unwrap_err().to_string();
+            // The file, and the line of `range`.
+            let line = format!("t.toml:{}:", 3 + body.lines().count());
+            assert!(e.contains(says) && e.starts_with(&line), "{body}: {e}");
+        }
     }
 }

@@ -7,8 +7,7 @@
 
 use glam::Vec3;
 
-use super::light::for_each_lit;
-use crate::scene::Light;
+use super::light::{LightSet, for_each_lit};
 #[cfg(test)]
 use crate::shade::light::unshadowed;
 
@@ -33,7 +32,7 @@ pub fn light_sums(
     v: Vec3,
     ns: f32,
     specular: bool,
-    lights: &[Light],
+    lights: LightSet,
     shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> (Vec3, Vec3) {
     let mut diffuse = Vec3::ZERO;
@@ -59,7 +58,7 @@ pub fn radiance(
     v: Vec3,
     s: &SurfaceColor,
     ambient: Vec3,
-    lights: &[Light],
+    lights: LightSet,
     shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> Vec3 {
     if s.illum == 0 {
@@ -86,7 +85,7 @@ pub fn combine(s: &SurfaceColor, ambient: Vec3, diffuse: Vec3, spec: Vec3) -> Ve
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::light::LightKind;
+    use crate::scene::light::{Light, LightKind};
 
     fn surface(illum: u8) -> SurfaceColor {
         SurfaceColor {
@@ -113,19 +112,51 @@ mod tests {
         let (p, n, v) = (Vec3::ZERO, Vec3::Y, Vec3::Y);
         let amb = Vec3::splat(0.1);
         // E = 4/4 = 1, n.l = 1, n.h = 1
-        let l2 = radiance(p, n, v, &surface(2), amb, &lights, &unshadowed);
+        let l2 = radiance(
+            p,
+            n,
+            v,
+            &surface(2),
+            amb,
+            LightSet::all(&lights),
+            &unshadowed,
+        );
         assert!(
             (l2 - Vec3::new(0.1 + 0.1 + 0.5 + 0.25, 0.1 + 0.5 + 0.25, 0.1 + 0.5 + 0.25)).length()
                 < 1e-6
         );
-        let l1 = radiance(p, n, v, &surface(1), amb, &lights, &unshadowed);
+        let l1 = radiance(
+            p,
+            n,
+            v,
+            &surface(1),
+            amb,
+            LightSet::all(&lights),
+            &unshadowed,
+        );
         assert!((l1 - Vec3::new(0.7, 0.6, 0.6)).length() < 1e-6);
         assert_eq!(
-            radiance(p, n, v, &surface(0), amb, &lights, &unshadowed),
+            radiance(
+                p,
+                n,
+                v,
+                &surface(0),
+                amb,
+                LightSet::all(&lights),
+                &unshadowed
+            ),
             Vec3::splat(0.5)
         );
         // A light below the surface adds nothing.
-        let below = radiance(p, -n, v, &surface(2), amb, &lights, &unshadowed);
+        let below = radiance(
+            p,
+            -n,
+            v,
+            &surface(2),
+            amb,
+            LightSet::all(&lights),
+            &unshadowed,
+        );
         assert!((below - Vec3::new(0.2, 0.1, 0.1)).length() < 1e-6);
     }
 }

@@ -77,7 +77,7 @@ impl<'a> ShadeContext<'a> {
         // `blinn_phong::light_sums`.
         let mut diffuse = V3::ZERO;
         let mut spec = V3::ZERO;
-        for (i, light) in self.lights.iter().enumerate() {
+        f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, e, lit, .. } = self.lit_lanes(i, light, f, n);
             diffuse = diffuse + V3::select(lit, e, V3::ZERO);
             if specular {
@@ -95,7 +95,7 @@ impl<'a> ShadeContext<'a> {
                     spec = spec + V3::select(shine, e.scale(pw), V3::ZERO);
                 }
             }
-        }
+        });
         // `blinn_phong::combine`.
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let spec_term = if specular { ks * spec } else { V3::ZERO };

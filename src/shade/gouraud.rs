@@ -37,7 +37,15 @@ pub fn vertex_light(
             let (p, nn) = (world[i], normal[i]);
             let v = ctx.view_vector(p);
             let shadow = |k: usize, l: Vec3| ctx.shadows.visibility(k, p, nn, l);
-            blinn_phong::light_sums(p, nn, v, ns[i], spec[i], ctx.lights, &shadow)
+            blinn_phong::light_sums(
+                p,
+                nn,
+                v,
+                ns[i],
+                spec[i],
+                super::light::LightSet::all(ctx.lights),
+                &shadow,
+            )
         })
         .collect()
 }

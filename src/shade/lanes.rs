@@ -25,7 +25,7 @@ use glam::{Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::ShadeContext;
-use super::light::incidence;
+use super::light::{LightMask, LightSet};
 use crate::assets::texture::{
     Chain, Filtering, Footprint, Gradients, Taps4, Texture, TextureFilter as Filter, TextureRef,
     Wrap,
@@ -34,7 +34,7 @@ use crate::scene::Material;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
-use crate::simd::V3;
+use crate::simd::{V3, clamp01};
 
 /// At most this many distinct texture sizes (and mip chains) among a lane
 /// material's maps: each fragment carries one filter footprint per size,
@@ -106,6 +106,20 @@ pub struct Lanes {
     pub ao: Vec4,
     /// Per texture size of the material (`LaneMaterial::footprints`).
     pub footprints: [[Footprint; 4]; MAX_SIZES],
+    /// The lights that may reach some lane (the union of the lanes'
+    /// tiles'); the others give every lane nothing.
+    pub lights: LightMask,
+}
+
+impl Lanes {
+    /// The frame's `lights` that may reach the lanes.
+    #[inline(always)]
+    pub fn light_set<'l>(&self, lights: &'l [Light]) -> LightSet<'l> {
+        LightSet {
+            lights,
+            mask: self.lights,
+        }
+    }
 }
 
 impl LaneMaterial<'_> {
@@ -325,46 +339,58 @@ pub(super) struct Lit {
 /// n.l) and the lanes it reaches.
 #[inline(always)]
 fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
-    match light.kind {
+    let position = match light.kind {
         LightKind::Directional {
             direction,
             irradiance,
-        } => (
-            V3::splat(-direction),
-            V3::splat(light.color * irradiance),
-            Vec4::ONE.cmpgt(Vec4::ZERO),
-        ),
-        LightKind::Point {
-            position,
+        } => {
+            return (
+                V3::splat(-direction),
+                V3::splat(light.color * irradiance),
+                Vec4::ONE.cmpgt(Vec4::ZERO),
+            );
+        }
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+    };
+    // `towards`: only r2 <= 0 misses.
+    let d = V3::splat(position) - p;
+    let r2 = d.dot(d);
+    let l = d / r2.sqrt();
+    let mut reaches = !r2.cmple(Vec4::ZERO);
+    // `window`: 1 without a range.
+    let w = match light.range {
+        Some(range) if range > 0.0 => {
+            let q = r2 / Vec4::splat(range * range);
+            let w = clamp01(Vec4::ONE - q * q);
+            reaches &= !w.cmple(Vec4::ZERO);
+            w * w
+        }
+        _ => Vec4::ONE,
+    };
+    let k = match light.kind {
+        LightKind::Spot {
+            direction,
             intensity,
-        } if light.range.is_none() => {
-            let d = V3::splat(position) - p;
-            let r2 = d.dot(d);
-            let k = Vec4::splat(intensity * 1.0) / r2;
-            (
-                d / r2.sqrt(),
-                V3::splat(light.color).scale(k),
-                // As `towards`: only r2 <= 0 misses.
-                !r2.cmple(Vec4::ZERO),
-            )
+            cos_inner,
+            cos_outer,
+            ..
+        } => {
+            // `spot_falloff` of -l.direction.
+            let cos_a = -l.dot(V3::splat(direction));
+            let span = cos_inner - cos_outer;
+            let f = if span <= 1e-7 {
+                Vec4::select(cos_a.cmpge(Vec4::splat(cos_outer)), Vec4::ONE, Vec4::ZERO)
+            } else {
+                let t = clamp01((cos_a - Vec4::splat(cos_outer)) / Vec4::splat(span));
+                t * t
+            };
+            reaches &= !f.cmple(Vec4::ZERO);
+            Vec4::splat(intensity) * f * w / r2
         }
-        _ => {
-            // Spot cones and range windows: lane by lane.
-            let mut l = [Vec3::ZERO; 4];
-            let mut e = [Vec3::ZERO; 4];
-            let mut ok = [0.0f32; 4];
-            for k in 0..4 {
-                if let Some(inc) = incidence(light, p.lane(k)) {
-                    (l[k], e[k], ok[k]) = (inc.l, inc.e, 1.0);
-                }
-            }
-            (
-                V3::from_lanes(l),
-                V3::from_lanes(e),
-                Vec4::from(ok).cmpgt(Vec4::ZERO),
-            )
-        }
-    }
+        LightKind::Point { intensity, .. } => Vec4::splat(intensity) * w / r2,
+        LightKind::Directional { .. } => Vec4::ZERO,
+    };
+    (l, V3::splat(light.color).scale(k), reaches)
 }
 
 /// The texture lookups of one lane call: where each footprint slot's

@@ -26,6 +26,7 @@ use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
 use blinn_phong::SurfaceColor;
+use light::{LightMask, LightSet};
 use pbr::PbrColor;
 
 /// Everything about the frame that shading needs, fixed for the frame.
@@ -139,6 +140,9 @@ pub struct Surface<'a> {
     /// Ambient occlusion at the point (1: unoccluded), multiplying the
     /// ambient term.
     pub ao: f32,
+    /// The lights that may reach the point (its tile's, `LightMask::ALL`
+    /// without culling); the others give it nothing.
+    pub lights: LightMask,
 }
 
 impl ShadeContext<'_> {
@@ -198,16 +202,30 @@ impl ShadeContext<'_> {
                 let n = self.mapped_normal(s);
                 let ambient = self.ambient * s.ao;
                 let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
-                blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
-                    + env
+                blinn_phong::radiance(
+                    s.position,
+                    n,
+                    v,
+                    &c,
+                    ambient,
+                    self.light_set(s),
+                    &self.shadow(s),
+                ) + env
             }
             ShadingMode::Flat => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
                 let (n, ambient) = (s.normal, self.ambient * s.ao);
                 let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
-                blinn_phong::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s))
-                    + env
+                blinn_phong::radiance(
+                    s.position,
+                    n,
+                    v,
+                    &c,
+                    ambient,
+                    self.light_set(s),
+                    &self.shadow(s),
+                ) + env
             }
         }
     }
@@ -241,7 +259,15 @@ impl ShadeContext<'_> {
         let v = self.view_vector(s.position);
         let n = self.mapped_normal(s);
         let ambient = self.ambient * s.ao;
-        let direct = pbr::radiance(s.position, n, v, &c, ambient, self.lights, &self.shadow(s));
+        let direct = pbr::radiance(
+            s.position,
+            n,
+            v,
+            &c,
+            ambient,
+            self.light_set(s),
+            &self.shadow(s),
+        );
         if let Some((e, tracer, samples)) = self.env_sampled {
             let lobes = env_sampled::Lobes::Pbr(&c);
             let l =
@@ -287,6 +313,15 @@ impl ShadeContext<'_> {
         }
         let r = env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, roughness);
         diffuse + c.ks * env.prefiltered_phong(r, roughness)
+    }
+
+    /// The lights that may reach the surface point.
+    #[inline(always)]
+    fn light_set(&self, s: &Surface) -> LightSet<'_> {
+        LightSet {
+            lights: self.lights,
+            mask: s.lights,
+        }
     }
 
     /// Light `i`'s shadow at the surface point, towards unit `l`.

@@ -45,9 +45,8 @@ use glam::Vec3;
 
 use super::env::EnvLight;
 pub use super::iridescence::Iridescence;
-use super::light::for_each_lit;
+use super::light::{LightSet, for_each_lit};
 pub use super::sheen::Sheen;
-use crate::scene::Light;
 
 /// A material evaluated at one point (factors times texture lookups).
 #[derive(Debug, Clone, Copy)]
@@ -327,7 +326,7 @@ pub fn radiance(
     v: Vec3,
     c: &PbrColor,
     ambient: Vec3,
-    lights: &[Light],
+    lights: LightSet,
     shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> Vec3 {
     if c.coat.is_some() || c.sheen.is_some() {
@@ -356,7 +355,7 @@ fn layered_radiance(
     v: Vec3,
     c: &PbrColor,
     ambient: Vec3,
-    lights: &[Light],
+    lights: LightSet,
     shadow: &impl Fn(usize, Vec3) -> f32,
 ) -> Vec3 {
     let mut direct = Vec3::ZERO;
@@ -507,7 +506,7 @@ mod tests {
             Vec3::Z,
             &c,
             Vec3::splat(0.5),
-            &[],
+            LightSet::all(&[]),
             &unshadowed,
         );
         assert!((l - Vec3::splat(0.5)).abs().max_element() < 1e-5, "{l}");
@@ -522,7 +521,7 @@ mod tests {
             Vec3::Z,
             &occluded,
             Vec3::splat(0.5),
-            &[],
+            LightSet::all(&[]),
             &unshadowed,
         );
         assert!((l - Vec3::splat(0.25)).abs().max_element() < 1e-5, "{l}");

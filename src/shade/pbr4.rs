@@ -19,7 +19,7 @@ use super::env::{EnvLight, dominant_direction4};
 use super::lanes::{Kind, Lanes, Lit, Lookups, Map, MapSet, PbrMaps};
 use super::pbr::{MIN_ALPHA, specular_occlusion};
 use crate::scene::Material;
-use crate::simd::V3;
+use crate::simd::{V3, clamp01};
 
 impl<'a> Kind<'a> {
     /// A metallic-roughness material's maps, or None where the lanes do
@@ -64,13 +64,6 @@ impl<'a> Kind<'a> {
 /// roughness and metallic texture, referred to twice).
 fn same_lookup(a: &Map, b: &Map) -> bool {
     std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
-}
-
-/// `f32::clamp(x, 0.0, 1.0)` per lane (signed zeros and NaN included).
-#[inline(always)]
-fn clamp01(x: Vec4) -> Vec4 {
-    let x = Vec4::select(x.cmplt(Vec4::ZERO), Vec4::ZERO, x);
-    Vec4::select(x.cmpgt(Vec4::ONE), Vec4::ONE, x)
 }
 
 /// `x.powi(5)` per lane: x (x^2 x^2), the products LLVM makes of it.
@@ -159,13 +152,13 @@ impl<'a> ShadeContext<'a> {
         };
         // `pbr::radiance`.
         let mut out = emissive;
-        for (i, light) in self.lights.iter().enumerate() {
+        f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
                 let added = out + e * brdf4(n, v, l, ndl, &c);
                 out = V3::select(lit, added, out);
             }
-        }
+        });
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let some_ambient = !(ambient.x.cmpeq(Vec4::ZERO)
             & ambient.y.cmpeq(Vec4::ZERO)
@@ -273,16 +266,7 @@ fn environment4(env: &EnvLight, n: V3, v: V3, c: &Color4, ao: Vec4) -> V3 {
 mod tests {
     use super::*;
     use crate::shade::pbr::{self, PbrColor};
-
-    fn xorshift(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        }
-    }
+    use crate::testing::xorshift;
 
     #[test]
     fn pow5_is_powi_bit_for_bit() {
@@ -292,15 +276,6 @@ mod tests {
         for x in xs {
             let got = pow5(Vec4::splat(x)).x;
             assert_eq!(got.to_bits(), x.powi(5).to_bits(), "{x}");
-        }
-    }
-
-    #[test]
-    fn clamp01_is_f32_clamp() {
-        for x in [-1.0f32, -0.0, 0.0, 0.3, 1.0, 1.5, f32::INFINITY, f32::NAN] {
-            let got = clamp01(Vec4::splat(x)).x;
-            let want = x.clamp(0.0, 1.0);
-            assert!(got.to_bits() == want.to_bits(), "{x}: {got} {want}");
         }
     }
 

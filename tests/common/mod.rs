@@ -248,3 +248,30 @@ pub fn cube() -> Prim {
         ..Default::default()
     }
 }
+
+/// Frames `frames` of camera 0 of `scene` from two renderers that take
+/// equivalent paths (`a` and `b`); panics at the first pixel whose colour
+/// or depth differs in any bit, and where fewer than 100 pixels are
+/// covered (a comparison of empty frames would prove nothing).
+pub fn same_frames(scene: &Scene, a: &Renderer, b: &Renderer, frames: &[u32], what: &str) {
+    for &f in frames {
+        let (mut x, mut y) = (Frame::new(0, 0), Frame::new(0, 0));
+        a.render(scene, 0, f, &mut x);
+        b.render(scene, 0, f, &mut y);
+        assert_eq!(x.color.len(), y.color.len());
+        let mut covered = 0;
+        for (i, (p, q)) in x.color.iter().zip(&y.color).enumerate() {
+            let bits = |v: glam::Vec4| v.to_array().map(f32::to_bits);
+            assert!(
+                bits(*p) == bits(*q) && x.depth[i].to_bits() == y.depth[i].to_bits(),
+                "{what}, frame {f}, pixel {} {}: {p} depth {} against {q} depth {}",
+                i as u32 % x.width,
+                i as u32 / x.width,
+                x.depth[i],
+                y.depth[i]
+            );
+            covered += x.depth[i].is_finite() as usize;
+        }
+        assert!(covered > 100, "{what}: only {covered} pixels covered");
+    }
+}

@@ -11,7 +11,7 @@ use crate::scene::light::{Light, LightKind};
 
 /// Defaults: a point light at the origin of intensity 10, white; a
 /// directional light of irradiance 1 travelling down -Y; spot cones of 20
-/// and 30 degrees; no shadows.
+/// and 30 degrees; no shadows; no range.
 pub(super) fn from_desc(l: &desc::LightDesc) -> Light {
     let color = Vec3::from(get(&l.color, [1.0; 3]));
     let position = Vec3::from(get(&l.position, [0.0; 3]));
@@ -38,7 +38,7 @@ pub(super) fn from_desc(l: &desc::LightDesc) -> Light {
         kind,
         color,
         shadows: get(&l.shadows, false),
-        range: None,
+        range: l.range.as_ref().map(|r| *r.get_ref()),
     }
 }
 

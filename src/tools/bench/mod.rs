@@ -34,6 +34,9 @@ pub struct BenchArgs {
     /// harness's nefertiti); diablo3-sun and diablo3-studio (the matched
     /// model under its directional light alone, or under the built-in
     /// studio environment alone: the cost of environment lighting);
+    /// diablo3-lights (the matched model on a floor under 24 point lights
+    /// with a range and 4 spots: what per-tile light culling saves, with
+    /// --no-light-culling for the other side);
     /// tris-5k, tris-20k, tris-80k, tris-320k,
     /// tris-1m (diablo3-matched subdivided 0 to 4 times: same pixels, more
     /// triangles); filters, shadows, ao, edges (time and error
@@ -67,6 +70,10 @@ pub struct BenchArgs {
     /// runs (as `render --cache`); without it every load is cold.
     #[arg(long, value_name = "DIR")]
     pub cache: Option<PathBuf>,
+    /// Shade every fragment with every light (per-tile light culling off;
+    /// the frames are the same): to measure what the culling saves.
+    #[arg(long)]
+    pub no_light_culling: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -155,6 +162,7 @@ fn scene_text(
         | "nefertiti-matched"
         | "diablo3-sun"
         | "diablo3-studio"
+        | "diablo3-lights"
         | "tris-5k"
         | "tris-20k"
         | "tris-80k"
@@ -162,7 +170,7 @@ fn scene_text(
         | "tris-1m" => matched_scene(case, assets, &d3, &common, &p)?,
         other => {
             return Err(Error::Argument(format!(
-                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, diablo3-sun, diablo3-studio, tris-5k .. tris-1m, filters, shadows, ao, edges or all"
+                "bench --case {other}: expected diablo3, nefertiti, flighthelmet, diablo3-4k, diablo3-4k-aniso, diablo3-matched, diablo3-matched-shadow, diablo3-4k-matched, nefertiti-matched, diablo3-sun, diablo3-studio, diablo3-lights, tris-5k .. tris-1m, filters, shadows, ao, edges or all"
             )));
         }
     })
@@ -214,6 +222,8 @@ fn matched_scene(
     }
     if case.ends_with("-shadow") {
         render.push_str("\nshadows = \"pcf\"\nshadow_map_size = 2048");
+    }
+    if case.ends_with("-shadow") || case == "diablo3-lights" {
         let (lo, hi) = obj_bounds(Path::new(&p(obj.clone())?))?;
         let path = floor_disc(lo, hi)?;
         // The harness's floor: sRGB 200 grey, ks 0.1, Ns 16.
@@ -260,9 +270,65 @@ fn case_lights(case: &str, scene: &Scene) -> Vec<Light> {
     match case {
         "diablo3-sun" => lights.truncate(1),
         "diablo3-studio" => lights.clear(),
+        "diablo3-lights" => {
+            lights.truncate(1);
+            lights.extend(local_lights(scene));
+        }
         _ => {}
     }
     lights
+}
+
+/// `diablo3-lights`: 24 coloured point lights with a range of a third of
+/// the model's radius, in three rings of eight around it (feet, waist,
+/// head), and four spots of 12 degrees from above on its quarters.
+fn local_lights(scene: &Scene) -> Vec<Light> {
+    let (center, r) = subject_bounds(scene);
+    let mut out = Vec::new();
+    for ring in 0..3 {
+        let y = center.y + r * (ring as f32 - 1.0) * 0.55;
+        for k in 0..8 {
+            let a = (k as f32 + 0.5 * ring as f32) * std::f32::consts::TAU / 8.0;
+            let position = Vec3::new(
+                center.x + 0.45 * r * a.cos(),
+                y,
+                center.z + 0.45 * r * a.sin(),
+            );
+            let hue = (k * 3 + ring) as f32 / 24.0 * std::f32::consts::TAU;
+            let color = Vec3::new(
+                0.6 + 0.4 * hue.cos(),
+                0.6 + 0.4 * (hue + 2.1).cos(),
+                0.6 + 0.4 * (hue + 4.2).cos(),
+            );
+            out.push(Light {
+                kind: LightKind::Point {
+                    position,
+                    intensity: 0.08 * r * r,
+                },
+                color,
+                shadows: false,
+                range: Some(r / 3.0),
+            });
+        }
+    }
+    for k in 0..4 {
+        let a = (k as f32 + 0.5) * std::f32::consts::TAU / 4.0;
+        let target = center + Vec3::new(0.3 * r * a.cos(), 0.0, 0.3 * r * a.sin());
+        let position = center + Vec3::new(0.0, 2.0 * r, 0.0);
+        out.push(Light {
+            kind: LightKind::Spot {
+                position,
+                direction: (target - position).normalize(),
+                intensity: 0.6 * r * r,
+                cos_inner: 8f32.to_radians().cos(),
+                cos_outer: 12f32.to_radians().cos(),
+            },
+            color: Vec3::new(1.0, 0.97, 0.9),
+            shadows: false,
+            range: None,
+        });
+    }
+    out
 }
 
 fn anchor_lights(scene: &Scene, shadows: bool) -> Vec<Light> {
@@ -305,7 +371,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     )?;
     // Mip chains are built when a frame first minifies a texture; the
     // benchmark builds them up front and counts them as loading.
-    let renderer = Renderer::new(&scene);
+    let renderer = Renderer::new(&scene).with_light_culling(!args.no_light_culling);
     let t_mips = Instant::now();
     if matches!(
         scene.settings.texture_filter,
@@ -385,7 +451,23 @@ fn lights_toml(lights: &[Light]) -> String {
                 "kind = \"point\"\nposition = {}\nintensity = {intensity}\n",
                 v(position)
             )),
-            _ => continue,
+            LightKind::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => s.push_str(&format!(
+                "kind = \"spot\"\nposition = {}\ndirection = {}\nintensity = {intensity}\n\
+                 inner_angle = {}\nouter_angle = {}\n",
+                v(position),
+                v(direction),
+                cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
+                cos_outer.clamp(-1.0, 1.0).acos().to_degrees()
+            )),
+        }
+        if let Some(r) = l.range {
+            s.push_str(&format!("range = {r}\n"));
         }
         s.push_str(&format!("color = {}\n", v(l.color)));
         if l.shadows {
