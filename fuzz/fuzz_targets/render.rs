@@ -1,5 +1,6 @@
 //! The render path: a tiny scene built from fuzzed geometry (raw f32 bits,
-//! so extreme and tiny magnitudes), a fuzzed light, camera, shadow, AO,
+//! so extreme and tiny magnitudes), a fuzzed light (with a range or a
+//! second ranged light: per-tile culling), camera, shadow, AO,
 //! cull and anti-aliasing settings, and half the time fuzzed texture
 //! coordinates on a textured, normal-mapped material with a fuzzed filter
 //! and address mode, rendered at 32x32. This is the target
@@ -59,6 +60,20 @@ fuzz_target!(|data: &[u8]| {
         .collect();
     let light = b.pick(&["point", "directional", "spot"]);
     let (lx, ly, lz) = (b.f32(), b.f32(), b.f32());
+    // Point and spot lights with a range: per-tile light culling (a
+    // second, unshadowed ranged light beside the first).
+    let range = match (light, b.u8() % 3) {
+        ("directional", _) | (_, 0) => String::new(),
+        (_, 1) => format!("range = {}\n", toml_f32(b.f32().abs().max(1e-6))),
+        _ => format!(
+            "range = {}\n[[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\nrange = {}\n",
+            toml_f32(b.f32().abs().max(1e-6)),
+            toml_f32(b.f32()),
+            toml_f32(b.f32()),
+            toml_f32(b.f32()),
+            toml_f32(b.f32().abs().max(1e-6)),
+        ),
+    };
     let shadows = b.pick(&["\"hard\"", "\"pcf\"", "\"raytraced\""]);
     let ao = b.pick(&[
         "",
@@ -129,7 +144,7 @@ fuzz_target!(|data: &[u8]| {
          shadow_map_size = {map_size}\ntexture_filter = \"{filter}\"\naddress = \"{address}\"\n{ao}\
          [ground]\nshadow = {ground}\n\
          [[model]]\npath = \"render.obj\"\nscale = {scale}\n\
-         [[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\ndirection = [{}, {}, {}]\nshadows = true\n{camera}",
+         [[light]]\nkind = \"{light}\"\nposition = [{}, {}, {}]\ndirection = [{}, {}, {}]\nshadows = true\n{range}{camera}",
         toml_f32(lx),
         toml_f32(ly),
         toml_f32(lz),
