@@ -9,24 +9,15 @@
 
 mod common;
 
-use common::{same_frames, scene_in, scratch, shared_assets};
+use common::{load_with, same_frames, scene_in, scratch, shared_assets};
 use softraster::render::Renderer;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
 
 /// Frames `frames` of camera 0 with and without the lanes; panics at the
 /// first pixel that differs in any bit.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
     let single = Renderer::new(scene).with_lanes(false);
     same_frames(scene, &Renderer::new(scene), &single, frames, what);
-}
-
-fn with(scene: &Path, sets: &[&str]) -> Scene {
-    let opts = LoadOptions {
-        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
-        ..Default::default()
-    };
-    Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"))
 }
 
 use std::path::Path;
@@ -36,14 +27,14 @@ fn the_showcase_is_the_same_with_and_without_lanes() {
     // Studio environment, ray-traced shadows, SSAO, MSAA 4, MTL maps.
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
     let small = ["output.width=160", "output.height=120"];
-    same_both_ways(&with(&scene, &small), &[0, 5], "showcase");
+    same_both_ways(&load_with(&scene, &small), &[0, 5], "showcase");
     let mut sets = small.to_vec();
     sets.extend([
         "render.msaa=1",
         "render.shadows=\"pcf\"",
         "render.ao.method=\"off\"",
     ]);
-    same_both_ways(&with(&scene, &sets), &[3], "showcase, pcf, one sample");
+    same_both_ways(&load_with(&scene, &sets), &[3], "showcase, pcf, one sample");
 }
 
 #[test]
@@ -115,9 +106,13 @@ fov = 45.0
     );
     let scene_file = dir.join("d3.toml");
     std::fs::write(&scene_file, &scene).unwrap();
-    same_both_ways(&with(&scene_file, &[]), &[0, 9, 40], "diablo3, trilinear");
     same_both_ways(
-        &with(
+        &load_with(&scene_file, &[]),
+        &[0, 9, 40],
+        "diablo3, trilinear",
+    );
+    same_both_ways(
+        &load_with(
             &scene_file,
             &[
                 "render.texture_filter=\"anisotropic\"",
@@ -131,7 +126,7 @@ fov = 45.0
         "diablo3, anisotropic, MSAA 4, shadow maps",
     );
     same_both_ways(
-        &with(
+        &load_with(
             &scene_file,
             &[
                 "light.0.shadows=true",
@@ -145,7 +140,7 @@ fov = 45.0
         "diablo3, environment, ray-traced shadows, SSAO, clamp",
     );
     same_both_ways(
-        &with(
+        &load_with(
             &scene_file,
             &[
                 "camera.0.projection=\"orthographic\"",
@@ -217,7 +212,7 @@ fn pbr_models_are_the_same_with_and_without_lanes() {
     // environment, its ground shadow), MSAA 4.
     let walker = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/walker.toml");
     let small = ["output.width=120", "output.height=120"];
-    same_both_ways(&with(&walker, &small), &[0, 30], "walker");
+    same_both_ways(&load_with(&walker, &small), &[0, 30], "walker");
     // The showcase's OBJ materials shaded as pbr (map_Kd as the base
     // colour, its normal maps), with lights, shadows, SSAO and ambient.
     let showcase = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
@@ -228,7 +223,7 @@ fn pbr_models_are_the_same_with_and_without_lanes() {
         "render.shadows=\"pcf\"",
         "ambient.color=[0.2, 0.15, 0.1]",
     ]);
-    same_both_ways(&with(&showcase, &sets), &[2], "showcase as pbr");
+    same_both_ways(&load_with(&showcase, &sets), &[2], "showcase as pbr");
 
     let Some(assets) = shared_assets() else {
         return;
@@ -270,9 +265,13 @@ outer_angle = 30
     );
     let file = dir.join("helmet.toml");
     std::fs::write(&file, scene).unwrap();
-    same_both_ways(&with(&file, &[]), &[0, 25], "FlightHelmet, three lights");
     same_both_ways(
-        &with(
+        &load_with(&file, &[]),
+        &[0, 25],
+        "FlightHelmet, three lights",
+    );
+    same_both_ways(
+        &load_with(
             &file,
             &[
                 "environment.preset=\"studio\"",

@@ -12,23 +12,14 @@ mod common;
 use std::fmt::Write;
 use std::path::Path;
 
-use common::{same_frames, scratch, shared_assets};
+use common::{load_with, same_frames, scratch, shared_assets};
 use softraster::render::Renderer;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
 
 /// Frames `frames` of camera 0 with and without light culling.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
     let all = Renderer::new(scene).with_light_culling(false);
     same_frames(scene, &Renderer::new(scene), &all, frames, what);
-}
-
-fn load(path: &Path, sets: &[&str]) -> Scene {
-    let opts = LoadOptions {
-        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
-        ..Default::default()
-    };
-    Scene::load(path, &opts).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// 60 point lights with ranges in a grid over the showcase's ground, 8
@@ -96,9 +87,9 @@ fn many_local_lights_give_the_same_frames_with_and_without_culling() {
     text.push_str(&many_lights());
     let path = dir.join("lights.toml");
     std::fs::write(&path, &text).unwrap();
-    same_both_ways(&load(&path, &[]), &[0, 7], "70 lights, MSAA 4, PCF");
+    same_both_ways(&load_with(&path, &[]), &[0, 7], "70 lights, MSAA 4, PCF");
     same_both_ways(
-        &load(
+        &load_with(
             &path,
             &[
                 "render.msaa=1",
@@ -111,7 +102,7 @@ fn many_local_lights_give_the_same_frames_with_and_without_culling() {
         "70 lights, pbr, one sample, ray-traced shadows, SSAO",
     );
     same_both_ways(
-        &load(
+        &load_with(
             &path,
             &[
                 "environment.preset=\"studio\"",
@@ -149,8 +140,16 @@ fn a_textured_character_under_local_lights_is_the_same_with_and_without_culling(
     assert_eq!(text.matches("range = ").count(), 24, "{text}");
     assert_eq!(text.matches("kind = \"spot\"").count(), 4, "{text}");
     let small = ["output.width=200", "output.height=200"];
-    same_both_ways(&load(&path, &small), &[0, 20], "diablo3 under 29 lights");
+    same_both_ways(
+        &load_with(&path, &small),
+        &[0, 20],
+        "diablo3 under 29 lights",
+    );
     let mut msaa = small.to_vec();
     msaa.extend(["render.msaa=4", "render.texture_filter=\"anisotropic\""]);
-    same_both_ways(&load(&path, &msaa), &[9], "diablo3 under 29 lights, MSAA 4");
+    same_both_ways(
+        &load_with(&path, &msaa),
+        &[9],
+        "diablo3 under 29 lights, MSAA 4",
+    );
 }

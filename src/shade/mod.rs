@@ -196,36 +196,19 @@ impl ShadeContext<'_> {
             }
             ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
             ShadingMode::Pbr => self.shade_pbr(s),
-            ShadingMode::BlinnPhong | ShadingMode::Auto => {
+            ShadingMode::BlinnPhong | ShadingMode::Auto | ShadingMode::Flat => {
                 let c = self.surface_color(s.material, &s.tc, s.color);
                 let v = self.view_vector(s.position);
-                let n = self.mapped_normal(s);
+                // Flat: the triangle's normal (already in `s.normal`).
+                let n = if self.mode == ShadingMode::Flat {
+                    s.normal
+                } else {
+                    self.mapped_normal(s)
+                };
                 let ambient = self.ambient * s.ao;
                 let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
-                blinn_phong::radiance(
-                    s.position,
-                    n,
-                    v,
-                    &c,
-                    ambient,
-                    self.light_set(s),
-                    &self.shadow(s),
-                ) + env
-            }
-            ShadingMode::Flat => {
-                let c = self.surface_color(s.material, &s.tc, s.color);
-                let v = self.view_vector(s.position);
-                let (n, ambient) = (s.normal, self.ambient * s.ao);
-                let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
-                blinn_phong::radiance(
-                    s.position,
-                    n,
-                    v,
-                    &c,
-                    ambient,
-                    self.light_set(s),
-                    &self.shadow(s),
-                ) + env
+                let lights = self.light_set(s);
+                blinn_phong::radiance(s.position, n, v, &c, ambient, lights, &self.shadow(s)) + env
             }
         }
     }

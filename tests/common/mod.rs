@@ -45,6 +45,15 @@ pub fn scene_in(dir: &Path, scene: &str, files: &[(&str, &str)]) -> Scene {
     Scene::load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Loads the scene file `path` with `--set` overrides `sets`.
+pub fn load_with(path: &Path, sets: &[&str]) -> Scene {
+    let opts = LoadOptions {
+        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
+        ..Default::default()
+    };
+    Scene::load(path, &opts).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// The shared model directory. When it is missing: under CI (`CI=true`)
 /// the calling test fails with a message naming the path, so tests on real
 /// models cannot pass by not running; elsewhere the test prints SKIPPED and
