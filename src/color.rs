@@ -1,7 +1,8 @@
 //! Colour encodings, at the ground floor: the sRGB transfer curve both
-//! ways, the tables that make it cheap (256 entries to decode an sRGB byte,
-//! 64K entries to encode a linear value to a byte, accurate to a twentieth
-//! of a code), and the plain byte encoding of data values. Textures decode
+//! ways, the tables that make it cheap (256 entries to decode an sRGB byte;
+//! to encode a linear value, the bytes of 64K evenly spaced values,
+//! accurate to a twentieth of a code, kept as 8.7 KB of segments), and the
+//! plain byte encoding of data values. Textures decode
 //! with it, mip chains re-encode with it, the output resolve encodes with
 //! it; tone mapping (a display decision) lives in `output::tonemap`.
 
@@ -39,41 +40,99 @@ pub fn srgb_to_linear_table() -> &'static [f32; 256] {
 
 const LUT_SIZE: usize = 1 << 16;
 
-fn srgb_lut() -> &'static [u8] {
-    static LUT: OnceLock<Vec<u8>> = OnceLock::new();
-    LUT.get_or_init(|| {
-        (0..LUT_SIZE)
-            .map(|i| {
-                let v = i as f32 / (LUT_SIZE - 1) as f32;
-                (linear_to_srgb(v) * 255.0 + 0.5) as u8
-            })
-            .collect()
+/// The encoding as first defined: the byte of each of 64K evenly spaced
+/// linear values, a value taking its nearest entry. `encode_srgb` gives
+/// exactly these bytes from a smaller table (`Segments`).
+fn srgb_lut() -> Vec<u8> {
+    (0..LUT_SIZE)
+        .map(|i| {
+            let v = i as f32 / (LUT_SIZE - 1) as f32;
+            (linear_to_srgb(v) * 255.0 + 0.5) as u8
+        })
+        .collect()
+}
+
+/// The 64K-entry table's entry for v in [0, 1].
+#[inline(always)]
+fn lut_index(v: f32) -> u32 {
+    (v * (LUT_SIZE - 1) as f32 + 0.5) as u32
+}
+
+/// The first float key: values below 2^-17 share segment 0 (they all
+/// encode to 0).
+const KEY_BASE: u32 = (127 - 17) << 7;
+/// Segments up to that of 1.0.
+const SEGMENTS: usize = ((127 << 7) - KEY_BASE + 1) as usize;
+
+/// The 64K-entry table, as segments of the float line small enough that
+/// the byte steps at most once in each: a value's segment is its exponent
+/// and top 7 mantissa bits (its bits >> 16), spanning 1/128 of its
+/// magnitude, where the byte changes by less than one (at most 0.88 at
+/// the top). Per segment, the byte at its start in the low byte and
+/// above it the first table entry (`lut_index`) of the next byte, if it
+/// starts inside the segment (else beyond every entry). 8.7 KB: it stays
+/// in the first-level cache where the 64 KB table did not.
+struct Segments([u32; SEGMENTS]);
+
+fn segments() -> &'static Segments {
+    static TABLE: OnceLock<Box<Segments>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let lut = srgb_lut();
+        let mut t = Box::new(Segments([0; SEGMENTS]));
+        for (k, e) in t.0.iter_mut().enumerate() {
+            let first = if k == 0 {
+                0.0
+            } else {
+                f32::from_bits((k as u32 + KEY_BASE) << 16)
+            };
+            let last = f32::from_bits(((k as u32 + 1 + KEY_BASE) << 16) - 1).min(1.0);
+            let (i0, i1) = (lut_index(first), lut_index(last));
+            let byte = lut[i0 as usize];
+            let step = (i0..=i1).find(|&i| lut[i as usize] != byte);
+            if let Some(s) = step {
+                assert!(lut[i1 as usize] == byte + 1, "two steps in a segment");
+                *e = byte as u32 | s << 8;
+            } else {
+                *e = byte as u32 | (LUT_SIZE as u32) << 8;
+            }
+        }
+        t
     })
 }
 
-/// Linear [0,1] -> sRGB byte (clamped; NaN gives 0).
+impl Segments {
+    /// The byte of v, which is in [0, 1] (or -0).
+    #[inline(always)]
+    fn encode(&self, v: f32) -> u8 {
+        let key = ((v.to_bits() & 0x7fff_ffff) >> 16).saturating_sub(KEY_BASE) as usize;
+        let e = self.0[key.min(SEGMENTS - 1)];
+        (e as u8) + (lut_index(v) >= e >> 8) as u8
+    }
+}
+
+/// Linear [0,1] -> sRGB byte (clamped; NaN gives 0): the byte of the
+/// nearest of 64K evenly spaced values, accurate to a twentieth of a code.
 #[inline]
 pub fn encode_srgb(v: f32) -> u8 {
-    let lut = srgb_lut();
-    let i = (v.clamp(0.0, 1.0) * (LUT_SIZE - 1) as f32 + 0.5) as usize;
-    lut[i.min(LUT_SIZE - 1)]
+    // max(NaN, 0) is 0.
+    segments().encode(v.max(0.0).min(1.0))
 }
 
 /// `encode_srgb` of the three channels of `c`, together (the same bytes).
 #[inline]
 pub fn encode_srgb3(c: glam::Vec3) -> [u8; 3] {
+    encode_srgb_xyz(glam::Vec4::new(c.x, c.y, c.z, 0.0))
+}
+
+/// `encode_srgb` of x, y and z of `c` (what `encode_srgb3` of them gives;
+/// kept in a vector register, where a `Vec3` goes through memory).
+#[inline]
+pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
     use glam::Vec4;
-    let lut = srgb_lut();
-    // max(NaN, 0) is 0, as clamp(NaN) gives index 0.
-    let v = Vec4::new(c.x, c.y, c.z, 0.0).max(Vec4::ZERO).min(Vec4::ONE)
-        * Vec4::splat((LUT_SIZE - 1) as f32)
-        + Vec4::splat(0.5);
-    let i = v.as_uvec4();
-    [
-        lut[(i.x as usize).min(LUT_SIZE - 1)],
-        lut[(i.y as usize).min(LUT_SIZE - 1)],
-        lut[(i.z as usize).min(LUT_SIZE - 1)],
-    ]
+    let t = segments();
+    // max(NaN, 0) is 0, as in `encode_srgb`.
+    let v = c.max(Vec4::ZERO).min(Vec4::ONE);
+    [t.encode(v.x), t.encode(v.y), t.encode(v.z)]
 }
 
 /// [0,1] -> byte without transfer curve (data: normals, depth, alpha).
@@ -85,6 +144,37 @@ pub fn encode_linear(v: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The segment table gives the 64K-entry table's byte for every
+    /// float in [0, 1] (each one of the 1.07 billion, and -0).
+    #[test]
+    fn segments_equal_the_full_table() {
+        let lut = srgb_lut();
+        let want = |v: f32| lut[lut_index(v) as usize];
+        assert_eq!(encode_srgb(-0.0), 0);
+        assert_eq!(encode_srgb(1.0), 255);
+        let top = 1.0f32.to_bits();
+        let chunks = 64u32;
+        let bad: u32 = std::thread::scope(|sc| {
+            let jobs: Vec<_> = (0..chunks)
+                .map(|c| {
+                    let want = &want;
+                    sc.spawn(move || {
+                        let (a, b) = (top / chunks * c, (top / chunks * (c + 1)).min(top));
+                        let b = if c + 1 == chunks { top + 1 } else { b };
+                        (a..b)
+                            .filter(|&bits| {
+                                let v = f32::from_bits(bits);
+                                encode_srgb(v) != want(v)
+                            })
+                            .count() as u32
+                    })
+                })
+                .collect();
+            jobs.into_iter().map(|j| j.join().unwrap_or(u32::MAX)).sum()
+        });
+        assert_eq!(bad, 0);
+    }
 
     #[test]
     fn three_channels_encode_as_one() {

@@ -14,11 +14,11 @@ use std::path::Path;
 
 use glam::Vec4;
 
-use crate::color::{encode_linear, encode_srgb3};
+use crate::color::{encode_linear, encode_srgb_xyz, encode_srgb3};
 use crate::error::Error;
 use crate::render::Frame;
 use crate::scene::RenderSettings;
-use crate::scene::settings::Background;
+use crate::scene::settings::{Background, Tonemap};
 use tonemap::tonemap;
 
 /// 8-bit display image: RGB, or RGBA for a transparent background.
@@ -48,6 +48,10 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
         };
         let rgb = if data_view {
             [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+        } else if s.tonemap == Tonemap::Clamp {
+            // `tonemap`'s clamp is the encoding's own: the same bytes,
+            // without a trip through memory.
+            encode_srgb_xyz(c * scale)
         } else {
             encode_srgb3(tonemap(c.truncate(), s.tonemap, scale))
         };
@@ -72,21 +76,47 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
 }
 
 /// One row of `resolve` into C bytes per pixel; runs of one colour (the
-/// background, mostly) resolve once.
+/// background, mostly) resolve once, and are copied four pixels at a time.
 #[inline]
 fn resolve_row<const C: usize>(out: &mut [u8], row: &[Vec4], pixel: impl Fn(&Vec4) -> [u8; 4]) {
-    let (out, _) = out.as_chunks_mut::<C>();
-    let mut last: Option<(Vec4, [u8; 4])> = None;
-    for (o, c) in out.iter_mut().zip(row) {
-        let px = match last {
-            Some((lc, px)) if lc == *c => px,
-            _ => {
-                let px = pixel(c);
-                last = Some((*c, px));
-                px
+    let Some(first) = row.first() else {
+        return;
+    };
+    let mut last = (*first, pixel(first));
+    // `last`'s bytes for four pixels (the first 4 C of them).
+    let repeat = |px: [u8; 4]| -> [u8; 16] {
+        let mut r = [0u8; 16];
+        for k in 0..4 {
+            r[k * C..k * C + C].copy_from_slice(&px[..C]);
+        }
+        r
+    };
+    let mut four = repeat(last.1);
+    let mut x = 0;
+    let n = row.len();
+    while x + 4 <= n {
+        let p = &row[x..x + 4];
+        let l = last.0;
+        if p[0] == l && p[1] == l && p[2] == l && p[3] == l {
+            out[x * C..x * C + 4 * C].copy_from_slice(&four[..4 * C]);
+            x += 4;
+            continue;
+        }
+        for c in p {
+            if *c != last.0 {
+                last = (*c, pixel(c));
+                four = repeat(last.1);
             }
-        };
-        o.copy_from_slice(&px[..C]);
+            out[x * C..x * C + C].copy_from_slice(&last.1[..C]);
+            x += 1;
+        }
+    }
+    for c in &row[x..] {
+        if *c != last.0 {
+            last = (*c, pixel(c));
+        }
+        out[x * C..x * C + C].copy_from_slice(&last.1[..C]);
+        x += 1;
     }
 }
 
