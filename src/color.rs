@@ -114,8 +114,8 @@ impl Segments {
 /// nearest of 64K evenly spaced values, accurate to a twentieth of a code.
 #[inline]
 pub fn encode_srgb(v: f32) -> u8 {
-    // max(NaN, 0) is 0.
-    segments().encode(v.max(0.0).min(1.0))
+    // NaN fails the test: 0.
+    segments().encode(if v >= 0.0 { v.min(1.0) } else { 0.0 })
 }
 
 /// `encode_srgb` of the three channels of `c`, together (the same bytes).

@@ -5,8 +5,8 @@
 //! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
 //! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
-//! frame by [`batch`]. [`color`], [`error`], [`raster`], [`raytrace`] and [`simd`]
-//! are the ground floor: they import nothing of the layers above.
+//! frame by [`batch`]. [`color`], [`error`], [`powers`], [`raster`], [`raytrace`] and
+//! [`simd`] are the ground floor: they import nothing of the layers above.
 //!
 //! The library is the renderer alone with `--no-default-features`; the
 //! default feature `tools` adds [`tools`] (bench, chart, accuracy tables,
@@ -45,6 +45,7 @@ pub mod bigbuf;
 pub mod color;
 pub mod error;
 pub mod output;
+pub mod powers;
 pub mod procedural;
 pub mod raster;
 pub mod raytrace;

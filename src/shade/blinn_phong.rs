@@ -43,7 +43,7 @@ pub fn light_sums(
             let h = (l + v).normalize_or_zero();
             let ndh = n.dot(h).max(0.0);
             if ndh > 0.0 {
-                spec += e * ndh.powf(ns);
+                spec += e * crate::powers::pow_unit(ndh, ns);
             }
         }
     });

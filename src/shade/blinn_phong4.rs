@@ -86,12 +86,9 @@ impl<'a> ShadeContext<'a> {
                 let shine = lit & ndh.cmpgt(Vec4::ZERO);
                 let bits = shine.bitmask();
                 if bits != 0 {
-                    let mut pw = Vec4::ZERO;
-                    for k in 0..4 {
-                        if bits & (1 << k) != 0 {
-                            pw[k] = ndh[k].powf(m.ns);
-                        }
-                    }
+                    // Lanes that do not shine give what they give (x = 0:
+                    // 2^-126 raised), left out by the select.
+                    let pw = crate::powers::pow4(ndh, m.ns);
                     spec = spec + V3::select(shine, e.scale(pw), V3::ZERO);
                 }
             }
