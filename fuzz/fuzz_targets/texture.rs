@@ -36,7 +36,10 @@ fuzz_target!(|data: &[u8]| {
                         assert_eq!(back.base().texel(x, y), t.base().texel(x, y));
                     }
                 }
-                assert_eq!(softraster::assets::mip::build_chain(&back).len(), chain.len());
+                assert_eq!(
+                    softraster::assets::mip::build_chain(&back).len(),
+                    chain.len()
+                );
             }
         }
         if let Some(t) = Texture::from_cache_bytes(data, srgb) {
