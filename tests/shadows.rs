@@ -752,3 +752,52 @@ fn shadow_maps_reused_across_frames_match_maps_rendered_afresh() {
         assert!(frames[0] != frames[2], "rotate = {rotate}");
     }
 }
+
+#[test]
+fn a_flat_model_left_out_of_the_map_still_shadows_what_lies_beyond_it() {
+    // A shelf (a flat square at height 1) over a floor, under a sun and
+    // a lamp: the floor, below everything, is left out of the maps; the
+    // shelf, with the floor beyond it, is not. The maps must agree with
+    // ray-traced shadows away from edges, the shelf's shadow on the floor
+    // included.
+    let dir = common::scratch("flat_casters");
+    std::fs::write(
+        dir.join("floor.obj"),
+        obj(procedural::ground(6.0, 0.0, 1.0)),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("shelf.obj"),
+        obj(procedural::ground(0.8, 1.0, 1.0)),
+    )
+    .unwrap();
+    let size = 240u32;
+    let camera = "[[camera]]\neye = [3.5, 6.0, 5.0]\ntarget = [0.0, 0.3, 0.0]\nfov = 50.0\n";
+    for (what, light) in [
+        (
+            "sun",
+            "kind = \"directional\"\ndirection = [0.6, -1.0, 0.3]\nirradiance = 1.0",
+        ),
+        (
+            "lamp",
+            "kind = \"point\"\nposition = [-0.4, 2.6, 0.3]\nintensity = 10.0",
+        ),
+    ] {
+        let scene = format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+             [[model]]\npath = \"floor.obj\"\n{MATTE}[[model]]\npath = \"shelf.obj\"\n{MATTE}\
+             [[light]]\n{light}\nshadows = true\n{camera}"
+        );
+        let truth = shadow_factor(&dir, &scene, "raytraced");
+        let in_shadow = truth.iter().filter(|k| **k < 0.5).count();
+        for method in ["hard", "pcf"] {
+            let f = shadow_factor(&dir, &scene, method);
+            let (far, near) = disagreements_off_edges(&f, &truth, size, size);
+            println!(
+                "{what}, {method}: {far} pixels disagree away from edges, {near} along edges; {in_shadow} shadowed"
+            );
+            assert!(in_shadow > 1500, "{what}: {in_shadow}");
+            assert!(far <= 3, "{what} {method}: {far}");
+        }
+    }
+}

@@ -9,6 +9,14 @@
 //! texels so the PCF footprint at its border reads real depths. Shadow maps
 //! draw both faces of every triangle, with opaque depth (alpha-tested and
 //! blended materials cast full shadows).
+//!
+//! A flat model (every vertex on one plane) with the light on one side of
+//! it and every other model on that side too (a floor under the models)
+//! can darken only points beyond its plane, where there are none: it is
+//! left out of that light's map (the map's fit still covers it). That
+//! saves rasterizing the floor over the whole map each frame, and the
+//! floor's depths no longer reach, through the PCF footprint, into the
+//! shadow tests of points that touch it.
 
 use crate::bigbuf::BigBuf;
 use std::sync::{Arc, Mutex};
@@ -29,10 +37,13 @@ use crate::shade::shadow::{Filter, LightShadow, MapProjection, ShadowMap, Shadow
 
 const CHUNK: usize = 4096;
 
-/// One model's world-space vertices and triangles this frame.
+/// One model's world-space vertices and triangles this frame, and
+/// whether it goes into the light's map (`casts_nothing`).
+#[derive(Clone, Copy)]
 struct Geo<'g> {
     world: &'g [Vec3],
     triangles: &'g [[u32; 3]],
+    casts: bool,
 }
 
 /// The shadow maps of the last frame rendered, with what they depend on:
@@ -142,10 +153,19 @@ fn light_shadows(
         .map(|(v, m)| Geo {
             world: &v.world,
             triangles: &m.mesh.triangles,
+            casts: true,
         })
         .collect();
-    let verts = verts.as_slice();
+    let eps = 1e-5 * fs.scene.bounds_radius.max(f32::MIN_POSITIVE);
+    let planes: Vec<Option<Plane>> = verts.iter().map(|g| plane_of(g, eps)).collect();
     for light in &fs.lights {
+        let mut verts = verts.clone();
+        for (k, plane) in planes.iter().enumerate() {
+            if let Some(plane) = plane {
+                verts[k].casts = !casts_nothing(&verts, k, *plane, &light.kind, eps);
+            }
+        }
+        let verts = verts.as_slice();
         let ls = if !light.shadows {
             LightShadow::None
         } else if s.shadows == ShadowMethod::Raytraced {
@@ -174,6 +194,73 @@ fn light_shadows(
         out.push(ls);
     }
     out
+}
+
+/// A plane: unit normal n and offset d, n.p = d on it.
+#[derive(Clone, Copy)]
+struct Plane {
+    n: Vec3,
+    d: f32,
+}
+
+/// The plane of a model whose vertices all lie within `eps` of one
+/// (normal from the largest of its first 16 triangles); None for any
+/// other model, or one without a triangle of non-zero area.
+fn plane_of(g: &Geo, eps: f32) -> Option<Plane> {
+    let corner = |i: u32| g.world.get(i as usize).copied();
+    let mut best: Option<(Vec3, f32, Vec3)> = None;
+    for t in g.triangles.iter().take(16) {
+        let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
+            continue;
+        };
+        let n = (b - a).cross(c - a);
+        let len = n.length();
+        if len.is_finite() && len > 0.0 && best.is_none_or(|(_, l, _)| len > l) {
+            best = Some((n / len, len, a));
+        }
+    }
+    let (n, _, a) = best?;
+    let d = n.dot(a);
+    // `!(x <= eps)`: a NaN distance is off the plane too.
+    if g.world.iter().any(|p| !((n.dot(*p) - d).abs() <= eps)) {
+        return None;
+    }
+    Some(Plane { n, d })
+}
+
+/// Whether the flat model `k` (on `plane`) can shadow nothing under
+/// `light`: the light lies off the plane on one side, and every vertex of
+/// every other model on that side (or within `eps` of the plane). A
+/// shadow ray leaves the light, passes the plane once and darkens only
+/// what lies beyond it.
+fn casts_nothing(verts: &[Geo], k: usize, plane: Plane, light: &LightKind, eps: f32) -> bool {
+    let side = match *light {
+        LightKind::Directional { direction, .. } => {
+            // Toward the light is -direction; it must not graze the plane.
+            let s = -plane.n.dot(direction);
+            if !(s.abs() > 1e-6) {
+                return false;
+            }
+            s
+        }
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+            let s = plane.n.dot(position) - plane.d;
+            if !(s.abs() > eps) {
+                return false;
+            }
+            s
+        }
+    };
+    let (n, d) = if side > 0.0 {
+        (plane.n, plane.d)
+    } else {
+        (-plane.n, -plane.d)
+    };
+    verts
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != k)
+        .all(|(_, g)| g.world.iter().all(|p| n.dot(*p) - d >= -eps))
 }
 
 /// A view matrix at `eye` looking along `dir` (unit).
@@ -310,6 +397,9 @@ fn render_map(
     let grid = TileGrid::bands(size, size);
     let mut chunks = Vec::new();
     for (mi, m) in verts.iter().enumerate() {
+        if !m.casts {
+            continue;
+        }
         let n = m.triangles.len();
         for start in (0..n).step_by(CHUNK) {
             chunks.push((mi, start, (start + CHUNK).min(n)));
@@ -373,5 +463,123 @@ fn render_map(
         view_from_world,
         projection,
         depth,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn geo<'g>(world: &'g [Vec3], triangles: &'g [[u32; 3]]) -> Geo<'g> {
+        Geo {
+            world,
+            triangles,
+            casts: true,
+        }
+    }
+
+    const QUAD: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+    fn quad(y: f32, half: f32) -> [Vec3; 4] {
+        [
+            Vec3::new(-half, y, -half),
+            Vec3::new(half, y, -half),
+            Vec3::new(half, y, half),
+            Vec3::new(-half, y, half),
+        ]
+    }
+
+    fn sun(direction: Vec3) -> LightKind {
+        LightKind::Directional {
+            direction: direction.normalize(),
+            irradiance: 1.0,
+        }
+    }
+
+    fn lamp(position: Vec3) -> LightKind {
+        LightKind::Point {
+            position,
+            intensity: 1.0,
+        }
+    }
+
+    #[test]
+    fn a_floor_under_everything_casts_nothing_and_only_then() {
+        let eps = 1e-5;
+        let floor = quad(0.0, 4.0);
+        // A tetrahedron standing on the floor (one corner touching it).
+        let tet = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.5),
+            Vec3::new(0.0, 2.0, -1.0),
+        ];
+        let tet_tris = [[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]];
+        let verts = [geo(&floor, &QUAD), geo(&tet, &tet_tris)];
+        let plane = plane_of(&verts[0], eps).expect("the floor is flat");
+        assert!(plane_of(&verts[1], eps).is_none(), "a tetrahedron is not");
+        let from_above = sun(Vec3::new(0.3, -1.0, 0.2));
+        assert!(casts_nothing(&verts, 0, plane, &from_above, eps));
+        // Lit from below, the floor shadows the model.
+        let from_below = sun(Vec3::new(0.3, 1.0, 0.2));
+        assert!(!casts_nothing(&verts, 0, plane, &from_below, eps));
+        // A light grazing the plane, or a lamp in it: kept.
+        assert!(!casts_nothing(&verts, 0, plane, &sun(Vec3::X), eps));
+        assert!(!casts_nothing(
+            &verts,
+            0,
+            plane,
+            &lamp(Vec3::new(9.0, 0.0, 0.0)),
+            eps
+        ));
+        assert!(casts_nothing(
+            &verts,
+            0,
+            plane,
+            &lamp(Vec3::new(0.0, 5.0, 0.0)),
+            eps
+        ));
+        assert!(!casts_nothing(
+            &verts,
+            0,
+            plane,
+            &lamp(Vec3::new(0.0, -5.0, 0.0)),
+            eps
+        ));
+
+        // A model reaching below the floor keeps it in the map.
+        let sunk = tet.map(|p| p - Vec3::new(0.0, 0.5, 0.0));
+        let verts = [geo(&floor, &QUAD), geo(&sunk, &tet_tris)];
+        assert!(!casts_nothing(&verts, 0, plane, &from_above, eps));
+
+        // A floor above another flat model shadows it; the lower one,
+        // with everything on its lit side, casts nothing.
+        let lower = quad(-1.0, 8.0);
+        let verts = [geo(&floor, &QUAD), geo(&lower, &QUAD)];
+        let lower_plane = plane_of(&verts[1], eps).expect("flat");
+        assert!(!casts_nothing(&verts, 0, plane, &from_above, eps));
+        assert!(casts_nothing(&verts, 1, lower_plane, &from_above, eps));
+
+        // Coplanar tiles cannot shadow each other.
+        let tile = quad(0.0, 1.0).map(|p| p + Vec3::new(10.0, 0.0, 0.0));
+        let verts = [geo(&floor, &QUAD), geo(&tile, &QUAD)];
+        assert!(casts_nothing(&verts, 0, plane, &from_above, eps));
+    }
+
+    #[test]
+    fn flatness_is_checked_at_every_vertex() {
+        let eps = 1e-5;
+        let mut bent = quad(0.0, 1.0).to_vec();
+        bent.push(Vec3::new(0.5, 1e-3, 0.5));
+        let tris = [[0, 1, 2], [0, 2, 3], [2, 3, 4]];
+        assert!(plane_of(&geo(&bent, &tris), eps).is_none());
+        bent[4].y = 1e-7;
+        assert!(plane_of(&geo(&bent, &tris), eps).is_some());
+        bent[4].y = f32::NAN;
+        assert!(plane_of(&geo(&bent, &tris), eps).is_none());
+        // No triangle of any area.
+        let line = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+        assert!(plane_of(&geo(&line, &[[0, 1, 2]]), eps).is_none());
+        assert!(plane_of(&geo(&line, &[[0, 1, 7]]), eps).is_none());
     }
 }
