@@ -648,6 +648,37 @@ fn disagreements_off_edges(map: &[f32], truth: &[f32], w: u32, h: u32) -> (usize
     (far, near)
 }
 
+/// Renders `models` under each of `lights` (name, `[[light]]` body) with
+/// shadow maps, hard and PCF, and with ray-traced shadows: the maps must
+/// agree with the rays except along shadow edges (at most 3 pixels), and
+/// more than `min_shadowed` pixels must be in shadow.
+fn maps_agree_with_ray_tracing(
+    dir: &Path,
+    models: &str,
+    lights: &[(&str, &str)],
+    camera: &str,
+    min_shadowed: usize,
+) {
+    let size = 240u32;
+    for (what, light) in lights {
+        let scene = format!(
+            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+             {models}[[light]]\n{light}\nshadows = true\n{camera}"
+        );
+        let truth = shadow_factor(dir, &scene, "raytraced");
+        let in_shadow = truth.iter().filter(|k| **k < 0.5).count();
+        for method in ["hard", "pcf"] {
+            let f = shadow_factor(dir, &scene, method);
+            let (far, near) = disagreements_off_edges(&f, &truth, size, size);
+            println!(
+                "{what} light, {method}: {far} pixels disagree away from edges, {near} along edges; {in_shadow} shadowed"
+            );
+            assert!(in_shadow > min_shadowed, "{what}: {in_shadow}");
+            assert!(far <= 3, "{what} {method}: {far}");
+        }
+    }
+}
+
 #[test]
 fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
     // Spheres all around a point light (every cube face casts), and a spot
@@ -664,7 +695,6 @@ fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
         obj(procedural::ground(6.0, 0.0, 1.0)),
     )
     .unwrap();
-    let size = 240u32;
     let mut models = format!("[[model]]\npath = \"ground.obj\"\n{MATTE}");
     for (x, y, z) in [
         (1.0, 1.6, 0.2),
@@ -679,7 +709,7 @@ fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
         ));
     }
     let camera = "[[camera]]\neye = [3.5, 6.0, 5.0]\ntarget = [0.0, 0.8, 0.0]\nfov = 50.0\n";
-    for (what, light) in [
+    let lights = [
         (
             "point",
             "kind = \"point\"\nposition = [0.0, 1.9, 0.0]\nintensity = 10.0",
@@ -688,23 +718,8 @@ fn point_and_spot_shadow_maps_agree_with_ray_tracing() {
             "spot",
             "kind = \"spot\"\nposition = [1.5, 4.0, 1.0]\ndirection = [-0.3, -1.0, -0.2]\nintensity = 40.0\ninner_angle = 30.0\nouter_angle = 40.0",
         ),
-    ] {
-        let scene = format!(
-            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
-             {models}[[light]]\n{light}\nshadows = true\n{camera}"
-        );
-        let truth = shadow_factor(&dir, &scene, "raytraced");
-        let in_shadow = truth.iter().filter(|k| **k < 0.5).count();
-        for method in ["hard", "pcf"] {
-            let f = shadow_factor(&dir, &scene, method);
-            let (far, near) = disagreements_off_edges(&f, &truth, size, size);
-            println!(
-                "{what} light, {method}: {far} pixels disagree away from edges, {near} along edges; {in_shadow} shadowed"
-            );
-            assert!(in_shadow > 2000, "{in_shadow}");
-            assert!(far <= 3, "{what} {method}: {far}");
-        }
-    }
+    ];
+    maps_agree_with_ray_tracing(&dir, &models, &lights, camera, 2000);
 }
 
 #[test]
@@ -771,9 +786,10 @@ fn a_flat_model_left_out_of_the_map_still_shadows_what_lies_beyond_it() {
         obj(procedural::ground(0.8, 1.0, 1.0)),
     )
     .unwrap();
-    let size = 240u32;
     let camera = "[[camera]]\neye = [3.5, 6.0, 5.0]\ntarget = [0.0, 0.3, 0.0]\nfov = 50.0\n";
-    for (what, light) in [
+    let models =
+        format!("[[model]]\npath = \"floor.obj\"\n{MATTE}[[model]]\npath = \"shelf.obj\"\n{MATTE}");
+    let lights = [
         (
             "sun",
             "kind = \"directional\"\ndirection = [0.6, -1.0, 0.3]\nirradiance = 1.0",
@@ -782,22 +798,6 @@ fn a_flat_model_left_out_of_the_map_still_shadows_what_lies_beyond_it() {
             "lamp",
             "kind = \"point\"\nposition = [-0.4, 2.6, 0.3]\nintensity = 10.0",
         ),
-    ] {
-        let scene = format!(
-            "[output]\nwidth = {size}\nheight = {size}\n[render]\nshadows = \"{{shadows}}\"\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
-             [[model]]\npath = \"floor.obj\"\n{MATTE}[[model]]\npath = \"shelf.obj\"\n{MATTE}\
-             [[light]]\n{light}\nshadows = true\n{camera}"
-        );
-        let truth = shadow_factor(&dir, &scene, "raytraced");
-        let in_shadow = truth.iter().filter(|k| **k < 0.5).count();
-        for method in ["hard", "pcf"] {
-            let f = shadow_factor(&dir, &scene, method);
-            let (far, near) = disagreements_off_edges(&f, &truth, size, size);
-            println!(
-                "{what}, {method}: {far} pixels disagree away from edges, {near} along edges; {in_shadow} shadowed"
-            );
-            assert!(in_shadow > 1500, "{what}: {in_shadow}");
-            assert!(far <= 3, "{what} {method}: {far}");
-        }
-    }
+    ];
+    maps_agree_with_ray_tracing(&dir, &models, &lights, camera, 1500);
 }

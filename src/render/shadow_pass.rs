@@ -221,8 +221,12 @@ fn plane_of(g: &Geo, eps: f32) -> Option<Plane> {
     }
     let (n, _, a) = best?;
     let d = n.dot(a);
-    // `!(x <= eps)`: a NaN distance is off the plane too.
-    if g.world.iter().any(|p| !((n.dot(*p) - d).abs() <= eps)) {
+    // A NaN distance is off the plane too.
+    let off = |p: &Vec3| {
+        let e = (n.dot(*p) - d).abs();
+        e.is_nan() || e > eps
+    };
+    if g.world.iter().any(off) {
         return None;
     }
     Some(Plane { n, d })
@@ -238,14 +242,14 @@ fn casts_nothing(verts: &[Geo], k: usize, plane: Plane, light: &LightKind, eps: 
         LightKind::Directional { direction, .. } => {
             // Toward the light is -direction; it must not graze the plane.
             let s = -plane.n.dot(direction);
-            if !(s.abs() > 1e-6) {
+            if s.is_nan() || s.abs() <= 1e-6 {
                 return false;
             }
             s
         }
         LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
             let s = plane.n.dot(position) - plane.d;
-            if !(s.abs() > eps) {
+            if s.is_nan() || s.abs() <= eps {
                 return false;
             }
             s
