@@ -393,11 +393,15 @@ impl<'a> FrameData<'a> {
                     let one = |i: usize| vis.id[i * n..(i + 1) * n].iter().all(|&s| s == id);
                     if id != NO_TRIANGLE && quad.iter().all(|&i| one(i)) {
                         let t = &self.tris[id as usize];
-                        if let Some(lm) = self.lane_material(t.draw as usize) {
+                        if let (Some(lm), Some(b)) =
+                            (self.lane_material(t.draw as usize), lanes.as_mut())
+                        {
                             let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
                             let it = cache.get(id, t);
                             let ao = ao.map_or([1.0; 4], |a| quad.map(|i| a[i]));
-                            let shaded = self.shade_quad(t, it, lm, q0, ao, lights_at(qx));
+                            let corners = b.corners.get(self, t.draw as usize, id, t);
+                            let shaded =
+                                self.shade_quad(t, it, lm, q0, ao, lights_at(qx), corners);
                             for (k, &i) in quad.iter().enumerate() {
                                 (color[i], depth[i]) =
                                     resolve(&[Part::Queued(0, n as f32)], &shaded[k..k + 1], inv_n);

@@ -47,6 +47,61 @@ pub(super) struct LaneBatches {
     waiting: Vec<Waiting>,
     /// The slot of the next fragment.
     next: u32,
+    /// The corners of the band's recent triangles.
+    pub corners: CornerCache,
+}
+
+/// How many triangles' corners a band keeps at hand.
+const CACHED: usize = 16;
+
+/// The corners of recently shaded triangles, by triangle id (slot: id
+/// mod 16): the quads and groups of a band come back to the same few
+/// triangles, whose corners are then gathered from the mesh once instead
+/// of once per quad or group.
+pub(super) struct CornerCache {
+    ids: [u32; CACHED],
+    corners: [Corners; CACHED],
+}
+
+impl CornerCache {
+    fn new() -> CornerCache {
+        CornerCache {
+            // No triangle has this id: every slot starts empty.
+            ids: [u32::MAX; CACHED],
+            corners: [Corners::NONE; CACHED],
+        }
+    }
+
+    /// Triangle `id`'s slot.
+    #[inline(always)]
+    fn slot(id: u32) -> usize {
+        id as usize % CACHED
+    }
+
+    /// Puts the corners of triangle `id` (`t`, of draw `draw`) in its slot
+    /// unless they are there.
+    #[inline]
+    fn fill(&mut self, data: &FrameData, draw: usize, id: u32, t: &Tri) {
+        let k = Self::slot(id);
+        if self.ids[k] != id {
+            self.corners[k] = data.corners(draw, t);
+            self.ids[k] = id;
+        }
+    }
+
+    /// The corners of triangle `id` if they are in its slot.
+    #[inline(always)]
+    fn peek(&self, id: u32) -> Option<&Corners> {
+        let k = Self::slot(id);
+        (self.ids[k] == id).then(|| &self.corners[k])
+    }
+
+    /// The corners of triangle `id` (`t`, of draw `draw`).
+    #[inline]
+    pub fn get(&mut self, data: &FrameData, draw: usize, id: u32, t: &Tri) -> &Corners {
+        self.fill(data, draw, id, t);
+        &self.corners[Self::slot(id)]
+    }
 }
 
 /// Up to four fragments of one draw, with their slots.
@@ -82,6 +137,7 @@ impl LaneBatches {
                 draws
             ],
             next: 0,
+            corners: CornerCache::new(),
         }
     }
 
@@ -96,7 +152,7 @@ impl LaneBatches {
         w.slots[w.len] = slot;
         w.len += 1;
         if w.len == 4 {
-            shade_group(data, draw as usize, w, sink);
+            shade_group(data, draw as usize, w, &mut self.corners, sink);
             w.len = 0;
         }
         slot
@@ -109,7 +165,7 @@ impl LaneBatches {
                 for k in w.len..4 {
                     w.group[k] = w.group[w.len - 1];
                 }
-                shade_group(data, draw, w, sink);
+                shade_group(data, draw, w, &mut self.corners, sink);
                 w.len = 0;
             }
         }
@@ -119,11 +175,17 @@ impl LaneBatches {
 /// Shades the four fragments of draw `draw` in `w` and hands those it
 /// holds to `sink` (linear colour, zero where not finite as the
 /// one-fragment path has it).
-fn shade_group(data: &FrameData, draw: usize, w: &Waiting, sink: &mut Sink) {
+fn shade_group(
+    data: &FrameData,
+    draw: usize,
+    w: &Waiting,
+    corners: &mut CornerCache,
+    sink: &mut Sink,
+) {
     let Some(lm) = data.lane_material(draw) else {
         return;
     };
-    let (lanes, depth) = data.gather(draw, &w.group);
+    let (lanes, depth) = data.gather(draw, &w.group, corners);
     let c = data.ctx.shade_lanes(lm, &lanes);
     for k in 0..w.len {
         let c = c.lane(k);
@@ -143,6 +205,18 @@ pub(super) struct Corners {
     color: [Vec4; 3],
     /// Counter-clockwise as the camera sees it.
     front: bool,
+}
+
+impl Corners {
+    /// What an empty cache slot holds.
+    const NONE: Corners = Corners {
+        world: [Vec3::ZERO; 3],
+        normal: [Vec3::ZERO; 3],
+        uv: [Vec2::ZERO; 3],
+        tangent: [Vec4::ZERO; 3],
+        color: [Vec4::ZERO; 3],
+        front: false,
+    };
 }
 
 /// Corner `j`'s `f` of four triangles, one per lane.
@@ -321,6 +395,7 @@ impl<'a> FrameData<'a> {
         q0: (i32, i32),
         ao: [f32; 4],
         lights: LightMask,
+        corners: &Corners,
     ) -> [(Vec3, f32); 4] {
         let draw = t.draw as usize;
         let (x, y) = q0;
@@ -334,7 +409,6 @@ impl<'a> FrameData<'a> {
             let all = (1u32 << self.pattern.len()) - 1;
             [0, 1, 2, 3].map(|k| self.shading_point(it, px[k].0, px[k].1, all))
         };
-        let corners = self.corners(draw, t);
         let l = V3::from_lanes([f[0].lambda, f[1].lambda, f[2].lambda, f[3].lambda]);
         let uv = |k: usize| {
             let c = &corners.uv;
@@ -354,7 +428,7 @@ impl<'a> FrameData<'a> {
         let footprints = [[fp[0]; 4], [fp[1]; 4], [fp[2]; 4]];
         let (lanes, depth) = self.lanes(
             draw,
-            &[&corners; 4],
+            &[corners; 4],
             l,
             lanes4(f[0].w, f[1].w, f[2].w, f[3].w),
             lanes4(ao[0], ao[1], ao[2], ao[3]),
@@ -371,8 +445,22 @@ impl<'a> FrameData<'a> {
 
     /// Four queued fragments of draw `draw` as the lanes take them, and
     /// their view depths.
-    fn gather(&self, draw: usize, frags: &[Pending; 4]) -> (Lanes, [f32; 4]) {
+    fn gather(
+        &self,
+        draw: usize,
+        frags: &[Pending; 4],
+        cache: &mut CornerCache,
+    ) -> (Lanes, [f32; 4]) {
         let tri = |k: usize| &self.tris[frags[k].id as usize];
+        for f in frags {
+            cache.fill(self, draw, f.id, &self.tris[f.id as usize]);
+        }
+        // Two of the lanes' triangles may share a slot; then the corners
+        // are gathered here.
+        let cached = frags.map(|f| cache.peek(f.id));
+        if let [Some(a), Some(b), Some(c), Some(d)] = cached {
+            return self.gather_from(draw, frags, &[a, b, c, d]);
+        }
         let c0 = self.corners(draw, tri(0));
         // Neighbouring fragments mostly share a triangle.
         let c1 = if frags[1].id == frags[0].id {
@@ -390,6 +478,16 @@ impl<'a> FrameData<'a> {
         } else {
             self.corners(draw, tri(3))
         };
+        self.gather_from(draw, frags, &[&c0, &c1, &c2, &c3])
+    }
+
+    /// `gather` with the lanes' triangles' corners at hand.
+    fn gather_from(
+        &self,
+        draw: usize,
+        frags: &[Pending; 4],
+        corners: &[&Corners; 4],
+    ) -> (Lanes, [f32; 4]) {
         let mut footprints = [[Footprint::Lod(0.0); 4]; MAX_SIZES];
         for (k, f) in frags.iter().enumerate() {
             for (s, fp) in footprints.iter_mut().enumerate() {
@@ -399,7 +497,7 @@ impl<'a> FrameData<'a> {
         let f = |k: usize| &frags[k];
         let (lanes, depth) = self.lanes(
             draw,
-            &[&c0, &c1, &c2, &c3],
+            corners,
             V3::from_lanes([f(0).lambda, f(1).lambda, f(2).lambda, f(3).lambda]),
             lanes4(f(0).w, f(1).w, f(2).w, f(3).w),
             lanes4(f(0).ao, f(1).ao, f(2).ao, f(3).ao),

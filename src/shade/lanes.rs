@@ -152,6 +152,40 @@ pub(super) struct MapSet<'c, 'a> {
     sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
 }
 
+impl Kind<'_> {
+    /// Each map the shading of `m` with these maps reads, in the order it
+    /// reads them (a map read twice, once).
+    #[inline]
+    fn for_each_map(&self, m: &Material, mut visit: impl FnMut(&Map)) {
+        match self {
+            Kind::BlinnPhong { kd, ks, normal } => {
+                kd.iter().for_each(&mut visit);
+                if m.illum != 0 {
+                    ks.iter().for_each(&mut visit);
+                    normal.iter().for_each(|(map, _)| visit(map));
+                }
+            }
+            Kind::Pbr(maps) => {
+                maps.base.iter().for_each(&mut visit);
+                maps.metallic_roughness.iter().for_each(&mut visit);
+                if let Some(o) = &maps.occlusion {
+                    let shared = maps
+                        .metallic_roughness
+                        .as_ref()
+                        .is_some_and(|mr| super::pbr4::same_lookup(o, mr));
+                    if !shared {
+                        visit(o);
+                    }
+                }
+                if m.pbr.emissive != Vec3::ZERO {
+                    maps.emissive.iter().for_each(&mut visit);
+                }
+                maps.normal.iter().for_each(|(map, _)| visit(map));
+            }
+        }
+    }
+}
+
 impl<'a> MapSet<'_, 'a> {
     /// `t` ready for four lookups, or None where the lanes cannot look it
     /// up as `ShadeContext::sample` does (a transform, a sampler of its
@@ -251,6 +285,7 @@ impl<'a> ShadeContext<'a> {
     /// `shade` of each (before its non-finite guard).
     pub fn shade_lanes(&self, lm: &LaneMaterial<'a>, f: &Lanes) -> V3 {
         let mut lookups = Lookups::new(f);
+        lm.kind.for_each_map(lm.material, |map| lookups.prefetch(map));
         match &lm.kind {
             Kind::BlinnPhong { kd, ks, normal } => {
                 self.blinn_phong_lanes(lm.material, [kd, ks], normal, &mut lookups, f)
@@ -408,13 +443,27 @@ impl<'f> Lookups<'f> {
         }
     }
 
+    /// Where the lanes' lookups of `map` fall (found once per slot).
+    #[inline(always)]
+    fn taps(&mut self, map: &Map) -> &Option<Taps4> {
+        let f = self.f;
+        self.taps[map.slot]
+            .get_or_insert_with(|| map.chain.taps4(f.u, f.v, &f.footprints[map.slot]))
+    }
+
+    /// Starts loading the texels `read(map)` will read.
+    #[inline]
+    pub fn prefetch(&mut self, map: &Map) {
+        if let Some(t) = self.taps(map) {
+            map.chain.prefetch(t);
+        }
+    }
+
     /// `map`'s red, green and blue at the four lanes.
     #[inline]
     pub fn read(&mut self, map: &Map) -> V3 {
         let f = self.f;
-        let taps = self.taps[map.slot]
-            .get_or_insert_with(|| map.chain.taps4(f.u, f.v, &f.footprints[map.slot]));
-        let [r, g, b] = match taps {
+        let [r, g, b] = match self.taps(map) {
             Some(t) => map.chain.read4(t, map.mode),
             None => map
                 .chain

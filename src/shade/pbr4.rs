@@ -62,7 +62,7 @@ impl<'a> Kind<'a> {
 
 /// Whether two maps are the same lookup (glTF's packed occlusion,
 /// roughness and metallic texture, referred to twice).
-fn same_lookup(a: &Map, b: &Map) -> bool {
+pub(super) fn same_lookup(a: &Map, b: &Map) -> bool {
     std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
 }
 

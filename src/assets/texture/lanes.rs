@@ -190,6 +190,35 @@ impl<'t> Chain<'t> {
         }
     }
 
+    /// Asks for the cache lines `read4` of `taps` will load, so that the
+    /// misses of several maps overlap instead of coming one map after the
+    /// other. A hint only: what `read4` returns does not change.
+    #[inline]
+    pub fn prefetch(&self, taps: &Taps4) {
+        if taps.shape != self.shape() {
+            return;
+        }
+        self.prefetch_place(&taps.near);
+        if let Some((far, _)) = &taps.far {
+            self.prefetch_place(far);
+        }
+    }
+
+    /// The lines of `place`'s inside lanes: the top-left texel's and the
+    /// bottom-right one's (the same line unless the footprint crosses a
+    /// block's edge).
+    #[inline(always)]
+    fn prefetch_place(&self, place: &Place4) {
+        for k in 0..4 {
+            if place.inside & (1 << k) != 0 {
+                let t = self.texels[place.level[k]];
+                let i = place.at[k];
+                prefetch_texel(t, i);
+                prefetch_texel(t, i + place.dx[k] + place.dy[k]);
+            }
+        }
+    }
+
     /// `sample_lod(mips, uv_k, mode, lod[k])` for the four lanes.
     fn sample_lod4(&self, u: Vec4, v: Vec4, lod: [f32; 4], mode: Wrap) -> Rgb4 {
         self.read4(&self.lod_taps4(u, v, lod), mode)
@@ -371,6 +400,24 @@ impl Place4 {
             inside,
         }
     }
+}
+
+/// A prefetch of texel `i` of `t` into every cache level (no effect on
+/// what is read, and none off x86-64).
+#[inline(always)]
+fn prefetch_texel(t: &[u32], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // A prefetch never faults; the address is kept inside the slice
+        // anyway (wrapping_add of an index `Place4::new` checked).
+        let p = t.as_ptr().wrapping_add(i.min(t.len().saturating_sub(1)));
+        // SAFETY: `_mm_prefetch` only hints the cache; it reads nothing
+        // the program sees, and SSE is part of x86-64's base set.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p as *const i8) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (t, i);
 }
 
 /// a (1 - f) + b f per channel, as `Vec4::lerp`.
