@@ -400,8 +400,7 @@ impl<'a> FrameData<'a> {
                             let it = cache.get(id, t);
                             let ao = ao.map_or([1.0; 4], |a| quad.map(|i| a[i]));
                             let corners = b.corners.get(self, t.draw as usize, id, t);
-                            let shaded =
-                                self.shade_quad(t, it, lm, q0, ao, lights_at(qx), corners);
+                            let shaded = self.shade_quad(t, it, lm, q0, ao, lights_at(qx), corners);
                             for (k, &i) in quad.iter().enumerate() {
                                 (color[i], depth[i]) =
                                     resolve(&[Part::Queued(0, n as f32)], &shaded[k..k + 1], inv_n);

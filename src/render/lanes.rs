@@ -274,6 +274,7 @@ impl<'a> FrameData<'a> {
     /// one fragment (the same operations in the same order, four at a
     /// time); and their view depths.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     pub(super) fn lanes(
         &self,
         draw: usize,
@@ -387,6 +388,7 @@ impl<'a> FrameData<'a> {
     /// where not finite) and view depth, as `fragment` and the lanes give
     /// them pixel by pixel. The quad's texture derivatives are its lanes'
     /// differences (what `gradients0` computes).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_quad(
         &self,
         t: &Tri,

@@ -285,7 +285,8 @@ impl<'a> ShadeContext<'a> {
     /// `shade` of each (before its non-finite guard).
     pub fn shade_lanes(&self, lm: &LaneMaterial<'a>, f: &Lanes) -> V3 {
         let mut lookups = Lookups::new(f);
-        lm.kind.for_each_map(lm.material, |map| lookups.prefetch(map));
+        lm.kind
+            .for_each_map(lm.material, |map| lookups.prefetch(map));
         match &lm.kind {
             Kind::BlinnPhong { kd, ks, normal } => {
                 self.blinn_phong_lanes(lm.material, [kd, ks], normal, &mut lookups, f)
@@ -432,23 +433,31 @@ fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
 /// lookups fall, found once for all its maps (`Texture::taps4`).
 pub(super) struct Lookups<'f> {
     f: &'f Lanes,
-    taps: [Option<Option<Taps4>>; MAX_SIZES],
+    /// Per slot, once found (bit k of `found` for slot k): where its
+    /// lookups fall, or None where some lane takes anisotropic probes.
+    taps: [Option<Taps4>; MAX_SIZES],
+    found: u32,
 }
 
 impl<'f> Lookups<'f> {
     fn new(f: &'f Lanes) -> Lookups<'f> {
         Lookups {
             f,
-            taps: Default::default(),
+            taps: [None, None, None],
+            found: 0,
         }
     }
 
     /// Where the lanes' lookups of `map` fall (found once per slot).
     #[inline(always)]
     fn taps(&mut self, map: &Map) -> &Option<Taps4> {
-        let f = self.f;
-        self.taps[map.slot]
-            .get_or_insert_with(|| map.chain.taps4(f.u, f.v, &f.footprints[map.slot]))
+        let (f, s) = (self.f, map.slot);
+        if self.found & (1 << s) == 0 {
+            self.found |= 1 << s;
+            map.chain
+                .taps4_into(f.u, f.v, &f.footprints[s], &mut self.taps[s]);
+        }
+        &self.taps[s]
     }
 
     /// Starts loading the texels `read(map)` will read.

@@ -129,16 +129,41 @@ impl<'t> Chain<'t> {
         Some(self.lod_taps4(u, v, lod))
     }
 
+    /// `*out = self.taps4(u, v, fps)`, written in place.
+    #[inline]
+    pub fn taps4_into(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], out: &mut Option<Taps4>) {
+        let mut lod = [0.0f32; 4];
+        for k in 0..4 {
+            match fps[k] {
+                Footprint::Lod(l) => lod[k] = l,
+                Footprint::Probes { .. } => {
+                    *out = None;
+                    return;
+                }
+            }
+        }
+        *out = Some(self.lod_taps4(u, v, lod));
+    }
+
     /// The taps of `sample_lod(mips, uv_k, mode, lod[k])` per lane: the
     /// level `lod[k]` selects, and the next one where it blends two.
+    #[inline(always)]
     fn lod_taps4(&self, u: Vec4, v: Vec4, lod: [f32; 4]) -> Taps4 {
         let mut near = [0usize; 4];
         let mut far = [0usize; 4];
         let mut weight = [0.0f32; 4];
         let mut two = false;
+        // The lanes of a quad of one triangle share one level of detail:
+        // then the first lane's choice is every lane's.
+        let lod_bits = lod.map(f32::to_bits);
+        let lanes = if lod_bits.iter().all(|&b| b == lod_bits[0]) {
+            1
+        } else {
+            4
+        };
         if let Some(mips) = self.mips {
             let top = mips.len() as f32;
-            for k in 0..4 {
+            for k in 0..lanes {
                 if lod[k] <= 0.0 || lod[k].is_nan() {
                     continue;
                 }
@@ -153,6 +178,11 @@ impl<'t> Chain<'t> {
                     weight[k] = f;
                     two = true;
                 }
+            }
+            if lanes == 1 {
+                near = [near[0]; 4];
+                far = [far[0]; 4];
+                weight = [weight[0]; 4];
             }
         }
         let level = |i: usize| self.level(i);
@@ -204,17 +234,13 @@ impl<'t> Chain<'t> {
         }
     }
 
-    /// The lines of `place`'s inside lanes: the top-left texel's and the
-    /// bottom-right one's (the same line unless the footprint crosses a
-    /// block's edge).
+    /// The line of each inside lane's top-left texel (the whole footprint
+    /// lies in it unless it crosses a block's edge).
     #[inline(always)]
     fn prefetch_place(&self, place: &Place4) {
         for k in 0..4 {
             if place.inside & (1 << k) != 0 {
-                let t = self.texels[place.level[k]];
-                let i = place.at[k];
-                prefetch_texel(t, i);
-                prefetch_texel(t, i + place.dx[k] + place.dy[k]);
+                prefetch_texel(self.texels[place.level[k]], place.at[k]);
             }
         }
     }
@@ -409,9 +435,9 @@ fn prefetch_texel(t: &[u32], i: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        // A prefetch never faults; the address is kept inside the slice
-        // anyway (wrapping_add of an index `Place4::new` checked).
-        let p = t.as_ptr().wrapping_add(i.min(t.len().saturating_sub(1)));
+        // A prefetch never faults, and `i` is an inside lane's texel
+        // (`Place4::new`), so the address lies in the slice anyway.
+        let p = t.as_ptr().wrapping_add(i);
         // SAFETY: `_mm_prefetch` only hints the cache; it reads nothing
         // the program sees, and SSE is part of x86-64's base set.
         unsafe { _mm_prefetch::<_MM_HINT_T0>(p as *const i8) };
@@ -512,6 +538,10 @@ mod tests {
                                 mips: Some(&chain),
                             };
                             fps[k] = t.footprint(g, &f);
+                        }
+                        if round % 4 == 1 {
+                            // A quad of one triangle: one footprint.
+                            fps = [fps[0]; 4];
                         }
                         let mips = if round % 5 == 4 {
                             None
