@@ -264,7 +264,7 @@ impl Shadows<'_> {
 fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     let n = m.size as i32;
     // Box [f - 1.5, f + 1.5] per axis; texel i covers [i, i+1].
-    let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
+    let (bx, by) = (floor_i32(fx - 1.5), floor_i32(fy - 1.5));
     let w = |i: i32, f: f32| {
         let lo = (i as f32).max(f - 1.5);
         let hi = (i as f32 + 1.0).min(f + 1.5);
@@ -307,6 +307,15 @@ fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     (((0.0 + t.x) + t.y) + t.z) + t.w
 }
 
+/// `x.floor() as i32` for x in [-2^31, 2^31) (the PCF box's corner, from
+/// texel coordinates inside the map), without a call to libm's `floorf`
+/// (x86-64's base set has no rounding instruction).
+#[inline(always)]
+fn floor_i32(x: f32) -> i32 {
+    let t = x as i32;
+    if t as f32 > x { t - 1 } else { t }
+}
+
 /// The cube face (+X, -X, +Y, -Y, +Z, -Z) a direction falls on.
 #[inline]
 pub fn cube_face(d: Vec3) -> usize {
@@ -325,6 +334,25 @@ pub fn cube_face(d: Vec3) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `floor_i32` is `floor` wherever the PCF box can be: every f32 of
+    /// [-1.5, 16384) near the integers and a sweep between them.
+    #[test]
+    fn floor_without_libm_is_floor() {
+        let mut xs = vec![-1.5f32, -1.0, -0.5, -0.0, 0.0, 1e-30, -1e-30, 16383.99];
+        for i in -2..16384i32 {
+            let f = i as f32;
+            xs.extend([f, f.next_down(), f.next_up(), f + 0.5]);
+        }
+        let mut x = -1.5f32;
+        while x < 4100.0 {
+            xs.push(x);
+            x += 0.013;
+        }
+        for x in xs {
+            assert_eq!(floor_i32(x), x.floor() as i32, "{x}");
+        }
+    }
 
     /// An 8x8 orthographic map of a light 5 units up, looking down -Y over
     /// [-1, 1] x [-1, 1], distances 0..10, with an occluder at height 1
@@ -395,7 +423,7 @@ mod tests {
     /// form.
     fn pcf_one_by_one(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
         let n = m.size as i32;
-        let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
+        let (bx, by) = (floor_i32(fx - 1.5), floor_i32(fy - 1.5));
         let w = |i: i32, f: f32| {
             let lo = (i as f32).max(f - 1.5);
             let hi = (i as f32 + 1.0).min(f + 1.5);
