@@ -109,9 +109,9 @@ impl<'a> FrameData<'a> {
         let mut cache = InterpolatorCache::default();
         for (i, g) in out.iter_mut().enumerate() {
             let (id, mask) = if n == 1 {
-                (vis.id[i], 1)
+                (vis.id()[i], 1)
             } else {
-                fragments(&vis.id[i * n..(i + 1) * n])
+                fragments(&vis.id()[i * n..(i + 1) * n])
                     .into_iter()
                     .filter(|f| f.0 != NO_TRIANGLE)
                     .fold((NO_TRIANGLE, 0u32), |best, f| {
@@ -160,9 +160,9 @@ impl<'a> FrameData<'a> {
         for (i, a) in out.iter_mut().enumerate() {
             let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
             let frags = if n == 1 {
-                smallvec::smallvec![(vis.id[i], 1)]
+                smallvec::smallvec![(vis.id()[i], 1)]
             } else {
-                fragments(&vis.id[i * n..(i + 1) * n])
+                fragments(&vis.id()[i * n..(i + 1) * n])
             };
             let mut best: Option<(f32, u32, Fragment)> = None;
             for (id, mask) in frags {
@@ -233,7 +233,7 @@ impl<'a> FrameData<'a> {
             let it = Interpolator::new(t);
             raster_triangle(t, rect, |px, py, z| {
                 let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
-                if !in_front(z, vis.depth[i], self.reverse) {
+                if !in_front(z, vis.depth()[i], self.reverse) {
                     return;
                 }
                 let g = if self.grads {
@@ -265,7 +265,7 @@ impl<'a> FrameData<'a> {
             let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
             let mut m = 0u32;
             for (s, &zs) in z.iter().enumerate().take(n) {
-                if mask & (1 << s) != 0 && in_front(zs, vis.depth[i * n + s], self.reverse) {
+                if mask & (1 << s) != 0 && in_front(zs, vis.depth()[i * n + s], self.reverse) {
                     m |= 1 << s;
                 }
             }
@@ -337,9 +337,9 @@ impl<'a> FrameData<'a> {
         let filled = flat_bg.is_some();
         let empty_at = |i: usize| {
             if n == 1 {
-                vis.id[i] == NO_TRIANGLE
+                vis.id()[i] == NO_TRIANGLE
             } else {
-                vis.id[i * n..(i + 1) * n]
+                vis.id()[i * n..(i + 1) * n]
                     .iter()
                     .all(|&id| id == NO_TRIANGLE)
             }
@@ -347,6 +347,7 @@ impl<'a> FrameData<'a> {
         // Per row: the span of pixels some triangle covers (over a flat
         // background only those are visited; the others are filled here).
         let mut spans = vec![(usize::MAX, 0usize); th];
+        let drawn = vis.drawn_columns();
         for (y, span) in spans.iter_mut().enumerate() {
             let row = y * tw..(y + 1) * tw;
             if !filled {
@@ -354,7 +355,13 @@ impl<'a> FrameData<'a> {
                 continue;
             }
             let (c, d) = (&mut color[row.clone()], &mut depth[row]);
-            for x in 0..tw {
+            // Outside the drawn columns every pixel is empty.
+            let (lo, hi) = drawn;
+            c[..lo].fill(self.bg);
+            d[..lo].fill(f32::INFINITY);
+            c[hi..].fill(self.bg);
+            d[hi..].fill(f32::INFINITY);
+            for x in lo..hi {
                 if empty_at(y * tw + x) {
                     c[x] = self.bg;
                     d[x] = f32::INFINITY;
@@ -389,8 +396,8 @@ impl<'a> FrameData<'a> {
                 if lanes.is_some() && qx + 1 < tw && qy + 1 < th {
                     let i0 = qy * tw + qx;
                     let quad = [i0, i0 + 1, i0 + tw, i0 + tw + 1];
-                    let id = vis.id[i0 * n];
-                    let one = |i: usize| vis.id[i * n..(i + 1) * n].iter().all(|&s| s == id);
+                    let id = vis.id()[i0 * n];
+                    let one = |i: usize| vis.id()[i * n..(i + 1) * n].iter().all(|&s| s == id);
                     if id != NO_TRIANGLE && quad.iter().all(|&i| one(i)) {
                         let t = &self.tris[id as usize];
                         if let (Some(lm), Some(b)) =
@@ -418,7 +425,7 @@ impl<'a> FrameData<'a> {
                         continue;
                     }
                     let i = y * tw + x;
-                    let ids = &vis.id[i * n..(i + 1) * n];
+                    let ids = &vis.id()[i * n..(i + 1) * n];
                     let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
                     let empty = ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE);
                     let bg = match flat_bg {

@@ -65,11 +65,11 @@ impl Culling {
                 let r = &mut range[x / TILE];
                 let i = (y * tw + x) * n;
                 for s in i..i + n {
-                    let id = vis.id[s];
+                    let id = vis.id()[s];
                     if id == NO_TRIANGLE {
                         continue;
                     }
-                    let z = vis.depth[s] as f64;
+                    let z = vis.depth()[s] as f64;
                     // With MSAA the shading point lies up to a pixel from
                     // the sample along each axis.
                     let g = if n == 1 {
@@ -212,13 +212,12 @@ mod tests {
             x1: 64,
             y1: 40,
         };
-        let mut vis = Visibility::new(rect, false, &[(0, 0)]);
-        vis.depth.fill(wall.z / wall.w);
-        vis.id.fill(0);
+        let mut id = vec![0; 64 * 16];
         // The middle 16 columns only: the left tile shows nothing.
         for y in 0..16 {
-            vis.id[y * 64..y * 64 + 16].fill(NO_TRIANGLE);
+            id[y * 64..y * 64 + 16].fill(NO_TRIANGLE);
         }
+        let vis = Visibility::from_parts(rect, &[(0, 0)], vec![wall.z / wall.w; 64 * 16], id);
         let lights = [
             // A small pool at the wall's center (x within 0.5 of 0, that
             // is columns 26..38: tiles 1 and 2).
