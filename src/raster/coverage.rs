@@ -357,9 +357,11 @@ pub struct Visibility {
     clear: f32,
 }
 
+/// A dropped tile's cleared buffers: depth, ids and the clear depth.
+type Spare = (Vec<f32>, Vec<u32>, f32);
+
 thread_local! {
-    /// Cleared buffers of dropped tiles (depth, ids, the clear depth).
-    static SPARE: RefCell<Vec<(Vec<f32>, Vec<u32>, f32)>> = const { RefCell::new(Vec::new()) };
+    static SPARE: RefCell<Vec<Spare>> = const { RefCell::new(Vec::new()) };
 }
 
 /// At most this many spare buffer pairs per thread.
