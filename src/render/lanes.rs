@@ -408,8 +408,17 @@ impl<'a> FrameData<'a> {
         let f = if self.pattern.len() == 1 {
             centers
         } else {
+            // `shading_point`: the center where the triangle covers it
+            // (computed above), else the covered samples' centroid.
             let all = (1u32 << self.pattern.len()) - 1;
-            [0, 1, 2, 3].map(|k| self.shading_point(it, px[k].0, px[k].1, all))
+            [0, 1, 2, 3].map(|k| {
+                let (x, y) = px[k];
+                if it.covers_center(x, y) {
+                    centers[k]
+                } else {
+                    self.shading_point(it, x, y, all)
+                }
+            })
         };
         let l = V3::from_lanes([f[0].lambda, f[1].lambda, f[2].lambda, f[3].lambda]);
         let uv = |k: usize| {
