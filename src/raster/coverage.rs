@@ -604,13 +604,7 @@ mod tests {
     /// and nothing is drawn outside `drawn_columns`.
     #[test]
     fn reused_tiles_equal_fresh_ones() {
-        let mut seed = 0x51_7cc1_b727_220a_u64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut rnd = crate::testing::xorshift(0x51_7cc1_b727_220a);
         const FOUR: &[(i8, i8)] = &[(-2, -6), (6, -2), (-6, 2), (2, 6)];
         for (round, pattern) in [&[(0i8, 0i8)][..], FOUR]
             .iter()

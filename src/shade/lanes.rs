@@ -152,6 +152,12 @@ pub(super) struct MapSet<'c, 'a> {
     sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
 }
 
+/// Whether two maps are the same lookup (glTF's packed occlusion,
+/// roughness and metallic texture, referred to twice).
+pub(super) fn same_lookup(a: &Map, b: &Map) -> bool {
+    std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
+}
+
 impl Kind<'_> {
     /// Each map the shading of `m` with these maps reads, in the order it
     /// reads them (a map read twice, once).
@@ -172,7 +178,7 @@ impl Kind<'_> {
                     let shared = maps
                         .metallic_roughness
                         .as_ref()
-                        .is_some_and(|mr| super::pbr4::same_lookup(o, mr));
+                        .is_some_and(|mr| same_lookup(o, mr));
                     if !shared {
                         visit(o);
                     }

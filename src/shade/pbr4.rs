@@ -16,7 +16,7 @@ use glam::{Vec3, Vec4};
 
 use super::ShadeContext;
 use super::env::{EnvLight, dominant_direction4};
-use super::lanes::{Kind, Lanes, Lit, Lookups, Map, MapSet, PbrMaps};
+use super::lanes::{Kind, Lanes, Lit, Lookups, MapSet, PbrMaps, same_lookup};
 use super::pbr::{MIN_ALPHA, specular_occlusion};
 use crate::scene::Material;
 use crate::simd::{V3, clamp01};
@@ -58,12 +58,6 @@ impl<'a> Kind<'a> {
             normal,
         }))
     }
-}
-
-/// Whether two maps are the same lookup (glTF's packed occlusion,
-/// roughness and metallic texture, referred to twice).
-pub(super) fn same_lookup(a: &Map, b: &Map) -> bool {
-    std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
 }
 
 /// `x.powi(5)` per lane: x (x^2 x^2), the products LLVM makes of it.
