@@ -25,6 +25,11 @@ Usage (from the repository root, after `cargo build --release`):
     pip install mitsuba==3.5.2 numpy pillow
     python3 benches/mitsuba_env.py                       # all four HDRIs, ~4 min
     python3 benches/mitsuba_env.py --hdri courtyard --spp 256
+    # The glossy metal row against softraster's own ray-traced reference
+    # (no Mitsuba needed): close, then apart.
+    python3 benches/mitsuba_env.py --spheres metals --reference sampled --samples 512
+    python3 benches/mitsuba_env.py --spheres metals --reference sampled --samples 512 \
+        --spacing 4.8 --width 1200 --height 320
 """
 import argparse
 import math
@@ -63,7 +68,17 @@ def parse_args():
                         "the lighting alone (use --width 1200 --height 320 to keep their size)")
     p.add_argument("--samples", type=int, default=256,
                    help="softraster's environment.samples for the sampled method")
+    p.add_argument("--spheres", choices=["mixed", "metals"], default="mixed",
+                   help="mixed: the dielectric and four metals above; metals: five metals "
+                        "(base colour 0.9) of roughness 0, 0.25, 0.5, 0.75 and 1, the "
+                        "issue's glossy sphere row")
+    p.add_argument("--reference", choices=["mitsuba", "sampled"], default="mitsuba",
+                   help="what the methods are measured against: Mitsuba 3, or softraster's "
+                        "own `sampled` method at --samples (needs no Mitsuba)")
     return p.parse_args()
+
+
+METALS = [(f"metal r{r}", 0.9, 1.0, r) for r in (0.0, 0.25, 0.5, 0.75, 1.0)]
 
 
 def write_sphere(path, seg=128, rings=64):
@@ -218,8 +233,11 @@ def sphere_boxes(a):
 
 
 def main():
-    global SPACING, EYE
+    global SPACING, EYE, SPHERES
     a = parse_args()
+    if a.spheres == "metals":
+        SPHERES = METALS
+    methods = list(METHODS) if a.reference == "mitsuba" else ["prefiltered", "prefiltered+ao"]
     SPACING = a.spacing
     EYE = (0.0, 0.0, 9.0 * a.spacing / 2.4)
     names = a.hdri or ["studio", "courtyard", "sunset", "city"]
@@ -231,36 +249,43 @@ def main():
         hdri = os.path.abspath(os.path.join(a.hdri_dir, f"{name}.exr"))
         if not os.path.exists(hdri):
             sys.exit(f"missing environment: {hdri}")
-        ref = os.path.join(a.out, f"{name}_mitsuba.png")
-        if not os.path.exists(ref):
-            render_mitsuba(a, hdri, obj, ref)
+        if a.reference == "mitsuba":
+            ref = os.path.join(a.out, f"{name}_{a.spheres}_mitsuba.png")
+            if not os.path.exists(ref):
+                render_mitsuba(a, hdri, obj, ref)
+        else:
+            scene = os.path.join(a.out, f"{name}_{a.spheres}_reference.toml")
+            write_scene(scene, a, hdri, obj, "sampled")
+            ref = render_softraster(a, scene, os.path.join(a.out, f"{name}_{a.spheres}_reference"))
         result = {}
-        for method in METHODS:
-            tag = method.replace("+", "_")
+        for method in methods:
+            tag = a.spheres + "_" + method.replace("+", "_")
             scene = os.path.join(a.out, f"{name}_{tag}.toml")
             write_scene(scene, a, hdri, obj, method)
             png = render_softraster(a, scene, os.path.join(a.out, f"{name}_{tag}"))
             whole = flip(a, ref, png)
             parts = []
             for k, box in enumerate(sphere_boxes(a)):
-                rc = os.path.join(a.out, f"{name}_mitsuba_s{k}.png")
+                rc = os.path.join(a.out, f"{name}_{a.spheres}_{a.reference}_s{k}.png")
                 tc = os.path.join(a.out, f"{name}_{tag}_s{k}.png")
                 crop(ref, box, rc)
                 crop(png, box, tc)
                 parts.append(flip(a, rc, tc))
             result[method] = (whole, parts)
         rows.append((name, result))
-        print(f"{name}: " + ", ".join(f"{m} {result[m][0]:.4f}" for m in METHODS), flush=True)
+        print(f"{name}: " + ", ".join(f"{m} {result[m][0]:.4f}" for m in methods), flush=True)
     print()
     print("| environment | method | whole frame | " + " | ".join(s[0] for s in SPHERES) + " |")
     print("|---|---|---|" + "---|" * len(SPHERES))
     for name, result in rows:
-        for method in METHODS:
+        for method in methods:
             whole, parts = result[method]
             print(f"| {name} | {method} | {whole:.4f} | " +
                   " | ".join(f"{p:.4f}" for p in parts) + " |")
-    print(f"\nmean FLIP against Mitsuba 3 ({a.spp} spp, path max_depth 2); "
-          f"softraster sampled at {a.samples} samples; images in {a.out}")
+    against = (f"Mitsuba 3 ({a.spp} spp, path max_depth 2)" if a.reference == "mitsuba"
+               else f"softraster's sampled method ({a.samples} samples)")
+    print(f"\nmean FLIP against {against}; softraster sampled at {a.samples} samples; "
+          f"images in {a.out}")
 
 
 if __name__ == "__main__":
