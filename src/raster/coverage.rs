@@ -342,8 +342,7 @@ pub const NO_TRIANGLE: u32 = u32::MAX;
 ///
 /// The buffers are reused: a dropped tile clears the columns it drew into
 /// and leaves its buffers to the next tile of its thread, so a tile costs
-/// no allocation and no clear of the columns no triangle reaches (about
-/// two thirds of a turntable's frame).
+/// no allocation and no clear of the columns no triangle reaches.
 pub struct Visibility {
     pub rect: TileRect,
     /// The sample offsets (one entry, (0, 0), without MSAA).

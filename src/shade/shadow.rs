@@ -423,7 +423,7 @@ mod tests {
     /// form.
     fn pcf_one_by_one(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
         let n = m.size as i32;
-        let (bx, by) = (floor_i32(fx - 1.5), floor_i32(fy - 1.5));
+        let (bx, by) = ((fx - 1.5).floor() as i32, (fy - 1.5).floor() as i32);
         let w = |i: i32, f: f32| {
             let lo = (i as f32).max(f - 1.5);
             let hi = (i as f32 + 1.0).min(f + 1.5);

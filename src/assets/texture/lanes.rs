@@ -119,14 +119,9 @@ impl<'t> Chain<'t> {
     /// where some lane takes anisotropic probes.
     #[inline]
     pub fn taps4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4]) -> Option<Taps4> {
-        let mut lod = [0.0f32; 4];
-        for k in 0..4 {
-            match fps[k] {
-                Footprint::Lod(l) => lod[k] = l,
-                Footprint::Probes { .. } => return None,
-            }
-        }
-        Some(self.lod_taps4(u, v, lod))
+        let mut out = None;
+        self.taps4_into(u, v, fps, &mut out);
+        out
     }
 
     /// `*out = self.taps4(u, v, fps)`, written in place.
