@@ -342,19 +342,23 @@ impl Output {
     }
 }
 
-/// A frame's files from its buffers, as the plan names them, and (with
-/// `color`) its display image for a video.
+/// A frame's files from its buffers and its display image (made where
+/// the plan writes a colour file or `color` asks for it), as the plan
+/// names them, and (with `color`) the display image for a video.
 fn outputs(
     frame: &Frame,
+    image: Option<Image8>,
     files: FrameFiles,
-    scene: &Scene,
     color: bool,
 ) -> (Vec<Output>, Option<Image8>) {
     let (width, height) = (frame.width, frame.height);
     let mut out = Vec::new();
-    let image = (files.color.is_some() || color).then(|| output::resolve(frame, &scene.settings));
-    if let (Some(p), Some(img)) = (files.color, &image) {
-        out.push(Output::Png(p, img.clone()));
+    let mut image = image;
+    if let (Some(p), Some(img)) = (files.color, image.take()) {
+        if color {
+            image = Some(img.clone());
+        }
+        out.push(Output::Png(p, img));
     }
     if let Some(p) = files.depth {
         out.push(Output::Exr(p, width, height, "Z", frame.depth.clone()));
@@ -400,7 +404,7 @@ fn outputs(
             out.push(Output::ExrChannels(p, width, height, c));
         }
     }
-    (out, if color { image } else { None })
+    (out, image)
 }
 
 /// `scene` with `render.exposure = "auto"` resolved to stops.
@@ -563,8 +567,15 @@ impl RenderJob {
                     continue;
                 }
                 let t0 = Instant::now();
-                renderer.render(scene, cam, frame, &mut buffer);
-                let (outputs, color) = outputs(&buffer, files, scene, in_video);
+                let image = if files.color.is_some() || in_video {
+                    let mut image = Image8::empty();
+                    renderer.render_display(scene, cam, frame, &mut buffer, &mut image);
+                    Some(image)
+                } else {
+                    renderer.render(scene, cam, frame, &mut buffer);
+                    None
+                };
+                let (outputs, color) = outputs(&buffer, image, files, in_video);
                 let done = FrameDone {
                     frame,
                     camera,

@@ -4,7 +4,7 @@
 //! accurate to a twentieth of a code, kept as 8.7 KB of segments), and the
 //! plain byte encoding of data values. Textures decode
 //! with it, mip chains re-encode with it, the output resolve encodes with
-//! it; tone mapping (a display decision) lives in `output::tonemap`.
+//! it; tone mapping (a display decision) lives in `shade::tonemap`.
 
 use std::sync::OnceLock;
 

@@ -29,6 +29,14 @@ struct End {
 /// distance (a polygon offset for lines and points).
 const DEPTH_SLACK: f32 = 2e-3;
 
+/// Whether some model of the scene has lines or points to draw.
+pub(super) fn any(fs: &FrameSetup) -> bool {
+    fs.scene
+        .models
+        .iter()
+        .any(|m| !m.mesh.lines.is_empty() || !m.mesh.points.is_empty())
+}
+
 pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, out: &mut Frame) {
     let s = &fs.scene.settings;
     let view = fs.camera.view_from_world();

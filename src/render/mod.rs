@@ -24,6 +24,7 @@
 
 mod ao_pass;
 mod band;
+pub mod display;
 mod exposure;
 mod fragment;
 mod frame;
@@ -43,6 +44,7 @@ use std::sync::{Arc, OnceLock};
 use glam::Vec3;
 use rayon::prelude::*;
 
+pub use display::{Image8, resolve};
 pub use exposure::auto_exposure;
 pub use frame::{AovPixel, Frame};
 pub use setup::FrameSetup;
@@ -170,12 +172,42 @@ impl Renderer {
         let fs = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
         if k == 1 {
-            self.render_at(&fs, s.width, s.height, out);
+            self.render_at(&fs, s.width, s.height, out, None);
             return;
         }
         let mut big = Frame::new(0, 0);
-        self.render_at(&fs, s.width * k, s.height * k, &mut big);
+        self.render_at(&fs, s.width * k, s.height * k, &mut big, None);
         frame::downsample(&big, k, out);
+    }
+
+    /// `render`, and `*image = resolve(out, &scene.settings)`: the display
+    /// bytes of each band are made as soon as the band is shaded (while
+    /// its colour is in the cache) unless a later pass (the line overlay,
+    /// supersampling's filter) still changes the frame.
+    pub fn render_display(
+        &self,
+        scene: &Scene,
+        camera: usize,
+        frame: u32,
+        out: &mut Frame,
+        image: &mut Image8,
+    ) {
+        if !self.serves(scene) {
+            return Renderer::new(scene)
+                .with_lanes(self.lanes)
+                .with_light_culling(self.light_culling)
+                .render_display(scene, camera, frame, out, image);
+        }
+        let fs = FrameSetup::new(scene, camera, frame);
+        let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
+        if k == 1 {
+            self.render_at(&fs, s.width, s.height, out, Some(image));
+            return;
+        }
+        let mut big = Frame::new(0, 0);
+        self.render_at(&fs, s.width * k, s.height * k, &mut big, None);
+        frame::downsample(&big, k, out);
+        display::resolve_into(out, s, image);
     }
 
     /// Builds every texture's mip chain now (a benchmark counts them as
@@ -312,8 +344,16 @@ impl Renderer {
             .collect()
     }
 
-    /// Renders the frame at `width` x `height` pixels: the passes in order.
-    fn render_at(&self, fs: &FrameSetup, width: u32, height: u32, out: &mut Frame) {
+    /// Renders the frame at `width` x `height` pixels: the passes in order;
+    /// with `display`, resolved into it too.
+    fn render_at(
+        &self,
+        fs: &FrameSetup,
+        width: u32,
+        height: u32,
+        out: &mut Frame,
+        mut display: Option<&mut Image8>,
+    ) {
         let s = &fs.scene.settings;
         out.resize(width, height);
         let pattern = sample_pattern(s.msaa).unwrap_or(&[(0, 0)]);
@@ -369,19 +409,30 @@ impl Renderer {
                 light_culling: self.light_culling,
             },
         );
-        self.bands(&data, &geo, tracer.as_ref(), out);
-        if !s.shading.is_data_view() {
+        let overlay = !s.shading.is_data_view() && lines::any(fs);
+        let fused = if overlay {
+            None
+        } else {
+            display.as_deref_mut()
+        };
+        self.bands(&data, &geo, tracer.as_ref(), out, fused);
+        if overlay {
             lines::draw(fs, &verts, width as f32 / s.width as f32, out);
+            if let Some(image) = display {
+                display::resolve_into(out, s, image);
+            }
         }
     }
 
-    /// Visibility, AO and shading, band by band, into `out`.
+    /// Visibility, AO and shading, band by band, into `out`; with
+    /// `display`, each band's display bytes as soon as it is shaded.
     fn bands(
         &self,
         data: &fragment::FrameData,
         geo: &Geometry,
         tracer: Option<&Tracer>,
         out: &mut Frame,
+        display: Option<&mut Image8>,
     ) {
         let bins = geo.bins();
         let grid = &geo.grid;
@@ -395,6 +446,23 @@ impl Renderer {
             out.aov.clear();
         }
         let bands = out.color.len().div_ceil(band);
+        let width = out.width as usize;
+        let encoder = display
+            .as_ref()
+            .map(|_| display::Encoder::new(&data.fs.scene.settings));
+        let bytes: Vec<&mut [u8]> = match (display, encoder) {
+            (Some(image), Some(e)) => {
+                e.shape(out.width, out.height, image);
+                image.data.chunks_mut(band * e.channels()).collect()
+            }
+            _ => (0..bands).map(|_| Default::default()).collect(),
+        };
+        // A band's display bytes, from its colour just shaded.
+        let show = |color: &[glam::Vec4], bytes: &mut [u8]| {
+            if let Some(e) = &encoder {
+                e.rows(color, width, bytes);
+            }
+        };
         if data.fs.scene.settings.ao.method == AoMethod::Off {
             out.ao.clear();
             let chunks = aov_chunks(&mut out.aov, band, bands);
@@ -402,13 +470,15 @@ impl Renderer {
                 .par_chunks_mut(band)
                 .zip(out.depth.par_chunks_mut(band))
                 .zip(chunks)
+                .zip(bytes)
                 .enumerate()
-                .for_each(|(ti, ((color, depth), aov))| {
+                .for_each(|(ti, (((color, depth), aov), bytes))| {
                     let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
                     if !aov.is_empty() {
                         data.aovs(&vis, aov);
                     }
                     data.shade_band(&vis, blended, None, color, depth);
+                    show(color, bytes);
                 });
             return;
         }
@@ -432,11 +502,13 @@ impl Renderer {
             .zip(out.ao.par_chunks(band))
             .zip(visible)
             .zip(chunks)
-            .for_each(|((((color, depth), ao), (vis, blended)), aov)| {
+            .zip(bytes)
+            .for_each(|(((((color, depth), ao), (vis, blended)), aov), bytes)| {
                 if !aov.is_empty() {
                     data.aovs(&vis, aov);
                 }
                 data.shade_band(&vis, blended, Some(ao), color, depth);
+                show(color, bytes);
             });
     }
 

@@ -14,6 +14,7 @@ pub mod pbr;
 mod pbr4;
 pub mod shadow;
 pub mod sheen;
+pub mod tonemap;
 
 use std::cell::Cell;
 

@@ -398,10 +398,10 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     let mut times = Vec::new();
     let mut png_ms = 0.0;
     let mut frame = Frame::new(0, 0);
+    let mut img = output::Image8::empty();
     for f in 0..args.frames {
         let t = Instant::now();
-        renderer.render(&scene, 0, f, &mut frame);
-        let img = output::resolve(&frame, &scene.settings);
+        renderer.render_display(&scene, 0, f, &mut frame, &mut img);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         let t = Instant::now();
         let dir = args.out.clone().unwrap_or_else(std::env::temp_dir);

@@ -1,0 +1,136 @@
+//! `Renderer::render_display` (display bytes made band by band, as each
+//! band is shaded) gives the bytes of `resolve` of the rendered frame, and
+//! the same frame as `render`, under every path that changes how or when
+//! the bytes are made: AO's second pass, MSAA, supersampling's filter, a
+//! transparent background (RGBA), tone maps and exposure, a data view, the
+//! line overlay drawn after the bands, and an image reused across sizes.
+
+mod common;
+
+use std::path::Path;
+
+use common::{load_with, scene_in, scratch};
+use softraster::output::{Image8, resolve};
+use softraster::render::{Frame, Renderer};
+use softraster::scene::Scene;
+
+/// Frames `frames` of camera 0, both ways, into one image kept across
+/// them (as the benchmark keeps it).
+fn same_bytes(scene: &Scene, frames: &[u32], image: &mut Image8, what: &str) {
+    let r = Renderer::new(scene);
+    for &f in frames {
+        let (mut a, mut b) = (Frame::new(0, 0), Frame::new(0, 0));
+        r.render(scene, 0, f, &mut a);
+        r.render_display(scene, 0, f, &mut b, image);
+        let bits = |fr: &Frame| -> Vec<u32> {
+            fr.color
+                .iter()
+                .flat_map(|c| c.to_array().map(f32::to_bits))
+                .chain(fr.depth.iter().map(|d| d.to_bits()))
+                .collect()
+        };
+        assert!(bits(&a) == bits(&b), "{what}, frame {f}: frames differ");
+        let want = resolve(&a, &scene.settings);
+        assert_eq!(
+            (image.width, image.height, image.channels),
+            (want.width, want.height, want.channels),
+            "{what}, frame {f}"
+        );
+        if let Some(i) = (0..want.data.len()).find(|&i| image.data[i] != want.data[i]) {
+            let px = i / want.channels as usize;
+            panic!(
+                "{what}, frame {f}: pixel {} {} channel {}: {} against resolve's {}",
+                px % want.width as usize,
+                px / want.width as usize,
+                i % want.channels as usize,
+                image.data[i],
+                want.data[i]
+            );
+        }
+        // Not a comparison of two blank images.
+        let first = &want.data[..want.channels as usize];
+        assert!(
+            want.data.chunks(want.channels as usize).any(|p| p != first),
+            "{what}: a uniform image"
+        );
+    }
+}
+
+#[test]
+fn band_by_band_bytes_equal_the_resolve_of_the_frame() {
+    let showcase = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
+    let small = ["output.width=96", "output.height=72", "animation.frames=8"];
+    let cases: &[(&str, &[&str])] = &[
+        ("showcase (AO, MSAA 4, ACES)", &[]),
+        (
+            "no AO, no MSAA",
+            &["render.ao.method=\"off\"", "render.msaa=1"],
+        ),
+        ("supersampled", &["render.ssaa=2", "render.msaa=1"]),
+        (
+            "clamp, exposure +1, flat grey",
+            &[
+                "render.tonemap=\"clamp\"",
+                "render.exposure=1.0",
+                "output.background=[0.2, 0.3, 0.4]",
+                "render.ao.method=\"off\"",
+            ],
+        ),
+        ("agx", &["render.tonemap=\"agx\"", "render.msaa=1"]),
+        ("normals view", &["render.shading=\"normals\""]),
+        ("wide", &["output.width=131", "output.height=37"]),
+    ];
+    let mut image = Image8::empty();
+    for (what, sets) in cases {
+        let all: Vec<&str> = small.iter().chain(sets.iter()).copied().collect();
+        let scene = load_with(&showcase, &all);
+        same_bytes(&scene, &[0, 3], &mut image, what);
+    }
+}
+
+#[test]
+fn a_transparent_background_gives_the_same_rgba() {
+    let dir = scratch("display-transparent");
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/showcase");
+    let a = assets.display().to_string().replace('\\', "/");
+    let toml = format!(
+        "[output]\nwidth = 90\nheight = 70\nbackground = \"transparent\"\n\
+         [render]\nmsaa = 4\ntonemap = \"pbr-neutral\"\n\
+         [animation]\nframes = 8\nturntable = {{ axis = [0.0, 1.0, 0.0], degrees = 360 }}\n\
+         [[model]]\npath = \"{a}/sphere.obj\"\n\
+         [[model]]\npath = \"{a}/torus.obj\"\ntranslate = [1.1, 0.2, 0.0]\n\
+         [[light]]\nkind = \"directional\"\ndirection = [-0.4, -1.0, -0.6]\nirradiance = 1.3\n"
+    );
+    let scene = scene_in(&dir, &toml, &[]);
+    let mut image = Image8::empty();
+    same_bytes(&scene, &[0, 5], &mut image, "transparent, MSAA 4");
+    assert_eq!(image.channels, 4);
+    // Partly covered edge pixels: alpha strictly between 0 and 255.
+    assert!(image.data.chunks(4).any(|p| p[3] > 0 && p[3] < 255));
+}
+
+#[test]
+fn lines_drawn_after_the_bands_are_in_the_bytes() {
+    let dir = scratch("display-lines");
+    let obj = "mtllib m.mtl\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nusemtl grey\nf 1 2 3 4\n\
+               usemtl white\nv -3 0.1 0.5\nv 3 0.1 0.5\nl 5 6\np 1\n";
+    let mtl = "newmtl grey\nKd 0.3 0.3 0.3\nnewmtl white\nKd 1 1 1\n";
+    let toml = "[output]\nwidth = 64\nheight = 48\nbackground = [0.0, 0.0, 0.0]\n\
+                [render]\nline_width = 3.0\n\
+                [[model]]\npath = \"m.obj\"\n\
+                [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\
+                [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n";
+    let scene = scene_in(&dir, toml, &[("m.obj", obj), ("m.mtl", mtl)]);
+    let mut image = Image8::empty();
+    same_bytes(&scene, &[0], &mut image, "a line over a quad");
+    // The line is in the bytes: its row is brighter than the quad's.
+    let w = image.width as usize;
+    let row_sum = |y: usize| -> u32 { (0..w).map(|x| image.data[(y * w + x) * 3] as u32).sum() };
+    let brightest = (0..image.height as usize)
+        .max_by_key(|&y| row_sum(y))
+        .unwrap();
+    assert!(
+        row_sum(brightest) > row_sum(5) + 100,
+        "no line in the image"
+    );
+}
