@@ -354,11 +354,13 @@ fn outputs(
     let (width, height) = (frame.width, frame.height);
     let mut out = Vec::new();
     let mut image = image;
-    if let (Some(p), Some(img)) = (files.color, image.take()) {
-        if color {
-            image = Some(img.clone());
+    if let Some(p) = files.color {
+        if let Some(img) = image.take() {
+            if color {
+                image = Some(img.clone());
+            }
+            out.push(Output::Png(p, img));
         }
-        out.push(Output::Png(p, img));
     }
     if let Some(p) = files.depth {
         out.push(Output::Exr(p, width, height, "Z", frame.depth.clone()));

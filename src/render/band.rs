@@ -16,6 +16,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use super::display::PlainBackground;
 use super::fragment::{FrameData, LANE_SLOT, Part, Point, Sink, resolve};
 use super::frame::AovPixel;
 use super::lanes::{LaneBatches, Pending};
@@ -82,7 +83,9 @@ impl<'a> FrameData<'a> {
 
     /// Shades a band's visible pixels into its rows of the frame, then
     /// composites its blended triangles. `ao`: the band's ambient
-    /// occlusion per pixel, when the scene asks for it.
+    /// occlusion per pixel, when the scene asks for it. Returns, where it
+    /// is known, the flat background: its colour and the columns outside
+    /// which every pixel of the band holds exactly that colour.
     pub fn shade_band(
         &self,
         vis: &Visibility,
@@ -90,11 +93,14 @@ impl<'a> FrameData<'a> {
         ao: Option<&[f32]>,
         color: &mut [Vec4],
         depth: &mut [f32],
-    ) {
-        self.shade_visible(vis, ao, color, depth);
+    ) -> Option<PlainBackground> {
+        let plain = self.shade_visible(vis, ao, color, depth);
         if !blended.is_empty() {
             self.blend(vis, blended, color);
+            // Blended layers may lie anywhere.
+            return None;
         }
+        plain
     }
 
     /// The geometry buffer of a band: view depth, interpolated normal and
@@ -318,7 +324,7 @@ impl<'a> FrameData<'a> {
         ao: Option<&[f32]>,
         color: &mut [Vec4],
         depth: &mut [f32],
-    ) {
+    ) -> Option<PlainBackground> {
         let rect = vis.rect;
         let (tw, th) = (rect.width(), rect.height());
         let n = vis.samples();
@@ -535,6 +541,12 @@ impl<'a> FrameData<'a> {
         for (i, parts) in deferred {
             (color[i], depth[i]) = resolve(&parts, &shaded, inv_n);
         }
+        // Over a flat background, the pixels outside the drawn columns
+        // were filled with it above, and no quad reaches them.
+        filled.then_some(PlainBackground {
+            color: self.bg,
+            columns: drawn,
+        })
     }
 
     /// Shades the fragment of triangle `id` covering samples `mask` of

@@ -59,7 +59,17 @@ pub fn resolve_into(frame: &Frame, s: &RenderSettings, image: &mut Image8) {
         .data
         .par_chunks_mut(c * w)
         .zip(frame.color.par_chunks(w))
-        .for_each(|(out, row)| enc.rows(row, w, out));
+        .for_each(|(out, row)| enc.band(row, w, None, out));
+}
+
+/// What a band knows of its background when it is one flat colour: the
+/// colour, and the columns outside which every pixel of the band holds
+/// exactly that colour (`FrameData::shade_band`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PlainBackground {
+    pub color: Vec4,
+    /// First and one past the last column that may hold something else.
+    pub columns: (usize, usize),
 }
 
 /// How a frame's pixels become display bytes, from the render settings.
@@ -102,38 +112,103 @@ impl Encoder {
         self.channels
     }
 
-    /// One pixel's bytes (the first `channels` of them).
-    #[inline]
-    fn pixel(&self, c: &Vec4) -> [u8; 4] {
-        let c = if self.alpha && c.w > 0.0 && c.w < 1.0 {
-            (c.truncate() / c.w).extend(c.w)
+    /// Rows of `width` pixels (`colors`, whole rows) into `out`, `channels`
+    /// bytes a pixel. With `plain`, the pixels outside its columns are
+    /// its colour's bytes without being read.
+    pub(super) fn band(
+        &self,
+        colors: &[Vec4],
+        width: usize,
+        plain: Option<PlainBackground>,
+        out: &mut [u8],
+    ) {
+        if self.alpha {
+            self.band_in::<4>(colors, width, plain, out);
         } else {
-            *c
-        };
-        let rgb = if self.data_view {
-            [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+            self.band_in::<3>(colors, width, plain, out);
+        }
+    }
+
+    /// `band` with C bytes a pixel, the encoding chosen once.
+    fn band_in<const C: usize>(
+        &self,
+        colors: &[Vec4],
+        width: usize,
+        plain: Option<PlainBackground>,
+        out: &mut [u8],
+    ) {
+        let scale = self.scale;
+        if self.data_view {
+            rows::<C>(colors, width, plain, out, |c| {
+                pixel::<C>(c, |c| {
+                    [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
+                })
+            });
         } else if self.tonemap == Tonemap::Clamp {
             // `tonemap`'s clamp is the encoding's own: the same bytes,
             // without a trip through memory.
-            encode_srgb_xyz(c * self.scale)
+            rows::<C>(colors, width, plain, out, |c| {
+                pixel::<C>(c, |c| encode_srgb_xyz(c * scale))
+            });
         } else {
-            encode_srgb3(tonemap(c.truncate(), self.tonemap, self.scale))
-        };
-        let a = if self.alpha { encode_linear(c.w) } else { 255 };
-        [rgb[0], rgb[1], rgb[2], a]
-    }
-
-    /// Rows of `width` pixels (`colors`, whole rows) into `out`, `channels`
-    /// bytes a pixel.
-    pub(super) fn rows(&self, colors: &[Vec4], width: usize, out: &mut [u8]) {
-        let c = self.channels;
-        for (row, bytes) in colors.chunks(width).zip(out.chunks_mut(width * c)) {
-            if self.alpha {
-                resolve_row::<4>(bytes, row, |p| self.pixel(p));
-            } else {
-                resolve_row::<3>(bytes, row, |p| self.pixel(p));
-            }
+            let op = self.tonemap;
+            rows::<C>(colors, width, plain, out, |c| {
+                pixel::<C>(c, |c| encode_srgb3(tonemap(c.truncate(), op, scale)))
+            });
         }
+    }
+}
+
+/// One pixel's bytes (the first C of them), its colour's encoded by `rgb`:
+/// with alpha (C = 4), straight colour and the coverage byte.
+#[inline(always)]
+fn pixel<const C: usize>(c: &Vec4, rgb: impl Fn(Vec4) -> [u8; 3]) -> [u8; 4] {
+    let alpha = C == 4;
+    let c = if alpha && c.w > 0.0 && c.w < 1.0 {
+        (c.truncate() / c.w).extend(c.w)
+    } else {
+        *c
+    };
+    let [r, g, b] = rgb(c);
+    let a = if alpha { encode_linear(c.w) } else { 255 };
+    [r, g, b, a]
+}
+
+/// Whole rows of `width` pixels into C bytes a pixel; with `plain`, the
+/// columns outside its span get its colour's bytes directly.
+#[inline(always)]
+fn rows<const C: usize>(
+    colors: &[Vec4],
+    width: usize,
+    plain: Option<PlainBackground>,
+    out: &mut [u8],
+    pixel: impl Fn(&Vec4) -> [u8; 4],
+) {
+    let (lo, hi) = plain.map_or((0, width), |p| {
+        let hi = p.columns.1.min(width);
+        (p.columns.0.min(hi), hi)
+    });
+    // The background's bytes for 64 pixels, copied a run at a time.
+    const RUN: usize = 64;
+    let bg = plain.map(|p| {
+        let px = pixel(&p.color);
+        let mut run = [0u8; RUN * 4];
+        for k in 0..RUN {
+            run[k * C..k * C + C].copy_from_slice(&px[..C]);
+        }
+        run
+    });
+    let fill = |bytes: &mut [u8], run: &[u8; RUN * 4]| {
+        for part in bytes.chunks_mut(RUN * C) {
+            part.copy_from_slice(&run[..part.len()]);
+        }
+    };
+    for (row, bytes) in colors.chunks(width).zip(out.chunks_mut(width * C)) {
+        if let Some(run) = &bg {
+            fill(&mut bytes[..lo * C], run);
+            fill(&mut bytes[hi * C..], run);
+        }
+        resolve_row::<C>(&mut bytes[lo * C..hi * C], &row[lo..hi], &pixel);
     }
 }
 

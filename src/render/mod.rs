@@ -458,9 +458,9 @@ impl Renderer {
             _ => (0..bands).map(|_| Default::default()).collect(),
         };
         // A band's display bytes, from its colour just shaded.
-        let show = |color: &[glam::Vec4], bytes: &mut [u8]| {
+        let show = |color: &[glam::Vec4], plain, bytes: &mut [u8]| {
             if let Some(e) = &encoder {
-                e.rows(color, width, bytes);
+                e.band(color, width, plain, bytes);
             }
         };
         if data.fs.scene.settings.ao.method == AoMethod::Off {
@@ -477,8 +477,8 @@ impl Renderer {
                     if !aov.is_empty() {
                         data.aovs(&vis, aov);
                     }
-                    data.shade_band(&vis, blended, None, color, depth);
-                    show(color, bytes);
+                    let plain = data.shade_band(&vis, blended, None, color, depth);
+                    show(color, plain, bytes);
                 });
             return;
         }
@@ -507,8 +507,8 @@ impl Renderer {
                 if !aov.is_empty() {
                     data.aovs(&vis, aov);
                 }
-                data.shade_band(&vis, blended, Some(ao), color, depth);
-                show(color, bytes);
+                let plain = data.shade_band(&vis, blended, Some(ao), color, depth);
+                show(color, plain, bytes);
             });
     }
 
