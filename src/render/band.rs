@@ -826,23 +826,31 @@ impl<'a> FrameData<'a> {
     }
 }
 
-/// The interpolator of the last triangle asked for: consecutive pixels
-/// mostly belong to one triangle.
-#[derive(Default)]
+/// The interpolators of the band's last triangles, one slot per id mod
+/// `SLOTS`: consecutive pixels mostly belong to one triangle, and the
+/// quads along an edge alternate between two or three.
 struct InterpolatorCache {
-    last: Option<(u32, Interpolator)>,
+    slots: [Option<(u32, Interpolator)>; InterpolatorCache::SLOTS],
+}
+
+impl Default for InterpolatorCache {
+    fn default() -> InterpolatorCache {
+        InterpolatorCache {
+            slots: [const { None }; InterpolatorCache::SLOTS],
+        }
+    }
 }
 
 impl InterpolatorCache {
+    const SLOTS: usize = 16;
+
     #[inline]
     fn get(&mut self, id: u32, t: &Tri) -> &Interpolator {
-        if self.last.as_ref().is_some_and(|(last, _)| *last != id) {
-            self.last = None;
+        let slot = &mut self.slots[id as usize % Self::SLOTS];
+        if !matches!(slot, Some((k, _)) if *k == id) {
+            *slot = None;
         }
-        &self
-            .last
-            .get_or_insert_with(|| (id, Interpolator::new(t)))
-            .1
+        &slot.get_or_insert_with(|| (id, Interpolator::new(t))).1
     }
 }
 
