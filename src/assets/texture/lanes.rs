@@ -23,7 +23,7 @@ use super::{Footprint, Level, Texture, Wrap};
 use smallvec::SmallVec;
 
 use crate::color::srgb_to_linear_table;
-use crate::simd::{lanes4, unit_bytes4, whole4};
+use crate::simd::{block_steps4, lanes4, unit_bytes4, whole4};
 
 /// Red, green and blue of four lookups, one lane each.
 pub type Rgb4 = [Vec4; 3];
@@ -48,10 +48,11 @@ struct Place4 {
     /// Level per lane (0: the image itself, k: mip level k).
     level: [usize; 4],
     /// Per lane: the footprint's top-left texel in the block layout, and
-    /// the steps to its right and lower neighbours (`Level::footprint`).
-    at: [usize; 4],
-    dx: [usize; 4],
-    dy: [usize; 4],
+    /// the steps to its right and lower neighbours (`Level::footprint`);
+    /// unspecified in lanes that are not inside.
+    at: [u32; 4],
+    dx: [u32; 4],
+    dy: [u32; 4],
     /// Fractions between the texels.
     fx: Vec4,
     fy: Vec4,
@@ -180,6 +181,18 @@ impl<'t> Chain<'t> {
                 weight = [weight[0]; 4];
             }
         }
+        if lanes == 1 {
+            // One level (or pair) for every lane: its size once.
+            let (n, f) = (self.level(near[0]), self.level(far[0]));
+            return Taps4 {
+                shape: self.shape(),
+                lod,
+                u,
+                v,
+                near: Place4::new(near, [n; 4], u, v),
+                far: two.then(|| (Place4::new(far, [f; 4], u, v), Vec4::splat(weight[0]))),
+            };
+        }
         let level = |i: usize| self.level(i);
         Taps4 {
             shape: self.shape(),
@@ -235,7 +248,7 @@ impl<'t> Chain<'t> {
     fn prefetch_place(&self, place: &Place4) {
         for k in 0..4 {
             if place.inside & (1 << k) != 0 {
-                prefetch_texel(self.texels[place.level[k]], place.at[k]);
+                prefetch_texel(self.texels[place.level[k]], place.at[k] as usize);
             }
         }
     }
@@ -255,13 +268,17 @@ impl<'t> Chain<'t> {
         for k in 0..4 {
             if place.inside & (1 << k) != 0 {
                 let t = self.texels[place.level[k]];
-                let (i, dx, dy) = (place.at[k], place.dx[k], place.dy[k]);
+                let (i, dx, dy) = (
+                    place.at[k] as usize,
+                    place.dx[k] as usize,
+                    place.dy[k] as usize,
+                );
                 debug_assert!(i + dx + dy < t.len());
                 // SAFETY: an inside lane's footprint has x0 + 1 < width and
                 // y0 + 1 < height in its level (`Place4::new`, for a level
                 // of this size: `read4` checks the shape), so its four
                 // texels, the last at i + dx + dy, lie in the level's
-                // blocks (`Level::footprint_steps`).
+                // blocks (`Level::footprint`'s steps).
                 unsafe {
                     texels[0][k] = u32::from_le(*t.get_unchecked(i));
                     texels[1][k] = u32::from_le(*t.get_unchecked(i + dx));
@@ -382,6 +399,16 @@ impl Place4 {
     /// `Level::footprint` finds the texels.
     #[inline(always)]
     fn new(level: [usize; 4], levels: [&Level; 4], u: Vec4, v: Vec4) -> Place4 {
+        if std::ptr::eq(levels[0], levels[1])
+            && std::ptr::eq(levels[0], levels[2])
+            && std::ptr::eq(levels[0], levels[3])
+        {
+            // One level for the four lanes (a quad's shared footprint):
+            // its size splat, the same values the lanes would gather.
+            let l = levels[0];
+            let (w, h) = (Vec4::splat(l.width as f32), Vec4::splat(l.height as f32));
+            return Place4::within(level, levels, w, h, u, v);
+        }
         let w = lanes4(
             levels[0].width as f32,
             levels[1].width as f32,
@@ -394,6 +421,19 @@ impl Place4 {
             levels[2].height as f32,
             levels[3].height as f32,
         );
+        Place4::within(level, levels, w, h, u, v)
+    }
+
+    /// `new`, given the levels' widths `w` and heights `h` per lane.
+    #[inline(always)]
+    fn within(
+        level: [usize; 4],
+        levels: [&Level; 4],
+        w: Vec4,
+        h: Vec4,
+        u: Vec4,
+        v: Vec4,
+    ) -> Place4 {
         let x = u * w - Vec4::splat(0.5);
         let y = v * h - Vec4::splat(0.5);
         let inside = (x.cmpge(Vec4::ZERO)
@@ -403,14 +443,9 @@ impl Place4 {
         .bitmask();
         let (x0, y0) = (x.trunc(), y.trunc());
         let (xi, yi) = (whole4(x0), whole4(y0));
-        let mut at = [0usize; 4];
-        let mut dx = [0usize; 4];
-        let mut dy = [0usize; 4];
-        for k in 0..4 {
-            if inside & (1 << k) != 0 {
-                (at[k], dx[k], dy[k]) = levels[k].footprint_steps(xi[k], yi[k]);
-            }
-        }
+        // `Level::footprint`'s steps for every lane at once (the lanes that
+        // are not inside get values no read uses).
+        let [at, dx, dy] = block_steps4(xi, yi, levels.map(|l| l.blocks_x));
         Place4 {
             level,
             at,

@@ -286,20 +286,6 @@ impl Level {
 }
 
 impl Level {
-    /// Where `footprint(x, y)` finds its texels: the first one's position
-    /// in the block layout and the steps to its right and lower
-    /// neighbours.
-    #[inline(always)]
-    fn footprint_steps(&self, x: u32, y: u32) -> (usize, usize, usize) {
-        let dx = if x & 3 == 3 { 13 } else { 1 };
-        let dy = if y & 3 == 3 {
-            (self.blocks_x as usize) * 16 - 12
-        } else {
-            4
-        };
-        (self.index(x, y), dx, dy)
-    }
-
     /// The texels in the block layout, each RGBA8 as a little-endian u32.
     #[inline(always)]
     fn texels(&self) -> &[u32] {
