@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::output::{self, Image8};
-use crate::render::{AovPixel, Frame, Renderer};
+use crate::render::{AovPixel, Frame, FrameSequence, Renderer};
 use crate::scene::{Scene, expand_pattern};
 
 pub struct RenderJob {
@@ -540,7 +540,7 @@ impl RenderJob {
             }
         };
         let renderer = Renderer::new(scene);
-        let mut buffer = Frame::new(0, 0);
+        let mut buffer = FrameSequence::new();
         'frames: for &frame in &plan.frames {
             for &cam in &plan.cameras {
                 let camera = plan.camera_name(cam).to_string();
@@ -569,15 +569,10 @@ impl RenderJob {
                     continue;
                 }
                 let t0 = Instant::now();
-                let image = if files.color.is_some() || in_video {
-                    let mut image = Image8::empty();
-                    renderer.render_display(scene, cam, frame, &mut buffer, &mut image);
-                    Some(image)
-                } else {
-                    renderer.render(scene, cam, frame, &mut buffer);
-                    None
-                };
-                let (outputs, color) = outputs(&buffer, image, files, in_video);
+                // The display image is made as the frame renders.
+                let mut image = (files.color.is_some() || in_video).then(Image8::empty);
+                renderer.render_next(scene, cam, frame, &mut buffer, image.as_mut());
+                let (outputs, color) = outputs(buffer.frame(), image, files, in_video);
                 let done = FrameDone {
                     frame,
                     camera,

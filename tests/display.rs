@@ -134,3 +134,88 @@ fn lines_drawn_after_the_bands_are_in_the_bytes() {
         "no line in the image"
     );
 }
+
+/// Frames rendered one after another into one `FrameSequence` (which
+/// skips filling what the last frame left as background) equal frames
+/// rendered fresh, bit for bit and byte for byte, while the turntable
+/// moves the silhouette, the size, background colour, MSAA and AO change
+/// between frames, and lines are drawn over the bands.
+#[test]
+fn a_sequence_of_frames_equals_fresh_frames() {
+    use softraster::render::FrameSequence;
+    let showcase = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
+    let flat = [
+        "output.width=96",
+        "output.height=72",
+        "animation.frames=8",
+        "output.background=[0.2, 0.3, 0.4]",
+        "render.ao.method=\"off\"",
+        "render.msaa=1",
+    ];
+    let variants: &[&[&str]] = &[
+        &[],
+        &["output.background=[0.5, 0.1, 0.1]"],
+        &["render.msaa=4"],
+        &["output.width=80", "output.height=90"],
+        &["render.ao.method=\"ssao\""],
+        &["output.background=\"blurred\""],
+        &[],
+    ];
+    let mut seq = FrameSequence::new();
+    let mut image = Image8::empty();
+    let same = |scene: &Scene, seq: &mut FrameSequence, image: &mut Image8, f: u32, what: &str| {
+        let r = Renderer::new(scene);
+        r.render_next(scene, 0, f, seq, Some(image));
+        let mut fresh = Frame::new(0, 0);
+        let mut want = Image8::empty();
+        r.render_display(scene, 0, f, &mut fresh, &mut want);
+        let got = seq.frame();
+        assert_eq!(got.color.len(), fresh.color.len(), "{what}");
+        for (i, (a, b)) in got.color.iter().zip(&fresh.color).enumerate() {
+            assert!(
+                a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
+                    && got.depth[i].to_bits() == fresh.depth[i].to_bits(),
+                "{what}, frame {f}, pixel {} {}: {a} depth {} against {b} depth {}",
+                i as u32 % got.width,
+                i as u32 / got.width,
+                got.depth[i],
+                fresh.depth[i]
+            );
+        }
+        assert!(*image == want, "{what}, frame {f}: display bytes differ");
+    };
+    for (v, sets) in variants.iter().enumerate() {
+        let all: Vec<&str> = flat.iter().chain(sets.iter()).copied().collect();
+        let scene = load_with(&showcase, &all);
+        for f in [0, 3, 5, 1] {
+            same(
+                &scene,
+                &mut seq,
+                &mut image,
+                f,
+                &format!("variant {v} {sets:?}"),
+            );
+        }
+    }
+    // Lines over the bands (wider than the quad under them), then frames
+    // without them into the same buffer.
+    let dir = scratch("display-sequence-lines");
+    let obj = "mtllib m.mtl\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nusemtl grey\nf 1 2 3 4\n\
+               usemtl white\nv -3 2.5 0.5\nv 3 2.5 0.5\nl 5 6\n";
+    let mtl = "newmtl grey\nKd 0.3 0.3 0.3\nnewmtl white\nKd 1 1 1\n";
+    let toml = "[output]\nwidth = 64\nheight = 48\nbackground = [0.0, 0.0, 0.0]\n\
+                [render]\nline_width = 3.0\n\
+                [[model]]\npath = \"m.obj\"\n\
+                [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\
+                [[camera]]\neye = [0.0, 0.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n";
+    let lines = scene_in(&dir, toml, &[("m.obj", obj), ("m.mtl", mtl)]);
+    let plain_obj = obj.replace("l 5 6\n", "");
+    let dir2 = scratch("display-sequence-nolines");
+    let no_lines = scene_in(&dir2, toml, &[("m.obj", &plain_obj), ("m.mtl", mtl)]);
+    for (k, scene) in [&no_lines, &lines, &no_lines, &lines, &no_lines]
+        .iter()
+        .enumerate()
+    {
+        same(scene, &mut seq, &mut image, 0, &format!("lines, step {k}"));
+    }
+}

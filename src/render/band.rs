@@ -83,18 +83,23 @@ impl<'a> FrameData<'a> {
 
     /// Shades a band's visible pixels into its rows of the frame, then
     /// composites its blended triangles. `ao`: the band's ambient
-    /// occlusion per pixel, when the scene asks for it. Returns, where it
-    /// is known, the flat background: its colour and the columns outside
-    /// which every pixel of the band holds exactly that colour.
+    /// occlusion per pixel, when the scene asks for it. `known`: what the
+    /// band's rows already hold, where the last frame rendered into them
+    /// left plain background (pixels of that colour and infinite depth
+    /// outside its columns), which then need no filling again. Returns,
+    /// where it is known, the flat background: its colour and the columns
+    /// outside which every pixel of the band holds exactly that colour
+    /// and infinite depth.
     pub fn shade_band(
         &self,
         vis: &Visibility,
         blended: Vec<u32>,
         ao: Option<&[f32]>,
+        known: Option<PlainBackground>,
         color: &mut [Vec4],
         depth: &mut [f32],
     ) -> Option<PlainBackground> {
-        let plain = self.shade_visible(vis, ao, color, depth);
+        let plain = self.shade_visible(vis, ao, known, color, depth);
         if !blended.is_empty() {
             self.blend(vis, blended, color);
             // Blended layers may lie anywhere.
@@ -322,6 +327,7 @@ impl<'a> FrameData<'a> {
         &self,
         vis: &Visibility,
         ao: Option<&[f32]>,
+        known: Option<PlainBackground>,
         color: &mut [Vec4],
         depth: &mut [f32],
     ) -> Option<PlainBackground> {
@@ -354,6 +360,16 @@ impl<'a> FrameData<'a> {
         // background only those are visited; the others are filled here).
         let mut spans = vec![(usize::MAX, 0usize); th];
         let drawn = vis.drawn_columns();
+        // Columns that may hold something other than this background now.
+        let stale = match known {
+            Some(k)
+                if k.color.to_array().map(f32::to_bits) == self.bg.to_array().map(f32::to_bits) =>
+            {
+                let hi = k.columns.1.min(tw);
+                (k.columns.0.min(hi), hi)
+            }
+            _ => (0, tw),
+        };
         for (y, span) in spans.iter_mut().enumerate() {
             let row = y * tw..(y + 1) * tw;
             if !filled {
@@ -363,10 +379,13 @@ impl<'a> FrameData<'a> {
             let (c, d) = (&mut color[row.clone()], &mut depth[row]);
             // Outside the drawn columns every pixel is empty.
             let (lo, hi) = drawn;
-            c[..lo].fill(self.bg);
-            d[..lo].fill(f32::INFINITY);
-            c[hi..].fill(self.bg);
-            d[hi..].fill(f32::INFINITY);
+            // (Only where it does not hold the background already.)
+            for r in [stale.0..lo.min(stale.1), hi.max(stale.0)..stale.1] {
+                if r.start < r.end {
+                    c[r.clone()].fill(self.bg);
+                    d[r].fill(f32::INFINITY);
+                }
+            }
             for x in lo..hi {
                 if empty_at(y * tw + x) {
                     c[x] = self.bg;

@@ -1,6 +1,7 @@
 //! The frame buffers a render fills, and the supersampling resolve that
 //! turns a frame rendered `k` times larger per axis into the output size.
 
+use super::display::PlainBackground;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -41,6 +42,43 @@ pub struct AovPixel {
     /// 1 + the material's index in the scene (models' materials in order);
     /// 0: none.
     pub material: u32,
+}
+
+/// Frames rendered one after another into one buffer that only the
+/// renderer writes (`Renderer::render_next`; `frame` reads it). Per band
+/// of rows it remembers the plain background the last frame left (its
+/// colour and the columns outside which the band holds only that colour
+/// at infinite depth), so that the next frame fills only the columns that
+/// changed instead of the whole band again.
+pub struct FrameSequence {
+    frame: Frame,
+    /// Per band of the last frame, where known.
+    pub(super) known: Vec<Option<PlainBackground>>,
+}
+
+impl Default for FrameSequence {
+    fn default() -> FrameSequence {
+        FrameSequence::new()
+    }
+}
+
+impl FrameSequence {
+    pub fn new() -> FrameSequence {
+        FrameSequence {
+            frame: Frame::new(0, 0),
+            known: Vec::new(),
+        }
+    }
+
+    /// The last frame rendered.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// The buffer and what is known of it, for the renderer.
+    pub(super) fn parts(&mut self) -> (&mut Frame, &mut Vec<Option<PlainBackground>>) {
+        (&mut self.frame, &mut self.known)
+    }
 }
 
 impl AovPixel {

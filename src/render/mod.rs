@@ -46,7 +46,7 @@ use rayon::prelude::*;
 
 pub use display::{Image8, resolve};
 pub use exposure::auto_exposure;
-pub use frame::{AovPixel, Frame};
+pub use frame::{AovPixel, Frame, FrameSequence};
 pub use setup::FrameSetup;
 
 use crate::assets::environment::EnvImage;
@@ -172,11 +172,11 @@ impl Renderer {
         let fs = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
         if k == 1 {
-            self.render_at(&fs, s.width, s.height, out, None);
+            self.render_at(&fs, s.width, s.height, out, None, None);
             return;
         }
         let mut big = Frame::new(0, 0);
-        self.render_at(&fs, s.width * k, s.height * k, &mut big, None);
+        self.render_at(&fs, s.width * k, s.height * k, &mut big, None, None);
         frame::downsample(&big, k, out);
     }
 
@@ -201,13 +201,42 @@ impl Renderer {
         let fs = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
         if k == 1 {
-            self.render_at(&fs, s.width, s.height, out, Some(image));
+            self.render_at(&fs, s.width, s.height, out, Some(image), None);
             return;
         }
         let mut big = Frame::new(0, 0);
-        self.render_at(&fs, s.width * k, s.height * k, &mut big, None);
+        self.render_at(&fs, s.width * k, s.height * k, &mut big, None, None);
         frame::downsample(&big, k, out);
         display::resolve_into(out, s, image);
+    }
+
+    /// `render_display` (with `image`) or `render` of the next frame of a
+    /// sequence into `seq`: the band rows the last frame left as plain
+    /// background are not filled again (the same frames and bytes).
+    pub fn render_next(
+        &self,
+        scene: &Scene,
+        camera: usize,
+        frame: u32,
+        seq: &mut FrameSequence,
+        image: Option<&mut Image8>,
+    ) {
+        let (out, known) = seq.parts();
+        let s = &scene.settings;
+        if (out.width, out.height) != (s.width, s.height) {
+            // Another size: nothing of the buffer is known.
+            known.clear();
+        }
+        if !self.serves(scene) || s.ssaa.max(1) > 1 {
+            // Another renderer, or a filter over a larger frame.
+            known.clear();
+            return match image {
+                Some(image) => self.render_display(scene, camera, frame, out, image),
+                None => self.render(scene, camera, frame, out),
+            };
+        }
+        let fs = FrameSetup::new(scene, camera, frame);
+        self.render_at(&fs, s.width, s.height, out, image, Some(known));
     }
 
     /// Builds every texture's mip chain now (a benchmark counts them as
@@ -353,6 +382,7 @@ impl Renderer {
         height: u32,
         out: &mut Frame,
         mut display: Option<&mut Image8>,
+        known: Option<&mut Vec<Option<display::PlainBackground>>>,
     ) {
         let s = &fs.scene.settings;
         out.resize(width, height);
@@ -415,8 +445,12 @@ impl Renderer {
         } else {
             display.as_deref_mut()
         };
-        self.bands(&data, &geo, tracer.as_ref(), out, fused);
+        let mut none = Vec::new();
+        let known = known.unwrap_or(&mut none);
+        self.bands(&data, &geo, tracer.as_ref(), out, fused, known);
         if overlay {
+            // Lines may cross the plain background anywhere.
+            known.clear();
             lines::draw(fs, &verts, width as f32 / s.width as f32, out);
             if let Some(image) = display {
                 display::resolve_into(out, s, image);
@@ -433,6 +467,7 @@ impl Renderer {
         tracer: Option<&Tracer>,
         out: &mut Frame,
         display: Option<&mut Image8>,
+        known: &mut Vec<Option<display::PlainBackground>>,
     ) {
         let bins = geo.bins();
         let grid = &geo.grid;
@@ -447,6 +482,9 @@ impl Renderer {
         }
         let bands = out.color.len().div_ceil(band);
         let width = out.width as usize;
+        // What the last frame left per band (nothing where it was not
+        // rendered into this buffer at this size).
+        known.resize(bands, None);
         let encoder = display
             .as_ref()
             .map(|_| display::Encoder::new(&data.fs.scene.settings));
@@ -471,13 +509,15 @@ impl Renderer {
                 .zip(out.depth.par_chunks_mut(band))
                 .zip(chunks)
                 .zip(bytes)
+                .zip(known.par_iter_mut())
                 .enumerate()
-                .for_each(|(ti, (((color, depth), aov), bytes))| {
+                .for_each(|(ti, ((((color, depth), aov), bytes), known))| {
                     let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
                     if !aov.is_empty() {
                         data.aovs(&vis, aov);
                     }
-                    let plain = data.shade_band(&vis, blended, None, color, depth);
+                    let plain = data.shade_band(&vis, blended, None, *known, color, depth);
+                    *known = plain;
                     show(color, plain, bytes);
                 });
             return;
@@ -503,13 +543,17 @@ impl Renderer {
             .zip(visible)
             .zip(chunks)
             .zip(bytes)
-            .for_each(|(((((color, depth), ao), (vis, blended)), aov), bytes)| {
-                if !aov.is_empty() {
-                    data.aovs(&vis, aov);
-                }
-                let plain = data.shade_band(&vis, blended, Some(ao), color, depth);
-                show(color, plain, bytes);
-            });
+            .zip(known.par_iter_mut())
+            .for_each(
+                |((((((color, depth), ao), (vis, blended)), aov), bytes), known)| {
+                    if !aov.is_empty() {
+                        data.aovs(&vis, aov);
+                    }
+                    let plain = data.shade_band(&vis, blended, Some(ao), *known, color, depth);
+                    *known = plain;
+                    show(color, plain, bytes);
+                },
+            );
     }
 
     /// Per texture: the mip chain this frame may read, built on the first

@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use crate::error::Error;
 use crate::output;
-use crate::render::{Frame, Renderer};
+use crate::render::{Frame, FrameSequence, Renderer};
 use crate::scene::Scene;
 use crate::scene::build::LoadOptions;
 use crate::scene::light::{Light, LightKind};
@@ -397,11 +397,11 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
     )];
     let mut times = Vec::new();
     let mut png_ms = 0.0;
-    let mut frame = Frame::new(0, 0);
+    let mut frames = FrameSequence::new();
     let mut img = output::Image8::empty();
     for f in 0..args.frames {
         let t = Instant::now();
-        renderer.render_display(&scene, 0, f, &mut frame, &mut img);
+        renderer.render_next(&scene, 0, f, &mut frames, Some(&mut img));
         times.push(t.elapsed().as_secs_f64() * 1e3);
         let t = Instant::now();
         let dir = args.out.clone().unwrap_or_else(std::env::temp_dir);
