@@ -354,13 +354,14 @@ fn outputs(
     let (width, height) = (frame.width, frame.height);
     let mut out = Vec::new();
     let mut image = image;
-    if let Some(p) = files.color {
-        if let Some(img) = image.take() {
-            if color {
-                image = Some(img.clone());
-            }
-            out.push(Output::Png(p, img));
+    // (`image.take()` runs only where a colour file is written.)
+    if let Some(p) = files.color
+        && let Some(img) = image.take()
+    {
+        if color {
+            image = Some(img.clone());
         }
+        out.push(Output::Png(p, img));
     }
     if let Some(p) = files.depth {
         out.push(Output::Exr(p, width, height, "Z", frame.depth.clone()));
