@@ -52,7 +52,8 @@ pub fn load_and_render(name: &str, text: &str, render: bool) {
 
 /// As `load_and_render`, for the given frames.
 pub fn load_and_render_frames(name: &str, text: &str, render: bool, frames: &[u32]) {
-    use softraster::render::{Frame, Renderer};
+    use softraster::output::Image8;
+    use softraster::render::{Frame, FrameSequence, Renderer};
     use softraster::scene::{LoadOptions, Scene};
     let path = dir().join(name);
     let Ok(scene) = Scene::from_text(&path, text, &LoadOptions::plain()) else {
@@ -63,10 +64,16 @@ pub fn load_and_render_frames(name: &str, text: &str, render: bool, frames: &[u3
     }
     let renderer = Renderer::new(&scene);
     let mut frame = Frame::new(0, 0);
+    // The sequence path (display bytes band by band, background kept
+    // between frames) must give the one-frame path's bytes.
+    let mut seq = FrameSequence::new();
+    let mut image = Image8::empty();
     for cam in 0..scene.cameras.len().min(2) {
         for &f in frames {
             renderer.render(&scene, cam, f, &mut frame);
-            let _ = softraster::output::resolve(&frame, &scene.settings);
+            let want = softraster::output::resolve(&frame, &scene.settings);
+            renderer.render_next(&scene, cam, f, &mut seq, Some(&mut image));
+            assert!(image == want, "render_next's bytes differ from resolve's");
         }
     }
 }
