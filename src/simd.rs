@@ -363,13 +363,9 @@ mod tests {
     /// blocks, at every remainder mod 4.
     #[test]
     fn block_steps_equal_the_scalar_formula() {
-        let mut s = 0x1234_5678u32;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s
-        };
+        let mut rnd = crate::testing::xorshift(0x1234_5678);
+        // Whole numbers below 2^24.
+        let mut next = || (rnd() * (1u32 << 24) as f32) as u32;
         for _ in 0..20_000 {
             let bx: [u32; 4] = std::array::from_fn(|_| 1 + next() % (1 << 14));
             let x: [u32; 4] = std::array::from_fn(|k| next() % (bx[k] * 4));

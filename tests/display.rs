@@ -109,18 +109,30 @@ fn a_transparent_background_gives_the_same_rgba() {
     assert!(image.data.chunks(4).any(|p| p[3] > 0 && p[3] < 255));
 }
 
+/// A grey quad of side 4 seen from `eye_z` on +Z, under a white line 3
+/// pixels wide from x = -3 to 3 at height `line_y` in front of it (and a
+/// point) where `line`.
+fn line_scene(name: &str, line_y: f32, eye_z: f32, line: bool) -> Scene {
+    let dir = scratch(name);
+    let lines = if line { "l 5 6\np 1\n" } else { "" };
+    let obj = format!(
+        "mtllib m.mtl\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nusemtl grey\nf 1 2 3 4\n\
+         usemtl white\nv -3 {line_y} 0.5\nv 3 {line_y} 0.5\n{lines}"
+    );
+    let mtl = "newmtl grey\nKd 0.3 0.3 0.3\nnewmtl white\nKd 1 1 1\n";
+    let toml = format!(
+        "[output]\nwidth = 64\nheight = 48\nbackground = [0.0, 0.0, 0.0]\n\
+         [render]\nline_width = 3.0\n\
+         [[model]]\npath = \"m.obj\"\n\
+         [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\
+         [[camera]]\neye = [0.0, 0.0, {eye_z}]\ntarget = [0.0, 0.0, 0.0]\n"
+    );
+    scene_in(&dir, &toml, &[("m.obj", &obj), ("m.mtl", mtl)])
+}
+
 #[test]
 fn lines_drawn_after_the_bands_are_in_the_bytes() {
-    let dir = scratch("display-lines");
-    let obj = "mtllib m.mtl\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nusemtl grey\nf 1 2 3 4\n\
-               usemtl white\nv -3 0.1 0.5\nv 3 0.1 0.5\nl 5 6\np 1\n";
-    let mtl = "newmtl grey\nKd 0.3 0.3 0.3\nnewmtl white\nKd 1 1 1\n";
-    let toml = "[output]\nwidth = 64\nheight = 48\nbackground = [0.0, 0.0, 0.0]\n\
-                [render]\nline_width = 3.0\n\
-                [[model]]\npath = \"m.obj\"\n\
-                [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\
-                [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n";
-    let scene = scene_in(&dir, toml, &[("m.obj", obj), ("m.mtl", mtl)]);
+    let scene = line_scene("display-lines", 0.1, 5.0, true);
     let mut image = Image8::empty();
     same_bytes(&scene, &[0], &mut image, "a line over a quad");
     // The line is in the bytes: its row is brighter than the quad's.
@@ -199,19 +211,8 @@ fn a_sequence_of_frames_equals_fresh_frames() {
     }
     // Lines over the bands (wider than the quad under them), then frames
     // without them into the same buffer.
-    let dir = scratch("display-sequence-lines");
-    let obj = "mtllib m.mtl\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nusemtl grey\nf 1 2 3 4\n\
-               usemtl white\nv -3 2.5 0.5\nv 3 2.5 0.5\nl 5 6\n";
-    let mtl = "newmtl grey\nKd 0.3 0.3 0.3\nnewmtl white\nKd 1 1 1\n";
-    let toml = "[output]\nwidth = 64\nheight = 48\nbackground = [0.0, 0.0, 0.0]\n\
-                [render]\nline_width = 3.0\n\
-                [[model]]\npath = \"m.obj\"\n\
-                [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n\
-                [[camera]]\neye = [0.0, 0.0, 9.0]\ntarget = [0.0, 0.0, 0.0]\n";
-    let lines = scene_in(&dir, toml, &[("m.obj", obj), ("m.mtl", mtl)]);
-    let plain_obj = obj.replace("l 5 6\n", "");
-    let dir2 = scratch("display-sequence-nolines");
-    let no_lines = scene_in(&dir2, toml, &[("m.obj", &plain_obj), ("m.mtl", mtl)]);
+    let lines = line_scene("display-sequence-lines", 2.5, 9.0, true);
+    let no_lines = line_scene("display-sequence-nolines", 2.5, 9.0, false);
     for (k, scene) in [&no_lines, &lines, &no_lines, &lines, &no_lines]
         .iter()
         .enumerate()
