@@ -53,7 +53,7 @@ pub struct AovPixel {
 pub struct FrameSequence {
     frame: Frame,
     /// Per band of the last frame, where known.
-    pub(super) known: Vec<Option<PlainBackground>>,
+    known: Vec<Option<PlainBackground>>,
 }
 
 impl Default for FrameSequence {

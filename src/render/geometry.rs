@@ -27,15 +27,6 @@ pub(super) struct Draw {
 /// Triangles a chunk of a draw sets up at most.
 const CHUNK: u32 = 2048;
 
-/// Triangles per chunk for a frame of `total` triangles: `CHUNK`, or for
-/// small meshes less, so that about eight chunks share the threads (three
-/// chunks of 2,048 for 5,000 triangles leave one thread idle a third of
-/// the time). Chunks only split the work: the triangles of every band
-/// keep their order whatever the size.
-fn chunk_size(total: u32) -> u32 {
-    (total / 8).clamp(256, CHUNK)
-}
-
 /// One chunk's output.
 pub(super) struct Chunk {
     /// The draw the chunk belongs to.
@@ -87,15 +78,11 @@ pub(super) fn setup_and_bin(
             });
         }
     }
-    let total = draws
-        .iter()
-        .fold(0u32, |n, d| n.saturating_add(d.end - d.first));
-    let chunk = chunk_size(total);
     let mut ranges = Vec::new();
     for (di, d) in draws.iter().enumerate() {
         let mut start = d.first;
         while start < d.end {
-            let end = (start + chunk).min(d.end);
+            let end = (start + CHUNK).min(d.end);
             ranges.push((di, start, end));
             start = end;
         }

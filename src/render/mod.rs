@@ -163,21 +163,7 @@ impl Renderer {
     /// the tools change those between frames); for other assets a
     /// renderer of their own is made for the call.
     pub fn render(&self, scene: &Scene, camera: usize, frame: u32, out: &mut Frame) {
-        if !self.serves(scene) {
-            return Renderer::new(scene)
-                .with_lanes(self.lanes)
-                .with_light_culling(self.light_culling)
-                .render(scene, camera, frame, out);
-        }
-        let fs = FrameSetup::new(scene, camera, frame);
-        let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
-        if k == 1 {
-            self.render_at(&fs, s.width, s.height, out, None, None);
-            return;
-        }
-        let mut big = Frame::new(0, 0);
-        self.render_at(&fs, s.width * k, s.height * k, &mut big, None, None);
-        frame::downsample(&big, k, out);
+        self.render_frame(scene, camera, frame, out, None);
     }
 
     /// `render`, and `*image = resolve(out, &scene.settings)`: the display
@@ -192,22 +178,36 @@ impl Renderer {
         out: &mut Frame,
         image: &mut Image8,
     ) {
+        self.render_frame(scene, camera, frame, out, Some(image));
+    }
+
+    /// `render`, and with `display` `render_display`.
+    fn render_frame(
+        &self,
+        scene: &Scene,
+        camera: usize,
+        frame: u32,
+        out: &mut Frame,
+        display: Option<&mut Image8>,
+    ) {
         if !self.serves(scene) {
             return Renderer::new(scene)
                 .with_lanes(self.lanes)
                 .with_light_culling(self.light_culling)
-                .render_display(scene, camera, frame, out, image);
+                .render_frame(scene, camera, frame, out, display);
         }
         let fs = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
         if k == 1 {
-            self.render_at(&fs, s.width, s.height, out, Some(image), None);
+            self.render_at(&fs, s.width, s.height, out, display, None);
             return;
         }
         let mut big = Frame::new(0, 0);
         self.render_at(&fs, s.width * k, s.height * k, &mut big, None, None);
         frame::downsample(&big, k, out);
-        display::resolve_into(out, s, image);
+        if let Some(image) = display {
+            display::resolve_into(out, s, image);
+        }
     }
 
     /// `render_display` (with `image`) or `render` of the next frame of a
@@ -230,10 +230,7 @@ impl Renderer {
         if !self.serves(scene) || s.ssaa.max(1) > 1 {
             // Another renderer, or a filter over a larger frame.
             known.clear();
-            return match image {
-                Some(image) => self.render_display(scene, camera, frame, out, image),
-                None => self.render(scene, camera, frame, out),
-            };
+            return self.render_frame(scene, camera, frame, out, image);
         }
         let fs = FrameSetup::new(scene, camera, frame);
         self.render_at(&fs, s.width, s.height, out, image, Some(known));
@@ -485,15 +482,18 @@ impl Renderer {
         // What the last frame left per band (nothing where it was not
         // rendered into this buffer at this size).
         known.resize(bands, None);
-        let encoder = display
-            .as_ref()
-            .map(|_| display::Encoder::new(&data.fs.scene.settings));
-        let bytes: Vec<&mut [u8]> = match (display, encoder) {
-            (Some(image), Some(e)) => {
+        // The display image in band-sized chunks, or an empty chunk per
+        // band without one.
+        let (encoder, bytes): (_, Vec<&mut [u8]>) = match display {
+            Some(image) => {
+                let e = display::Encoder::new(&data.fs.scene.settings);
                 e.shape(out.width, out.height, image);
-                image.data.chunks_mut(band * e.channels()).collect()
+                (
+                    Some(e),
+                    image.data.chunks_mut(band * e.channels()).collect(),
+                )
             }
-            _ => (0..bands).map(|_| Default::default()).collect(),
+            None => (None, (0..bands).map(|_| Default::default()).collect()),
         };
         // A band's display bytes, from its colour just shaded.
         let show = |color: &[glam::Vec4], plain, bytes: &mut [u8]| {

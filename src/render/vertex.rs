@@ -50,38 +50,29 @@ fn transform(
     let mut world = vec![Vec3::ZERO; n];
     let mut normal = vec![Vec3::ZERO; n];
     let mut clip = vec![Vec4::ZERO; n];
-    // Chunks of vertices per task: a smaller mesh is placed on the calling
-    // thread (waking another for it would cost more than the work).
     const V_CHUNK: usize = 8192;
-    let place = |c: usize, ((w, nn), cl): ((&mut [Vec3], &mut [Vec3]), &mut [Vec4])| {
-        let base = c * V_CHUNK;
-        for i in 0..w.len() {
-            let p = world_from_object.transform_point3(positions[base + i]);
-            w[i] = p;
-            nn[i] = (normal_from_object * normals[base + i]).normalize_or(Vec3::Y);
-            cl[i] = clip_from_world * p.extend(1.0);
-        }
-    };
-    if n <= V_CHUNK {
-        place(0, ((&mut world[..], &mut normal[..]), &mut clip[..]));
-    } else {
-        world
-            .par_chunks_mut(V_CHUNK)
-            .zip(normal.par_chunks_mut(V_CHUNK))
-            .zip(clip.par_chunks_mut(V_CHUNK))
-            .enumerate()
-            .for_each(|(c, parts)| place(c, parts));
-    }
+    world
+        .par_chunks_mut(V_CHUNK)
+        .zip(normal.par_chunks_mut(V_CHUNK))
+        .zip(clip.par_chunks_mut(V_CHUNK))
+        .enumerate()
+        .for_each(|(c, ((w, nn), cl))| {
+            let base = c * V_CHUNK;
+            for i in 0..w.len() {
+                let p = world_from_object.transform_point3(positions[base + i]);
+                w[i] = p;
+                nn[i] = (normal_from_object * normals[base + i]).normalize_or(Vec3::Y);
+                cl[i] = clip_from_world * p.extend(1.0);
+            }
+        });
     // Tangents follow the surface (not the inverse transpose); a mirroring
     // transform flips the bitangent.
     let m3 = Mat3::from_mat4(world_from_object);
     let flip = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let turn = |t: &Vec4| (m3 * t.truncate()).normalize_or(Vec3::X).extend(t.w * flip);
-    let tangent = if tangents.len() <= 4 * V_CHUNK {
-        tangents.iter().map(turn).collect()
-    } else {
-        tangents.par_iter().map(turn).collect()
-    };
+    let tangent = tangents
+        .par_iter()
+        .map(|t| (m3 * t.truncate()).normalize_or(Vec3::X).extend(t.w * flip))
+        .collect();
     ModelVertices {
         world,
         normal,

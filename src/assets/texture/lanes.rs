@@ -181,18 +181,6 @@ impl<'t> Chain<'t> {
                 weight = [weight[0]; 4];
             }
         }
-        if lanes == 1 {
-            // One level (or pair) for every lane: its size once.
-            let (n, f) = (self.level(near[0]), self.level(far[0]));
-            return Taps4 {
-                shape: self.shape(),
-                lod,
-                u,
-                v,
-                near: Place4::new(near, [n; 4], u, v),
-                far: two.then(|| (Place4::new(far, [f; 4], u, v), Vec4::splat(weight[0]))),
-            };
-        }
         let level = |i: usize| self.level(i);
         Taps4 {
             shape: self.shape(),
