@@ -51,7 +51,10 @@ pub struct BenchArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Also write the frames as PNG here (to look at them).
+    /// Also write the frames as PNG here (to look at them). Without it
+    /// the frames follow each other untouched, as in the llvmpipe
+    /// harness's timed loop, and the PNG column is the last frame encoded
+    /// three times; with it each frame is written after it is timed.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// MSAA samples for the turntable cases (1, 2, 4, 8 or 16).
@@ -396,21 +399,38 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         45.0,
     )];
     let mut times = Vec::new();
-    let mut png_ms = 0.0;
+    let (mut png_ms, mut pngs) = (0.0, 0);
     let mut frames = FrameSequence::new();
     let mut img = output::Image8::empty();
+    let mut write_png = |path: &Path, img: &output::Image8| -> Result<(), Error> {
+        let t = Instant::now();
+        output::png::write(path, img)?;
+        png_ms += t.elapsed().as_secs_f64() * 1e3;
+        pngs += 1;
+        Ok(())
+    };
     for f in 0..args.frames {
         let t = Instant::now();
         renderer.render_next(&scene, 0, f, &mut frames, Some(&mut img));
         times.push(t.elapsed().as_secs_f64() * 1e3);
-        let t = Instant::now();
-        let dir = args.out.clone().unwrap_or_else(std::env::temp_dir);
-        let path = dir.join(format!("softraster-bench-{case}-{f:04}.png"));
-        output::png::write(&path, &img)?;
-        if args.out.is_none() {
-            let _ = std::fs::remove_file(&path);
+        // Frames follow each other as in the harness's timed loop (its
+        // `--no-write`): a PNG encoded between two frames would idle the
+        // workers and cool the caches for the next. With --out each frame
+        // is written after it is timed.
+        if let Some(dir) = &args.out {
+            write_png(&dir.join(format!("softraster-bench-{case}-{f:04}.png")), &img)?;
         }
-        png_ms += t.elapsed().as_secs_f64() * 1e3;
+    }
+    if args.out.is_none() && args.frames > 0 {
+        // The PNG column: the last frame, encoded three times.
+        let path = std::env::temp_dir().join(format!(
+            "softraster-bench-{case}-{}.png",
+            std::process::id()
+        ));
+        for _ in 0..3 {
+            write_png(&path, &img)?;
+        }
+        let _ = std::fs::remove_file(&path);
     }
     let mut steady: Vec<f64> = times.iter().skip(1).copied().collect();
     if steady.is_empty() {
@@ -426,7 +446,7 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         steady_ms: steady[steady.len() / 2],
         min_ms: steady[0],
         total_ms: times.iter().sum(),
-        png_ms: png_ms / args.frames as f64,
+        png_ms: png_ms / pngs.max(1) as f64,
     })
 }
 
