@@ -418,7 +418,10 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
         // workers and cool the caches for the next. With --out each frame
         // is written after it is timed.
         if let Some(dir) = &args.out {
-            write_png(&dir.join(format!("softraster-bench-{case}-{f:04}.png")), &img)?;
+            write_png(
+                &dir.join(format!("softraster-bench-{case}-{f:04}.png")),
+                &img,
+            )?;
         }
     }
     if args.out.is_none() && args.frames > 0 {
