@@ -33,9 +33,31 @@ use crate::raster::setup::{Tri, Viewport, setup};
 use crate::raytrace::Tracer;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::settings::{CullMode, ShadowMethod};
-use crate::shade::shadow::{Filter, LightShadow, MapProjection, ShadowMap, Shadows};
+use crate::shade::shadow::{
+    DRAWN_TILE, Drawn, Filter, LightShadow, MapProjection, ShadowMap, Shadows,
+};
 
 const CHUNK: usize = 4096;
+
+// A map's band of rows is one row of its `Drawn` tiles.
+const _: () = assert!(crate::raster::bin::BAND_ROWS as usize == DRAWN_TILE);
+
+/// The depth buffer of an earlier frame's map, drawn into again: 0 but
+/// in the tiles `drawn` marks.
+pub(super) struct Spare {
+    depth: BigBuf<f32>,
+    drawn: Drawn,
+}
+
+impl Spare {
+    /// `m`'s buffer and marks (`m` keeps empty ones).
+    fn take(m: &mut ShadowMap) -> Spare {
+        Spare {
+            depth: std::mem::take(&mut m.depth),
+            drawn: std::mem::take(&mut m.drawn),
+        }
+    }
+}
 
 /// One model's world-space vertices and triangles this frame, and
 /// whether it goes into the light's map (`casts_nothing`).
@@ -121,9 +143,9 @@ pub(super) fn shadows<'a>(
             {
                 for ls in old.iter_mut() {
                     match ls {
-                        LightShadow::Map(m) => spare.push(std::mem::take(&mut m.depth)),
+                        LightShadow::Map(m) => spare.push(Spare::take(m)),
                         LightShadow::Cube { faces, .. } => {
-                            spare.extend(faces.iter_mut().map(|m| std::mem::take(&mut m.depth)))
+                            spare.extend(faces.iter_mut().map(Spare::take))
                         }
                         LightShadow::None | LightShadow::Ray { .. } => {}
                     }
@@ -142,7 +164,7 @@ pub(super) fn shadows<'a>(
 fn light_shadows(
     fs: &FrameSetup,
     mv: &[ModelVertices],
-    spare: &mut Vec<BigBuf<f32>>,
+    spare: &mut Vec<Spare>,
 ) -> Vec<LightShadow> {
     let s = &fs.scene.settings;
     let mut out = Vec::with_capacity(fs.lights.len());
@@ -280,12 +302,7 @@ fn look(eye: Vec3, dir: Vec3) -> Mat4 {
     )
 }
 
-fn directional(
-    verts: &[Geo],
-    direction: Vec3,
-    size: u32,
-    spare: &mut Vec<BigBuf<f32>>,
-) -> LightShadow {
+fn directional(verts: &[Geo], direction: Vec3, size: u32, spare: &mut Vec<Spare>) -> LightShadow {
     let view = look(Vec3::ZERO, direction);
     let (lo, hi) = verts
         .par_iter()
@@ -346,7 +363,7 @@ fn spot(
     direction: Vec3,
     cos_outer: f32,
     size: u32,
-    spare: &mut Vec<BigBuf<f32>>,
+    spare: &mut Vec<Spare>,
 ) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
@@ -363,7 +380,7 @@ fn spot(
     ))
 }
 
-fn point(verts: &[Geo], position: Vec3, size: u32, spare: &mut Vec<BigBuf<f32>>) -> LightShadow {
+fn point(verts: &[Geo], position: Vec3, size: u32, spare: &mut Vec<Spare>) -> LightShadow {
     let Some(near) = near_plane(verts, position) else {
         return LightShadow::None;
     };
@@ -389,7 +406,7 @@ fn render_map(
     view_from_world: Mat4,
     projection: MapProjection,
     size: u32,
-    spare: &mut Vec<BigBuf<f32>>,
+    spare: &mut Vec<Spare>,
 ) -> ShadowMap {
     let clip_from_world = projection.clip_from_view() * view_from_world;
     let vp = Viewport {
@@ -447,26 +464,48 @@ fn render_map(
         })
         .collect();
     let texels = size as usize * size as usize;
-    let mut depth = match spare.iter().position(|d| d.len() == texels) {
-        Some(k) => spare.swap_remove(k),
-        None => BigBuf::zeroed(texels),
+    // A spare buffer is 0 but for the tiles its map drew into.
+    let (mut depth, old) = match spare.iter().position(|d| d.depth.len() == texels) {
+        Some(k) => {
+            let s = spare.swap_remove(k);
+            (s.depth, Some(s.drawn))
+        }
+        None => (BigBuf::zeroed(texels), None),
     };
     let band = (grid.tile_w * grid.tile_h) as usize;
-    depth.par_chunks_mut(band).enumerate().for_each(|(ti, d)| {
-        d.fill(0.0);
-        let rect = grid.rect(ti);
-        let stride = rect.width();
-        for (tris, bins) in &per_chunk {
-            for &i in &bins[ti] {
-                raster_depth_max(&tris[i as usize], rect, d, stride);
+    let mut drawn = Drawn::none(size);
+    depth
+        .par_chunks_mut(band)
+        .zip(drawn.rows_mut().collect::<Vec<_>>())
+        .enumerate()
+        .for_each(|(ti, (d, marks))| {
+            let rect = grid.rect(ti);
+            let stride = rect.width();
+            if let Some(old) = &old {
+                for cols in old.columns(ti) {
+                    let cols = cols.start.min(stride)..cols.end.min(stride);
+                    for row in d.chunks_exact_mut(stride) {
+                        row[cols.clone()].fill(0.0);
+                    }
+                }
             }
-        }
-    });
+            for (tris, bins) in &per_chunk {
+                for &i in &bins[ti] {
+                    let t = &tris[i as usize];
+                    let (x0, x1) = (t.min_x.max(rect.x0), t.max_x.min(rect.x1 - 1));
+                    if x0 <= x1 {
+                        Drawn::mark(marks, (x0 - rect.x0) as usize, (x1 - rect.x0) as usize);
+                    }
+                    raster_depth_max(t, rect, d, stride);
+                }
+            }
+        });
     ShadowMap {
         size,
         view_from_world,
         projection,
         depth,
+        drawn,
     }
 }
 
@@ -585,5 +624,87 @@ mod tests {
         let line = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
         assert!(plane_of(&geo(&line, &[[0, 1, 2]]), eps).is_none());
         assert!(plane_of(&geo(&line, &[[0, 1, 7]]), eps).is_none());
+    }
+}
+
+#[cfg(test)]
+mod drawn_tests {
+    use super::*;
+
+    /// A small square (a caster) at (cx, cz), 2 units above a floor that
+    /// does not cast, under a sun from straight above.
+    fn caster(cx: f32, cz: f32) -> Vec<Vec3> {
+        let h = 0.3;
+        let mut v = vec![
+            Vec3::new(-4.0, 0.0, -4.0),
+            Vec3::new(4.0, 0.0, -4.0),
+            Vec3::new(4.0, 0.0, 4.0),
+            Vec3::new(-4.0, 0.0, 4.0),
+        ];
+        v.extend([
+            Vec3::new(cx - h, 2.0, cz - h),
+            Vec3::new(cx + h, 2.0, cz - h),
+            Vec3::new(cx + h, 2.0, cz + h),
+            Vec3::new(cx - h, 2.0, cz + h),
+        ]);
+        v
+    }
+
+    fn map_of(world: &[Vec3], spare: &mut Vec<Spare>) -> ShadowMap {
+        let tris = [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+        let floor = [[0u32, 1, 2], [0, 2, 3]];
+        let verts = [
+            Geo {
+                world,
+                triangles: &floor,
+                casts: false,
+            },
+            Geo {
+                world,
+                triangles: &tris[2..],
+                casts: true,
+            },
+        ];
+        match directional(&verts, Vec3::new(0.0, -1.0, 0.0), 256, spare) {
+            LightShadow::Map(m) => m,
+            _ => panic!("a directional light over finite geometry has a map"),
+        }
+    }
+
+    /// Every texel of a tile the marks leave clear is 0, and something
+    /// was drawn (so the test can fail).
+    fn check_marks(m: &ShadowMap) {
+        let n = m.size as usize;
+        let mut drawn = 0;
+        for y in 0..n {
+            for x in 0..n {
+                let d = m.depth[y * n + x];
+                if d != 0.0 {
+                    drawn += 1;
+                    assert!(
+                        m.drawn.tile(x / DRAWN_TILE, y / DRAWN_TILE),
+                        "texel {x} {y} holds {d} in a tile marked clear"
+                    );
+                }
+            }
+        }
+        assert!(drawn > 100, "the caster drew {drawn} texels");
+    }
+
+    #[test]
+    fn marks_cover_every_drawn_texel_and_a_reused_buffer_equals_a_fresh_one() {
+        let mut spare = Vec::new();
+        let mut first = map_of(&caster(-2.0, -2.5), &mut spare);
+        check_marks(&first);
+        // The caster moves across the map: drawn into the first map's
+        // buffer, whose old tiles are cleared, the map equals one drawn
+        // into a new buffer (0 where the first caster stood).
+        spare.push(Spare::take(&mut first));
+        let moved = caster(2.5, 1.0);
+        let reused = map_of(&moved, &mut spare);
+        assert!(spare.is_empty(), "the spare buffer was used");
+        let fresh = map_of(&moved, &mut Vec::new());
+        check_marks(&reused);
+        assert_eq!(&reused.depth[..], &fresh.depth[..]);
     }
 }

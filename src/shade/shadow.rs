@@ -88,6 +88,87 @@ pub struct ShadowMap {
     /// Reverse-Z depth per texel, rows from the top; 0 where nothing was
     /// drawn.
     pub depth: crate::bigbuf::BigBuf<f32>,
+    /// The tiles something was drawn into (elsewhere every texel is 0).
+    pub drawn: Drawn,
+}
+
+/// Side of a `Drawn` tile, in texels.
+pub const DRAWN_TILE: usize = 16;
+
+/// Which tiles of `DRAWN_TILE` x `DRAWN_TILE` texels of a square map may
+/// hold a depth other than 0: a tile whose bit is clear holds 0 in every
+/// texel (nothing was drawn there), so a lookup there need not read the
+/// map, and a buffer drawn into again need not be cleared there.
+#[derive(Debug, Clone, Default)]
+pub struct Drawn {
+    /// 64-bit words per row of tiles.
+    words: usize,
+    bits: Vec<u64>,
+}
+
+impl Drawn {
+    /// No tile drawn, for a `size` x `size` map.
+    pub fn none(size: u32) -> Drawn {
+        let tiles = (size as usize).div_ceil(DRAWN_TILE);
+        let words = tiles.div_ceil(64);
+        Drawn {
+            words,
+            bits: vec![0; words * tiles],
+        }
+    }
+
+    /// Every tile marked (a map whose texels were written by hand).
+    pub fn all(size: u32) -> Drawn {
+        let mut d = Drawn::none(size);
+        d.bits.fill(u64::MAX);
+        d
+    }
+
+    /// The rows of tiles, each `words` words: to mark them in parallel.
+    pub fn rows_mut(&mut self) -> std::slice::ChunksMut<'_, u64> {
+        self.bits.chunks_mut(self.words.max(1))
+    }
+
+    /// Marks the tiles holding texel columns `x0..=x1` in one row's words.
+    pub fn mark(row: &mut [u64], x0: usize, x1: usize) {
+        for t in x0 / DRAWN_TILE..=x1 / DRAWN_TILE {
+            row[t / 64] |= 1 << (t % 64);
+        }
+    }
+
+    /// Whether tile (`tx`, `ty`) is marked.
+    #[inline]
+    pub fn tile(&self, tx: usize, ty: usize) -> bool {
+        self.bits
+            .get(ty * self.words + tx / 64)
+            .is_some_and(|w| w & (1 << (tx % 64)) != 0)
+    }
+
+    /// The marked tiles of tile row `ty`, as texel column ranges.
+    pub fn columns(&self, ty: usize) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        let row = self.bits.get(ty * self.words..(ty + 1) * self.words);
+        row.into_iter()
+            .flatten()
+            .enumerate()
+            .flat_map(|(w, &bits)| {
+                (0..64)
+                    .filter(move |b| bits & (1 << b) != 0)
+                    .map(move |b| (w * 64 + b) * DRAWN_TILE..(w * 64 + b + 1) * DRAWN_TILE)
+            })
+    }
+
+    /// Whether every texel of columns `x0..=x1` and rows `y0..=y1` (each
+    /// span at most one tile boundary wide) is 0 by the marks.
+    #[inline]
+    fn clear_box(&self, x0: usize, x1: usize, y0: usize, y1: usize) -> bool {
+        let (tx0, tx1, ty0, ty1) = (
+            x0 / DRAWN_TILE,
+            x1 / DRAWN_TILE,
+            y0 / DRAWN_TILE,
+            y1 / DRAWN_TILE,
+        );
+        !(self.tile(tx0, ty0) || self.tile(tx1, ty0) || self.tile(tx0, ty1) || self.tile(tx1, ty1))
+    }
 }
 
 /// What a light with `shadows = true` is tested against this frame.
@@ -285,10 +366,19 @@ fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     let wxv = Vec4::from(wx);
     let inside = bx >= 0 && bx + 3 < n;
     let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
+    // Where nothing was drawn under the 4x4 texels they are all 0: not
+    // read (the same values; the reads would mostly miss the cache).
+    let (r0, r3) = (
+        by.clamp(0, n - 1) as usize,
+        (by + 3).clamp(0, n - 1) as usize,
+    );
+    let clear = m.drawn.clear_box(cols[0], cols[3], r0, r3);
     let mut p = [Vec4::ZERO; 4];
     for (j, pj) in p.iter_mut().enumerate() {
         let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
-        let stored = if inside {
+        let stored = if clear {
+            Vec4::ZERO
+        } else if inside {
             let at = base + bx as usize;
             Vec4::from_slice(&m.depth[at..at + 4])
         } else {
@@ -377,6 +467,7 @@ mod tests {
                 far,
             },
             depth,
+            drawn: Drawn::all(8),
         }
     }
 
@@ -481,6 +572,61 @@ mod tests {
             let got = pcf(&m, fx, fy, z, gx, gy);
             assert_eq!(got.to_bits(), want.to_bits(), "{fx} {fy} {z} {gx} {gy}");
         }
+    }
+
+    /// PCF over a map whose marks leave most tiles clear (those are not
+    /// read) equals PCF over the same map with every tile marked (all
+    /// read), at points all over it, some in the drawn tiles, some by
+    /// their edges, some on the map's border.
+    #[test]
+    fn pcf_skips_clear_tiles_without_changing_a_value() {
+        let n = 64usize;
+        let mut marked = map();
+        marked.size = n as u32;
+        // Depth in texels 16..37 x 16..40 (starting at a tile's corner,
+        // so a footprint whose first tile is clear may reach it): tiles
+        // 1 and 2 of tile rows 1 and 2.
+        marked.depth = (0..n * n)
+            .map(|i| {
+                let (x, y) = (i % n, i / n);
+                if (16..37).contains(&x) && (16..40).contains(&y) {
+                    0.3 + 0.01 * ((x * 7 + y * 3) % 11) as f32
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut drawn = Drawn::none(n as u32);
+        for (ty, row) in drawn.rows_mut().enumerate() {
+            if (1..3).contains(&ty) {
+                Drawn::mark(row, 16, 36);
+            }
+        }
+        assert!(!drawn.tile(0, 0) && drawn.tile(1, 1) && drawn.tile(2, 2) && !drawn.tile(3, 1));
+        marked.drawn = drawn;
+        let mut all = marked.clone();
+        all.drawn = Drawn::all(n as u32);
+        let mut lit = 0;
+        let mut seen = std::collections::HashSet::new();
+        for k in 0..4000 {
+            let fx = (k % 80) as f32 * 0.83 - 1.2;
+            let fy = (k / 80) as f32 * 1.37 - 1.7;
+            let (fx, fy) = (fx.clamp(0.0, 63.99), fy.clamp(0.0, 63.99));
+            let z = 0.25 + 0.05 * (k % 5) as f32;
+            let (a, b) = (
+                pcf(&marked, fx, fy, z, 0.001, -0.002),
+                pcf(&all, fx, fy, z, 0.001, -0.002),
+            );
+            assert_eq!(a.to_bits(), b.to_bits(), "at {fx} {fy}");
+            lit += (a > 0.0 && a < 1.0) as usize;
+            seen.insert(a.to_bits());
+        }
+        // Partly shadowed lookups, so the drawn texels were compared.
+        assert!(
+            lit > 50 && seen.len() > 10,
+            "{lit} partial, {} values",
+            seen.len()
+        );
     }
 
     #[test]
