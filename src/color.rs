@@ -126,6 +126,7 @@ pub fn encode_srgb3(c: glam::Vec3) -> [u8; 3] {
 
 /// `encode_srgb` of x, y and z of `c` (what `encode_srgb3` of them gives;
 /// kept in a vector register, where a `Vec3` goes through memory).
+#[cfg(not(target_arch = "x86_64"))]
 #[inline]
 pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
     use glam::Vec4;
@@ -133,6 +134,40 @@ pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
     // max(NaN, 0) is 0, as in `encode_srgb`.
     let v = c.max(Vec4::ZERO).min(Vec4::ONE);
     [t.encode(v.x), t.encode(v.y), t.encode(v.z)]
+}
+
+/// (On x86-64 the segment keys and table entries of the lanes are found
+/// together, in SSE2: `Segments::encode`'s operations lane by lane.)
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
+    use glam::Vec4;
+    use std::arch::x86_64::*;
+    let t = segments();
+    // max(NaN, 0) is 0, as in `encode_srgb`: v is in [0, 1].
+    let v = c.max(Vec4::ZERO).min(Vec4::ONE);
+    let (mut key, mut index) = ([0u32; 4], [0u32; 4]);
+    // SAFETY: SSE2 only (in every x86-64 target's base features); the
+    // stores write the 16 bytes of `key` and `index`.
+    unsafe {
+        let v: __m128 = v.into();
+        // `Segments::encode`'s key: (|bits| >> 16) - KEY_BASE, 0 below.
+        let bits = _mm_and_si128(_mm_castps_si128(v), _mm_set1_epi32(0x7fff_ffff));
+        let d = _mm_sub_epi32(_mm_srli_epi32(bits, 16), _mm_set1_epi32(KEY_BASE as i32));
+        let k = _mm_and_si128(d, _mm_cmpgt_epi32(d, _mm_setzero_si128()));
+        // `lut_index`: v * 65535 + 0.5, truncated (in 0.5..=65535.5).
+        let i = _mm_cvttps_epi32(_mm_add_ps(
+            _mm_mul_ps(v, _mm_set1_ps((LUT_SIZE - 1) as f32)),
+            _mm_set1_ps(0.5),
+        ));
+        _mm_storeu_si128(key.as_mut_ptr() as *mut __m128i, k);
+        _mm_storeu_si128(index.as_mut_ptr() as *mut __m128i, i);
+    }
+    let byte = |j: usize| {
+        let e = t.0[(key[j] as usize).min(SEGMENTS - 1)];
+        (e as u8) + (index[j] >= e >> 8) as u8
+    };
+    [byte(0), byte(1), byte(2)]
 }
 
 /// [0,1] -> byte without transfer curve (data: normals, depth, alpha).
@@ -204,7 +239,8 @@ mod tests {
             } else {
                 next()
             };
-            let c = glam::Vec3::new(v, 0.25, -v);
+            let w = if k % 3 == 0 { next() } else { 0.25 };
+            let c = glam::Vec3::new(v, w, -v);
             assert_eq!(
                 encode_srgb3(c),
                 [encode_srgb(c.x), encode_srgb(c.y), encode_srgb(c.z)],
