@@ -31,56 +31,24 @@ fn missing_cpu_feature() -> Option<&'static str> {
             let xcr0 = unsafe { xgetbv0() };
             xcr0 & 0b110 == 0b110
         };
-        let checks: [(&'static str, bool, bool); 13] = [
-            ("sse3", cfg!(target_feature = "sse3"), l1.ecx & 1 != 0),
-            (
-                "ssse3",
-                cfg!(target_feature = "ssse3"),
-                l1.ecx & (1 << 9) != 0,
-            ),
-            (
-                "fma",
-                cfg!(target_feature = "fma"),
-                l1.ecx & (1 << 12) != 0 && os_avx,
-            ),
-            (
-                "sse4.1",
-                cfg!(target_feature = "sse4.1"),
-                l1.ecx & (1 << 19) != 0,
-            ),
-            (
-                "sse4.2",
-                cfg!(target_feature = "sse4.2"),
-                l1.ecx & (1 << 20) != 0,
-            ),
-            (
-                "movbe",
-                cfg!(target_feature = "movbe"),
-                l1.ecx & (1 << 22) != 0,
-            ),
-            (
-                "popcnt",
-                cfg!(target_feature = "popcnt"),
-                l1.ecx & (1 << 23) != 0,
-            ),
-            (
-                "avx",
-                cfg!(target_feature = "avx"),
-                l1.ecx & (1 << 28) != 0 && os_avx,
-            ),
-            (
-                "f16c",
-                cfg!(target_feature = "f16c"),
-                l1.ecx & (1 << 29) != 0 && os_avx,
-            ),
-            ("bmi1", cfg!(target_feature = "bmi1"), l7b & (1 << 3) != 0),
-            (
-                "avx2",
-                cfg!(target_feature = "avx2"),
-                l7b & (1 << 5) != 0 && os_avx,
-            ),
-            ("bmi2", cfg!(target_feature = "bmi2"), l7b & (1 << 8) != 0),
-            ("lzcnt", cfg!(target_feature = "lzcnt"), ext & (1 << 5) != 0),
+        let bit = |r: u32, b: u32| r & (1 << b) != 0;
+        // (AVX state: the OS must save the registers too.)
+        let vex = |b: u32| bit(l1.ecx, b) && os_avx;
+        // Name, whether this build uses it, whether the CPU has it.
+        let checks = [
+            ("sse3", cfg!(target_feature = "sse3"), bit(l1.ecx, 0)),
+            ("ssse3", cfg!(target_feature = "ssse3"), bit(l1.ecx, 9)),
+            ("fma", cfg!(target_feature = "fma"), vex(12)),
+            ("sse4.1", cfg!(target_feature = "sse4.1"), bit(l1.ecx, 19)),
+            ("sse4.2", cfg!(target_feature = "sse4.2"), bit(l1.ecx, 20)),
+            ("movbe", cfg!(target_feature = "movbe"), bit(l1.ecx, 22)),
+            ("popcnt", cfg!(target_feature = "popcnt"), bit(l1.ecx, 23)),
+            ("avx", cfg!(target_feature = "avx"), vex(28)),
+            ("f16c", cfg!(target_feature = "f16c"), vex(29)),
+            ("bmi1", cfg!(target_feature = "bmi1"), bit(l7b, 3)),
+            ("avx2", cfg!(target_feature = "avx2"), bit(l7b, 5) && os_avx),
+            ("bmi2", cfg!(target_feature = "bmi2"), bit(l7b, 8)),
+            ("lzcnt", cfg!(target_feature = "lzcnt"), bit(ext, 5)),
         ];
         for (name, built_for, present) in checks {
             if built_for && !present {

@@ -349,14 +349,9 @@ impl<'a> ShadeContext<'a> {
         let mut lit = reaches & ndl.cmpgt(Vec4::ZERO);
         let mut s = Vec4::ONE;
         if light.shadows {
-            let bits = lit.bitmask();
-            for k in 0..4 {
-                if bits & (1 << k) != 0 {
-                    s[k] = self
-                        .shadows
-                        .visibility(i, p.lane(k), f.geo_normal[k], l.lane(k));
-                }
-            }
+            s = self
+                .shadows
+                .visibility4(i, p, &f.geo_normal, l, lit.bitmask());
             lit &= s.cmpgt(Vec4::ZERO);
         }
         Lit {

@@ -24,7 +24,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::raytrace::Tracer;
 use crate::scene::ShadowBias;
-use crate::simd::lanes4;
+use crate::simd::{V3, lanes4};
 
 /// How a map projects light-view space (looking down -Z) to texels.
 #[derive(Debug, Clone, Copy)]
@@ -315,6 +315,25 @@ impl Shadows<'_> {
                 (fx, fy, z, gx, gy, near * t / (d * d))
             }
         };
+        self.filtered(m, fx, fy, z, gx, gy, z_per_texel)
+    }
+
+    /// The lookup at texel coordinates (`fx`, `fy`) of the receiver's
+    /// plane (depth `z` there, `gx`, `gy` per texel, capped at
+    /// `z_per_texel` times the slope cap), by the filter.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn filtered(
+        &self,
+        m: &ShadowMap,
+        fx: f32,
+        fy: f32,
+        z: f32,
+        gx: f32,
+        gy: f32,
+        z_per_texel: f32,
+    ) -> f32 {
+        let size = m.size as f32;
         // The plane's slope, capped like the slope bias.
         let cap = z_per_texel * MAX_TAN;
         // (min/max, not clamp: with extreme geometry cap can be NaN.)
@@ -322,20 +341,163 @@ impl Shadows<'_> {
         if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size {
             return 1.0;
         }
-        let n = m.size as i32;
-        // Lit when the stored depth is not nearer (greater) than the
-        // receiver's at that texel center.
-        let lit = |ix: i32, iy: i32| -> f32 {
-            let (cx, cy) = (ix.clamp(0, n - 1), iy.clamp(0, n - 1));
-            let stored = m.depth[(cy * n + cx) as usize];
-            let zr = z + gx * (ix as f32 + 0.5 - fx) + gy * (iy as f32 + 0.5 - fy);
-            if stored <= zr { 1.0 } else { 0.0 }
-        };
         match self.filter {
-            Filter::Hard => lit(fx as i32, fy as i32),
+            Filter::Hard => hard(m, fx, fy, z, gx, gy),
             Filter::Pcf => pcf(m, fx, fy, z, gx, gy),
         }
     }
+
+    /// `visibility(i, p_k, ng[k], l_k)` for each lane k in `lanes` (bit k;
+    /// the others are 1), the lanes of `p` and `l`: an orthographic map's
+    /// lookups placed four at a time (the same operations lane by lane),
+    /// the other kinds lane by lane.
+    pub fn visibility4(&self, i: usize, p: V3, ng: &[Vec3; 4], l: V3, lanes: u32) -> Vec4 {
+        let mut out = Vec4::ONE;
+        if let Some(LightShadow::Map(m)) = self.lights.get(i)
+            && let MapProjection::Ortho { .. } = m.projection
+        {
+            let n = V3::from_lanes(*ng);
+            let cos = n.dot(l);
+            let Ortho4 {
+                d,
+                near,
+                fx,
+                fy,
+                z,
+                gx,
+                gy,
+                z_per_texel,
+            } = self.place4_ortho(m, p, n, cos);
+            for k in 0..4 {
+                if lanes & (1 << k) == 0 {
+                    continue;
+                }
+                out[k] = if cos[k] <= 0.0 {
+                    0.0
+                } else if d[k] < near {
+                    1.0
+                } else {
+                    self.filtered(m, fx[k], fy[k], z[k], gx[k], gy[k], z_per_texel)
+                };
+            }
+            return out;
+        }
+        for k in 0..4 {
+            if lanes & (1 << k) != 0 {
+                out[k] = self.visibility(i, p.lane(k), ng[k], l.lane(k));
+            }
+        }
+        out
+    }
+}
+
+/// Four orthographic lookups placed (`Shadows::place4_ortho`): per lane
+/// the receiver's distance `d` (none is taken nearer than `near`), its
+/// texel coordinates, plane depth and slopes, as `Shadows::lookup`
+/// computes them.
+struct Ortho4 {
+    d: Vec4,
+    near: f32,
+    fx: Vec4,
+    fy: Vec4,
+    z: Vec4,
+    gx: Vec4,
+    gy: Vec4,
+    z_per_texel: f32,
+}
+
+impl Shadows<'_> {
+    /// `lookup`'s placement in an orthographic map for four points `p`
+    /// with geometric normals `n` (`cos` = n.l): the same operations in
+    /// the same order, lane by lane (the scalar constants computed as it
+    /// computes them).
+    #[inline]
+    fn place4_ortho(&self, m: &ShadowMap, p: V3, n: V3, cos: Vec4) -> Ortho4 {
+        let MapProjection::Ortho {
+            x0,
+            x1,
+            y0,
+            y1,
+            near,
+            far,
+        } = m.projection
+        else {
+            unreachable!("place4_ortho is called for orthographic maps only")
+        };
+        let b = &self.bias;
+        let sp = Vec4::splat;
+        let sin = (Vec4::ONE - cos * cos).max(Vec4::ZERO).sqrt();
+        let tan = (sin / cos).min(sp(MAX_TAN));
+        let size = m.size as f32;
+        let v = &m.view_from_world;
+        let q0 = point4(v, p);
+        // `texel(d)`: the same for every distance in an orthographic map.
+        let t = (x1 - x0) / size;
+        let nv = vector4(v, n);
+        let q = q0 + nv.scale(sp(b.normal) * sin * sp(t));
+        let d = -q.z;
+        let depth_bias = sp(t) * (sp(b.constant) + sp(b.slope) * tan);
+        let fx = (q.x - sp(x0)) / sp(x1 - x0) * sp(size);
+        let fy = (sp(y1) - q.y) / sp(y1 - y0) * sp(size);
+        let a = 1.0 / (far - near);
+        let z = (sp(far) - (d - depth_bias)) * sp(a);
+        let (tx, ty) = ((x1 - x0) / size, (y1 - y0) / size);
+        let inv = Vec4::select(nv.z.abs().cmpgt(sp(1e-12)), Vec4::ONE / nv.z, Vec4::ZERO);
+        let gx = -(nv.x * sp(tx) * inv) * sp(a);
+        let gy = (nv.y * sp(ty) * inv) * sp(a);
+        Ortho4 {
+            d,
+            near,
+            fx,
+            fy,
+            z,
+            gx,
+            gy,
+            z_per_texel: t * a,
+        }
+    }
+}
+
+/// `m.transform_point3(p)` of four points: per coordinate
+/// ((x p.x + y p.y) + z p.z) + w, as glam sums the columns.
+#[inline(always)]
+fn point4(m: &Mat4, p: V3) -> V3 {
+    let c = |k: usize| {
+        let col = |v: Vec4| Vec4::splat(v[k]);
+        ((col(m.x_axis) * p.x + col(m.y_axis) * p.y) + col(m.z_axis) * p.z) + col(m.w_axis)
+    };
+    V3 {
+        x: c(0),
+        y: c(1),
+        z: c(2),
+    }
+}
+
+/// `m.transform_vector3(v)` of four vectors: (x v.x + y v.y) + z v.z.
+#[inline(always)]
+fn vector4(m: &Mat4, v: V3) -> V3 {
+    let c = |k: usize| {
+        let col = |a: Vec4| Vec4::splat(a[k]);
+        (col(m.x_axis) * v.x + col(m.y_axis) * v.y) + col(m.z_axis) * v.z
+    };
+    V3 {
+        x: c(0),
+        y: c(1),
+        z: c(2),
+    }
+}
+
+/// The "hard" filter: the one texel under (`fx`, `fy`), lit when its
+/// stored depth is not nearer (greater) than the receiver's plane at its
+/// center.
+#[inline]
+fn hard(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+    let n = m.size as i32;
+    let (ix, iy) = (fx as i32, fy as i32);
+    let (cx, cy) = (ix.clamp(0, n - 1), iy.clamp(0, n - 1));
+    let stored = m.depth[(cy * n + cx) as usize];
+    let zr = z + gx * (ix as f32 + 0.5 - fx) + gy * (iy as f32 + 0.5 - fy);
+    if stored <= zr { 1.0 } else { 0.0 }
 }
 
 /// The PCF kernel at texel coordinates (`fx`, `fy`) inside the map: the
@@ -626,6 +788,72 @@ mod tests {
             lit > 50 && seen.len() > 10,
             "{lit} partial, {} values",
             seen.len()
+        );
+    }
+
+    /// Four lanes of an orthographic map give each lane's one-lane
+    /// `visibility` bit for bit (both filters, two biases), over points
+    /// inside, beside and in front of the map, normals towards and away
+    /// from the light, grazing ones, and lanes left out.
+    #[test]
+    fn four_lane_lookups_equal_one_lane_lookups() {
+        let mut r = crate::testing::xorshift(0x5eed_0004);
+        let n = 64usize;
+        let mut m = map();
+        m.size = n as u32;
+        // Rough terrain of depths (some texels empty), seen from above.
+        m.depth = (0..n * n)
+            .map(|_| if r() < 0.2 { 0.0 } else { 0.45 + 0.2 * r() })
+            .collect();
+        m.drawn = Drawn::all(n as u32);
+        let (mut shaded, mut partial) = (0, 0);
+        for filter in [Filter::Pcf, Filter::Hard] {
+            for bias in [
+                ShadowBias::default(),
+                ShadowBias {
+                    constant: 0.3,
+                    slope: 2.0,
+                    normal: 1.5,
+                },
+            ] {
+                let s = Shadows {
+                    lights: std::sync::Arc::new([LightShadow::Map(m.clone())]),
+                    filter,
+                    bias,
+                    tracer: None,
+                };
+                for _ in 0..3000 {
+                    let mut v = |s: f32| (r() * 2.0 - 1.0) * s;
+                    let p = [0, 1, 2, 3].map(|_| Vec3::new(v(1.3), v(6.0), v(1.3)));
+                    let ng = [0, 1, 2, 3].map(|_| {
+                        let g = Vec3::new(v(1.0), v(1.0) + 0.3, v(1.0));
+                        g.try_normalize().unwrap_or(Vec3::Y)
+                    });
+                    let l = [0, 1, 2, 3].map(|_| Vec3::new(v(0.3), 1.0, v(0.3)).normalize());
+                    let lanes = (r() * 16.0) as u32 | 1;
+                    let four = s.visibility4(0, V3::from_lanes(p), &ng, V3::from_lanes(l), lanes);
+                    for k in 0..4 {
+                        let want = if lanes & (1 << k) != 0 {
+                            s.visibility(0, p[k], ng[k], l[k])
+                        } else {
+                            1.0
+                        };
+                        assert_eq!(
+                            four[k].to_bits(),
+                            want.to_bits(),
+                            "lane {k}: {p:?} {ng:?} {l:?}"
+                        );
+                        shaded += (want == 0.0) as usize;
+                        partial += (want > 0.0 && want < 1.0) as usize;
+                    }
+                }
+            }
+        }
+        // Shadowed and partly shadowed lanes, so the comparison means
+        // something.
+        assert!(
+            shaded > 1000 && partial > 500,
+            "{shaded} shadowed, {partial} partial"
         );
     }
 
