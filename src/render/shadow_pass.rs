@@ -34,7 +34,7 @@ use crate::raytrace::Tracer;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::settings::{CullMode, ShadowMethod};
 use crate::shade::shadow::{
-    DRAWN_TILE, Drawn, Filter, LightShadow, MapProjection, ShadowMap, Shadows,
+    DRAWN_TILE, Drawn, Filter, LightShadow, MapProjection, OrthoBox, ShadowMap, Shadows,
 };
 
 const CHUNK: usize = 4096;
@@ -324,7 +324,7 @@ fn directional(verts: &[Geo], direction: Vec3, size: u32, spare: &mut Vec<Spare>
     let side = ext.x.max(ext.y) + 2.0 * pad;
     let (cx, cy) = ((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5);
     let dz = ext.z * 0.01 + pad;
-    let projection = MapProjection::Ortho {
+    let projection = MapProjection::Ortho(OrthoBox {
         x0: cx - side * 0.5,
         x1: cx + side * 0.5,
         y0: cy - side * 0.5,
@@ -332,7 +332,7 @@ fn directional(verts: &[Geo], direction: Vec3, size: u32, spare: &mut Vec<Spare>
         // Distance is -z in view space.
         near: -hi.z - dz,
         far: -lo.z + dz,
-    };
+    });
     LightShadow::Map(render_map(verts, view, projection, size, spare))
 }
 

@@ -29,17 +29,21 @@ use crate::simd::{V3, lanes4};
 /// How a map projects light-view space (looking down -Z) to texels.
 #[derive(Debug, Clone, Copy)]
 pub enum MapProjection {
-    /// x in [x0, x1], y in [y0, y1]; distance (-z) in [near, far].
-    Ortho {
-        x0: f32,
-        x1: f32,
-        y0: f32,
-        y1: f32,
-        near: f32,
-        far: f32,
-    },
+    /// A box of light-view space.
+    Ortho(OrthoBox),
     /// tan of the half field of view (square), near plane distance.
     Perspective { tan_half: f32, near: f32 },
+}
+
+/// x in [x0, x1], y in [y0, y1]; distance (-z) in [near, far].
+#[derive(Debug, Clone, Copy)]
+pub struct OrthoBox {
+    pub x0: f32,
+    pub x1: f32,
+    pub y0: f32,
+    pub y1: f32,
+    pub near: f32,
+    pub far: f32,
 }
 
 impl MapProjection {
@@ -47,22 +51,20 @@ impl MapProjection {
     pub fn clip_from_view(&self) -> Mat4 {
         use glam::Vec4;
         match *self {
-            MapProjection::Ortho {
-                x0,
-                x1,
-                y0,
-                y1,
-                near,
-                far,
-            } => {
-                let (sx, sy) = (2.0 / (x1 - x0), 2.0 / (y1 - y0));
+            MapProjection::Ortho(o) => {
+                let (sx, sy) = (2.0 / (o.x1 - o.x0), 2.0 / (o.y1 - o.y0));
                 // z_clip = (far - d) / (far - near) with d = -z_view.
-                let a = 1.0 / (far - near);
+                let a = 1.0 / (o.far - o.near);
                 Mat4::from_cols(
                     Vec4::new(sx, 0.0, 0.0, 0.0),
                     Vec4::new(0.0, sy, 0.0, 0.0),
                     Vec4::new(0.0, 0.0, a, 0.0),
-                    Vec4::new(-(x0 + x1) / (x1 - x0), -(y0 + y1) / (y1 - y0), far * a, 1.0),
+                    Vec4::new(
+                        -(o.x0 + o.x1) / (o.x1 - o.x0),
+                        -(o.y0 + o.y1) / (o.y1 - o.y0),
+                        o.far * a,
+                        1.0,
+                    ),
                 )
             }
             MapProjection::Perspective { tan_half, near } => {
@@ -260,7 +262,7 @@ impl Shadows<'_> {
         let v = &m.view_from_world;
         let q0 = v.transform_point3(p);
         let texel = |d: f32| match m.projection {
-            MapProjection::Ortho { x0, x1, .. } => (x1 - x0) / size,
+            MapProjection::Ortho(o) => (o.x1 - o.x0) / size,
             MapProjection::Perspective { tan_half, .. } => 2.0 * d * tan_half / size,
         };
         // Normal offset.
@@ -272,23 +274,16 @@ impl Shadows<'_> {
         // Texel coordinates of q, the receiver's reverse-Z depth there, and
         // its gradient per texel along the map's x and y (rows run down).
         let (fx, fy, z, gx, gy, z_per_texel) = match m.projection {
-            MapProjection::Ortho {
-                x0,
-                x1,
-                y0,
-                y1,
-                near,
-                far,
-            } => {
-                if d < near {
+            MapProjection::Ortho(o) => {
+                if d < o.near {
                     return 1.0;
                 }
-                let fx = (q.x - x0) / (x1 - x0) * size;
-                let fy = (y1 - q.y) / (y1 - y0) * size;
-                let a = 1.0 / (far - near);
-                let z = (far - (d - depth_bias)) * a;
+                let fx = (q.x - o.x0) / (o.x1 - o.x0) * size;
+                let fy = (o.y1 - q.y) / (o.y1 - o.y0) * size;
+                let a = 1.0 / (o.far - o.near);
+                let z = (o.far - (d - depth_bias)) * a;
                 // d' = d + (nv.x dx + nv.y dy) / nv.z along the plane.
-                let (tx, ty) = ((x1 - x0) / size, (y1 - y0) / size);
+                let (tx, ty) = ((o.x1 - o.x0) / size, (o.y1 - o.y0) / size);
                 let inv = if nv.z.abs() > 1e-12 { 1.0 / nv.z } else { 0.0 };
                 let gx = -(nv.x * tx * inv) * a;
                 let gy = (nv.y * ty * inv) * a;
@@ -354,7 +349,7 @@ impl Shadows<'_> {
     pub fn visibility4(&self, i: usize, p: V3, ng: &[Vec3; 4], l: V3, lanes: u32) -> Vec4 {
         let mut out = Vec4::ONE;
         if let Some(LightShadow::Map(m)) = self.lights.get(i)
-            && let MapProjection::Ortho { .. } = m.projection
+            && let MapProjection::Ortho(o) = m.projection
         {
             let n = V3::from_lanes(*ng);
             let cos = n.dot(l);
@@ -367,7 +362,7 @@ impl Shadows<'_> {
                 gx,
                 gy,
                 z_per_texel,
-            } = self.place4_ortho(m, p, n, cos);
+            } = self.place4_ortho(m, o, p, n, cos);
             for k in 0..4 {
                 if lanes & (1 << k) == 0 {
                     continue;
@@ -407,23 +402,12 @@ struct Ortho4 {
 }
 
 impl Shadows<'_> {
-    /// `lookup`'s placement in an orthographic map for four points `p`
+    /// `lookup`'s placement in orthographic map `m` (box `o`) for four points `p`
     /// with geometric normals `n` (`cos` = n.l): the same operations in
     /// the same order, lane by lane (the scalar constants computed as it
     /// computes them).
     #[inline]
-    fn place4_ortho(&self, m: &ShadowMap, p: V3, n: V3, cos: Vec4) -> Ortho4 {
-        let MapProjection::Ortho {
-            x0,
-            x1,
-            y0,
-            y1,
-            near,
-            far,
-        } = m.projection
-        else {
-            unreachable!("place4_ortho is called for orthographic maps only")
-        };
+    fn place4_ortho(&self, m: &ShadowMap, o: OrthoBox, p: V3, n: V3, cos: Vec4) -> Ortho4 {
         let b = &self.bias;
         let sp = Vec4::splat;
         let sin = (Vec4::ONE - cos * cos).max(Vec4::ZERO).sqrt();
@@ -432,22 +416,22 @@ impl Shadows<'_> {
         let v = &m.view_from_world;
         let q0 = point4(v, p);
         // `texel(d)`: the same for every distance in an orthographic map.
-        let t = (x1 - x0) / size;
+        let t = (o.x1 - o.x0) / size;
         let nv = vector4(v, n);
         let q = q0 + nv.scale(sp(b.normal) * sin * sp(t));
         let d = -q.z;
         let depth_bias = sp(t) * (sp(b.constant) + sp(b.slope) * tan);
-        let fx = (q.x - sp(x0)) / sp(x1 - x0) * sp(size);
-        let fy = (sp(y1) - q.y) / sp(y1 - y0) * sp(size);
-        let a = 1.0 / (far - near);
-        let z = (sp(far) - (d - depth_bias)) * sp(a);
-        let (tx, ty) = ((x1 - x0) / size, (y1 - y0) / size);
+        let fx = (q.x - sp(o.x0)) / sp(o.x1 - o.x0) * sp(size);
+        let fy = (sp(o.y1) - q.y) / sp(o.y1 - o.y0) * sp(size);
+        let a = 1.0 / (o.far - o.near);
+        let z = (sp(o.far) - (d - depth_bias)) * sp(a);
+        let (tx, ty) = ((o.x1 - o.x0) / size, (o.y1 - o.y0) / size);
         let inv = Vec4::select(nv.z.abs().cmpgt(sp(1e-12)), Vec4::ONE / nv.z, Vec4::ZERO);
         let gx = -(nv.x * sp(tx) * inv) * sp(a);
         let gy = (nv.y * sp(ty) * inv) * sp(a);
         Ortho4 {
             d,
-            near,
+            near: o.near,
             fx,
             fy,
             z,
@@ -620,14 +604,14 @@ mod tests {
         ShadowMap {
             size: 8,
             view_from_world,
-            projection: MapProjection::Ortho {
+            projection: MapProjection::Ortho(OrthoBox {
                 x0: -1.0,
                 x1: 1.0,
                 y0: -1.0,
                 y1: 1.0,
                 near,
                 far,
-            },
+            }),
             depth,
             drawn: Drawn::all(8),
         }
