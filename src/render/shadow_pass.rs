@@ -464,11 +464,17 @@ fn render_map(
         })
         .collect();
     let texels = size as usize * size as usize;
-    // A spare buffer is 0 but for the tiles its map drew into.
+    // A spare buffer is 0 but for the tiles its map drew into (all of
+    // them where its marks do not fit this size).
     let (mut depth, old) = match spare.iter().position(|d| d.depth.len() == texels) {
         Some(k) => {
             let s = spare.swap_remove(k);
-            (s.depth, Some(s.drawn))
+            let drawn = if s.drawn.fits(size) {
+                s.drawn
+            } else {
+                Drawn::all(size)
+            };
+            (s.depth, Some(drawn))
         }
         None => (BigBuf::zeroed(texels), None),
     };
@@ -706,5 +712,11 @@ mod drawn_tests {
         let fresh = map_of(&moved, &mut Vec::new());
         check_marks(&reused);
         assert_eq!(&reused.depth[..], &fresh.depth[..]);
+        // A spare whose marks say nothing is cleared whole.
+        let mut stale = map_of(&caster(-2.0, -2.5), &mut Vec::new());
+        stale.drawn = Drawn::default();
+        let mut spare = vec![Spare::take(&mut stale)];
+        let again = map_of(&moved, &mut spare);
+        assert_eq!(&again.depth[..], &fresh.depth[..]);
     }
 }

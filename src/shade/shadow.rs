@@ -100,7 +100,9 @@ pub const DRAWN_TILE: usize = 16;
 /// Which tiles of `DRAWN_TILE` x `DRAWN_TILE` texels of a square map may
 /// hold a depth other than 0: a tile whose bit is clear holds 0 in every
 /// texel (nothing was drawn there), so a lookup there need not read the
-/// map, and a buffer drawn into again need not be cleared there.
+/// map, and a buffer drawn into again need not be cleared there. Marks
+/// that do not fit the map (`Drawn::default()`, another size) say nothing:
+/// every tile may hold a depth.
 #[derive(Debug, Clone, Default)]
 pub struct Drawn {
     /// 64-bit words per row of tiles.
@@ -138,12 +140,21 @@ impl Drawn {
         }
     }
 
-    /// Whether tile (`tx`, `ty`) is marked.
+    /// Whether these marks are a `size` x `size` map's.
+    pub fn fits(&self, size: u32) -> bool {
+        let tiles = (size as usize).div_ceil(DRAWN_TILE);
+        self.words == tiles.div_ceil(64) && self.bits.len() == self.words * tiles
+    }
+
+    /// Whether tile (`tx`, `ty`) may hold a depth: marked, or beyond the
+    /// marks (which then say nothing about it).
     #[inline]
     pub fn tile(&self, tx: usize, ty: usize) -> bool {
-        self.bits
-            .get(ty * self.words + tx / 64)
-            .is_some_and(|w| w & (1 << (tx % 64)) != 0)
+        tx / 64 >= self.words
+            || self
+                .bits
+                .get(ty * self.words + tx / 64)
+                .is_none_or(|w| w & (1 << (tx % 64)) != 0)
     }
 
     /// The marked tiles of tile row `ty`, as texel column ranges.
@@ -752,6 +763,12 @@ mod tests {
         marked.drawn = drawn;
         let mut all = marked.clone();
         all.drawn = Drawn::all(n as u32);
+        // Marks that say nothing (another map's, none) read every texel.
+        let mut unknown = marked.clone();
+        unknown.drawn = Drawn::default();
+        let mut other = marked.clone();
+        other.drawn = Drawn::none(8);
+        assert!(marked.drawn.fits(n as u32) && !other.drawn.fits(n as u32));
         let mut lit = 0;
         let mut seen = std::collections::HashSet::new();
         for k in 0..4000 {
@@ -764,6 +781,14 @@ mod tests {
                 pcf(&all, fx, fy, z, 0.001, -0.002),
             );
             assert_eq!(a.to_bits(), b.to_bits(), "at {fx} {fy}");
+            for m in [&unknown, &other] {
+                let c = pcf(m, fx, fy, z, 0.001, -0.002);
+                assert_eq!(
+                    c.to_bits(),
+                    b.to_bits(),
+                    "at {fx} {fy}, marks that do not fit"
+                );
+            }
             lit += (a > 0.0 && a < 1.0) as usize;
             seen.insert(a.to_bits());
         }
