@@ -46,6 +46,29 @@ fn plane_distances(p: Vec4, guard_x: f32, guard_y: f32) -> [f32; 6] {
     ]
 }
 
+/// The outcode bits of the six planes (`outcode`).
+pub const OUTSIDE_PLANES: u8 = 0x3f;
+/// The outcode bit of a position with a NaN or infinite coordinate.
+pub const NOT_FINITE: u8 = 0x40;
+
+/// Which planes `p` lies outside of (bit k: distance k of
+/// `plane_distances` below 0, as `clip_triangle` tests them), and
+/// `NOT_FINITE`. Computed once per vertex, a triangle is classified from
+/// its corners' codes as `clip_triangle` classifies it: all codes 0 is
+/// `Inside`, a plane bit common to all three is `Rejected`.
+#[inline]
+pub fn outcode(p: Vec4, guard_x: f32, guard_y: f32) -> u8 {
+    let d = plane_distances(p, guard_x, guard_y);
+    let mut code = 0;
+    for (k, dk) in d.iter().enumerate() {
+        code |= u8::from(*dk < 0.0) << k;
+    }
+    if !p.is_finite() {
+        code |= NOT_FINITE;
+    }
+    code
+}
+
 #[allow(clippy::large_enum_variant)] // returned by value per triangle; boxing would allocate
 pub enum Clipped {
     /// Entirely outside one plane.

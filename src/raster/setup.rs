@@ -118,6 +118,48 @@ impl Viewport {
     }
 }
 
+/// A vertex projected to the viewport and snapped, as `setup` does it to
+/// each corner: per vertex once (`project`), shared by the triangles
+/// around it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Projected {
+    /// Fixed-point screen coordinates (1/2^15 pixel).
+    pub x: i32,
+    pub y: i32,
+    /// z/w and 1/w.
+    pub z: f32,
+    pub inv_w: f32,
+    /// Within the snapping limit (1.25 times the guard band; false for a
+    /// NaN): a triangle with a corner that is not is dropped.
+    pub ok: bool,
+}
+
+/// Projects and snaps clip-space position `p` to viewport `vp`.
+#[inline]
+pub fn project(p: glam::Vec4, vp: Viewport) -> Projected {
+    let (w, h) = (vp.width as f64, vp.height as f64);
+    let iw = 1.0 / p.w as f64;
+    let sx = (p.x as f64 * iw * 0.5 + 0.5) * w;
+    let sy = (0.5 - p.y as f64 * iw * 0.5) * h;
+    // Clipping keeps vertices inside the guard band (2^14 pixels from
+    // the center); one beyond 1.25 times that (or not finite) comes
+    // from a numerical breakdown on extreme input and is dropped. With
+    // |dx|, |dy| <= 2.5 * 2^14 pixels = 2^(15.33 + SUBPIXEL_BITS) fixed
+    // point, area2 <= 2 * 2^60.7 < 2^63: no i64 overflow below.
+    const LIMIT: f64 = 1.25 * 16384.0;
+    let inside = |d: f64| d.abs() <= LIMIT; // false for NaN
+    if !(inside(sx - w * 0.5) && inside(sy - h * 0.5)) {
+        return Projected::default();
+    }
+    Projected {
+        x: (sx * SUBPIXEL as f64).round() as i32,
+        y: (sy * SUBPIXEL as f64).round() as i32,
+        z: (p.z as f64 * iw) as f32,
+        inv_w: iw as f32,
+        ok: true,
+    }
+}
+
 /// Projects, snaps, culls and orders one (clipped) triangle. None when it is
 /// culled, has zero area after snapping, or covers no pixel center.
 pub fn setup(
@@ -127,31 +169,27 @@ pub fn setup(
     draw: u32,
     prim: u32,
 ) -> Option<Tri> {
-    let (w, h) = (vp.width as f64, vp.height as f64);
-    let mut x = [0i32; 3];
-    let mut y = [0i32; 3];
-    let mut z = [0f32; 3];
-    let mut inv_w = [0f32; 3];
-    for k in 0..3 {
-        let p = v[k].pos;
-        let iw = 1.0 / p.w as f64;
-        let sx = (p.x as f64 * iw * 0.5 + 0.5) * w;
-        let sy = (0.5 - p.y as f64 * iw * 0.5) * h;
-        // Clipping keeps vertices inside the guard band (2^14 pixels from
-        // the center); one beyond 1.25 times that (or not finite) comes
-        // from a numerical breakdown on extreme input and is dropped. With
-        // |dx|, |dy| <= 2.5 * 2^14 pixels = 2^(15.33 + SUBPIXEL_BITS) fixed
-        // point, area2 <= 2 * 2^60.7 < 2^63: no i64 overflow below.
-        const LIMIT: f64 = 1.25 * 16384.0;
-        let inside = |d: f64| d.abs() <= LIMIT; // false for NaN
-        if !(inside(sx - w * 0.5) && inside(sy - h * 0.5)) {
-            return None;
-        }
-        x[k] = (sx * SUBPIXEL as f64).round() as i32;
-        y[k] = (sy * SUBPIXEL as f64).round() as i32;
-        z[k] = (p.z as f64 * iw) as f32;
-        inv_w[k] = iw as f32;
+    let p = v.map(|v| project(v.pos, vp));
+    setup_projected(p, v.map(|v| v.bary), vp, cull, draw, prim)
+}
+
+/// `setup` of a triangle whose corners are already projected, with their
+/// barycentrics `bary` in the original triangle.
+pub fn setup_projected(
+    p: [Projected; 3],
+    mut bary: [Vec3; 3],
+    vp: Viewport,
+    cull: CullMode,
+    draw: u32,
+    prim: u32,
+) -> Option<Tri> {
+    if !(p[0].ok && p[1].ok && p[2].ok) {
+        return None;
     }
+    let mut x = p.map(|p| p.x);
+    let mut y = p.map(|p| p.y);
+    let mut z = p.map(|p| p.z);
+    let mut inv_w = p.map(|p| p.inv_w);
     let area2 = (x[1] as i64 - x[0] as i64) * (y[2] as i64 - y[0] as i64)
         - (y[1] as i64 - y[0] as i64) * (x[2] as i64 - x[0] as i64);
     if area2 == 0 {
@@ -164,7 +202,6 @@ pub fn setup(
         CullMode::Front if front => return None,
         _ => {}
     }
-    let mut bary = [v[0].bary, v[1].bary, v[2].bary];
     if area2 < 0 {
         x.swap(1, 2);
         y.swap(1, 2);
@@ -235,6 +272,25 @@ mod tests {
         assert!(setup(cw, vp, CullMode::Back, 0, 0).is_none());
         assert!(setup(cw, vp, CullMode::None, 0, 0).is_some_and(|t| !t.front));
         assert!(setup(ccw, vp, CullMode::Front, 0, 0).is_none());
+    }
+
+    #[test]
+    fn a_corner_beyond_the_snapping_limit_drops_the_triangle() {
+        let vp = Viewport {
+            width: 8,
+            height: 8,
+            msaa: false,
+        };
+        // 1e6 half-viewports out: far beyond 1.25 times the guard band.
+        let far = cv(1e6, 0.0);
+        assert!(!project(far.pos, vp).ok);
+        assert!(!project(Vec4::new(f32::NAN, 0.0, 0.5, 1.0), vp).ok);
+        for k in 0..3 {
+            let mut t = [cv(-1.0, -1.0), cv(1.0, -1.0), cv(-1.0, 1.0)];
+            assert!(setup(t, vp, CullMode::None, 0, 0).is_some());
+            t[k] = far;
+            assert!(setup(t, vp, CullMode::None, 0, 0).is_none(), "corner {k}");
+        }
     }
 
     #[test]

@@ -10,10 +10,11 @@ use rayon::prelude::*;
 
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
+use crate::assets::mesh::Mesh;
 use crate::raster::CullMode;
 use crate::raster::bin::{TileGrid, bin};
-use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
-use crate::raster::setup::{SUBPIXEL, Tri, Viewport, setup};
+use crate::raster::clip::{ClipVertex, Clipped, OUTSIDE_PLANES, clip_triangle, outcode};
+use crate::raster::setup::{Projected, SUBPIXEL, Tri, Viewport, project, setup, setup_projected};
 
 /// One model's triangles that share a material.
 #[derive(Clone, Copy)]
@@ -88,6 +89,7 @@ pub(super) fn setup_and_bin(
         }
     }
     let grid = TileGrid::bands(vp.width, vp.height);
+    let corners = corners_all(verts, vp);
     let per_chunk: Vec<(Vec<Tri>, Chunk)> = ranges
         .par_iter()
         .map(|&(di, start, end)| {
@@ -100,8 +102,16 @@ pub(super) fn setup_and_bin(
                 model.closed,
             );
             let measure = densities && material.maps().next().is_some();
-            let (tris, density) =
-                setup_range(fs, &verts[d.model], d, di, start..end, vp, cull, measure);
+            let (tris, density) = setup_range(
+                fs,
+                (&verts[d.model], &corners[d.model]),
+                d,
+                di,
+                start..end,
+                vp,
+                cull,
+                measure,
+            );
             let bins = bin(&tris, &grid, vp.msaa);
             let chunk = Chunk {
                 draw: di,
@@ -127,12 +137,50 @@ pub(super) fn setup_and_bin(
     }
 }
 
+/// A vertex as every triangle around it sees it: its outcode against
+/// the clip planes and its projection to the viewport.
+#[derive(Debug, Clone, Copy, Default)]
+struct Corner {
+    code: u8,
+    screen: Projected,
+}
+
+/// Every model's `Corner`s, computed once per vertex (a mesh's vertex is
+/// a corner of about six triangles), in parallel.
+fn corners_all(verts: &[ModelVertices], vp: Viewport) -> Vec<Vec<Corner>> {
+    verts
+        .iter()
+        .map(|mv| corners_all_of(&mv.clip, vp))
+        .collect()
+}
+
+/// The `Corner`s of clip-space positions `clip`.
+fn corners_all_of(clip: &[glam::Vec4], vp: Viewport) -> Vec<Corner> {
+    const V_CHUNK: usize = 8192;
+    let (gx, gy) = vp.guard_band();
+    let mut out = vec![Corner::default(); clip.len()];
+    out.par_chunks_mut(V_CHUNK)
+        .zip(clip.par_chunks(V_CHUNK))
+        .for_each(|(out, clip)| {
+            for (o, &p) in out.iter_mut().zip(clip) {
+                *o = Corner {
+                    code: outcode(p, gx, gy),
+                    screen: project(p, vp),
+                };
+            }
+        });
+    out
+}
+
 /// Clips and sets up triangles `prims` of draw `d` (index `di`); with
 /// `measure`, also their largest texel density per coordinate set.
+/// Triangles inside every plane (most of them) are set up from their
+/// corners' projections, which is what `clip_triangle` and `setup` would
+/// give them; only the others are clipped.
 #[allow(clippy::too_many_arguments)]
 fn setup_range(
     fs: &FrameSetup,
-    mv: &ModelVertices,
+    (mv, corners): (&ModelVertices, &[Corner]),
     d: Draw,
     di: usize,
     prims: std::ops::Range<u32>,
@@ -141,38 +189,98 @@ fn setup_range(
     measure: bool,
 ) -> (Vec<Tri>, [f32; 2]) {
     let mesh = &fs.scene.models[d.model].mesh;
-    let (gx, gy) = vp.guard_band();
     let mut tris = Vec::with_capacity(prims.len());
     let mut max_density = [0.0f32; 2];
+    let mut place = Placer {
+        clip: &mv.clip,
+        corners,
+        vp,
+        cull,
+        draw: di as u32,
+    };
     for prim in prims {
         let before = tris.len();
         let idx = mesh.triangles[prim as usize];
-        let v = idx.map(|i| mv.clip[i as usize]);
+        place.triangle(idx, prim, &mut tris);
+        measure_density(measure, &tris[before..], mesh, idx, &mut max_density);
+    }
+    (tris, max_density)
+}
+
+/// What setting up one draw's triangles needs.
+struct Placer<'a> {
+    clip: &'a [glam::Vec4],
+    corners: &'a [Corner],
+    vp: Viewport,
+    cull: CullMode,
+    draw: u32,
+}
+
+impl Placer<'_> {
+    /// Clips and sets up the mesh triangle `prim` with vertices `idx`,
+    /// pushing what is left of it to `tris` (nothing, one triangle, or
+    /// the fan of its clipped polygon).
+    #[inline]
+    fn triangle(&mut self, idx: [u32; 3], prim: u32, tris: &mut Vec<Tri>) {
+        let (vp, cull, draw) = (self.vp, self.cull, self.draw);
+        let c = idx.map(|i| self.corners[i as usize]);
+        if c[0].code | c[1].code | c[2].code == 0 {
+            // `clip_triangle` would say Inside, and `setup` would project
+            // the corners as they are projected already.
+            let bary = [Vec3::X, Vec3::Y, Vec3::Z];
+            tris.extend(setup_projected(
+                c.map(|c| c.screen),
+                bary,
+                vp,
+                cull,
+                draw,
+                prim,
+            ));
+            return;
+        }
+        if c[0].code & c[1].code & c[2].code & OUTSIDE_PLANES != 0 {
+            // All three outside one plane: Rejected.
+            return;
+        }
+        let v = idx.map(|i| self.clip[i as usize]);
+        let (gx, gy) = vp.guard_band();
         let base = |k: usize, b: Vec3| ClipVertex { pos: v[k], bary: b };
         match clip_triangle(v, gx, gy) {
             Clipped::Rejected => {}
             Clipped::Inside => {
                 let tri = [base(0, Vec3::X), base(1, Vec3::Y), base(2, Vec3::Z)];
-                tris.extend(setup(tri, vp, cull, di as u32, prim));
+                tris.extend(setup(tri, vp, cull, draw, prim));
             }
             Clipped::Polygon(p) => {
                 let p = p.as_slice();
                 for k in 1..p.len() - 1 {
-                    tris.extend(setup([p[0], p[k], p[k + 1]], vp, cull, di as u32, prim));
-                }
-            }
-        }
-        if measure {
-            for t in &tris[before..] {
-                for (set, uvs) in [&mesh.uvs, &mesh.uvs1].into_iter().enumerate() {
-                    if !uvs.is_empty() {
-                        max_density[set] = max_density[set].max(uv_density(t, uvs, idx));
-                    }
+                    tris.extend(setup([p[0], p[k], p[k + 1]], vp, cull, draw, prim));
                 }
             }
         }
     }
-    (tris, max_density)
+}
+
+/// With `measure`, raises `max_density` to the texel densities of `tris`
+/// (the triangles set up from mesh triangle `idx`).
+#[inline]
+fn measure_density(
+    measure: bool,
+    tris: &[Tri],
+    mesh: &Mesh,
+    idx: [u32; 3],
+    max_density: &mut [f32; 2],
+) {
+    if !measure {
+        return;
+    }
+    for t in tris {
+        for (set, uvs) in [&mesh.uvs, &mesh.uvs1].into_iter().enumerate() {
+            if !uvs.is_empty() {
+                max_density[set] = max_density[set].max(uv_density(t, uvs, idx));
+            }
+        }
+    }
 }
 
 /// UV area per pixel area of a set-up triangle (texture units squared per
@@ -195,6 +303,130 @@ fn uv_density(t: &Tri, uvs: &[glam::Vec2], idx: [u32; 3]) -> f32 {
 mod tests {
     use super::*;
     use crate::scene::Scene;
+    use crate::testing::xorshift;
+    use glam::Vec4;
+
+    /// `clip_triangle` then `setup` on every triangle, as before corners
+    /// were projected once per vertex.
+    fn clip_then_setup(v: [Vec4; 3], vp: Viewport, cull: CullMode, prim: u32) -> Vec<Tri> {
+        let (gx, gy) = vp.guard_band();
+        let base = |k: usize, b: Vec3| ClipVertex { pos: v[k], bary: b };
+        match clip_triangle(v, gx, gy) {
+            Clipped::Rejected => Vec::new(),
+            Clipped::Inside => {
+                let tri = [base(0, Vec3::X), base(1, Vec3::Y), base(2, Vec3::Z)];
+                setup(tri, vp, cull, 7, prim).into_iter().collect()
+            }
+            Clipped::Polygon(p) => {
+                let p = p.as_slice();
+                (1..p.len() - 1)
+                    .filter_map(|k| setup([p[0], p[k], p[k + 1]], vp, cull, 7, prim))
+                    .collect()
+            }
+        }
+    }
+
+    fn same(a: &Tri, b: &Tri) -> bool {
+        let bits = |t: &Tri| {
+            (
+                t.x,
+                t.y,
+                [t.min_x, t.min_y, t.max_x, t.max_y],
+                t.z.map(f32::to_bits),
+                t.inv_w.map(f32::to_bits),
+                t.bary.map(|b| b.to_array().map(f32::to_bits)),
+                (t.area2, t.draw, t.prim, t.front),
+            )
+        };
+        bits(a) == bits(b)
+    }
+
+    #[test]
+    fn projected_corners_set_up_what_clip_and_setup_do() {
+        // Vertices inside the view, beyond the screen edges, beyond the
+        // guard band, behind the eye and beyond the far plane, on the
+        // planes, and broken (NaN, infinite, w = 0): every triangle of
+        // them, culled or not, with and without MSAA.
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut clip = Vec::new();
+        for i in 0..600 {
+            let w = match i % 7 {
+                0 => -(next() + 0.1),
+                1 => 0.0,
+                _ => 0.2 + 4.0 * next(),
+            };
+            let spread = [1.0, 3.0, 3000.0][i % 3];
+            let mut p = Vec4::new(
+                (next() * 2.0 - 1.0) * spread * w,
+                (next() * 2.0 - 1.0) * spread * w,
+                (next() * 1.4 - 0.2) * w,
+                w,
+            );
+            match i % 50 {
+                11 => p.x = f32::NAN,
+                23 => p.y = f32::INFINITY,
+                37 => p.z = p.w,
+                41 => p.z = 0.0,
+                _ => {}
+            }
+            clip.push(p);
+        }
+        let n = clip.len() as u32;
+        let (mut checked, mut inside, mut cut) = (0, 0, 0);
+        for (vp, cull) in [
+            (
+                Viewport {
+                    width: 64,
+                    height: 48,
+                    msaa: false,
+                },
+                CullMode::None,
+            ),
+            (
+                Viewport {
+                    width: 700,
+                    height: 700,
+                    msaa: true,
+                },
+                CullMode::Back,
+            ),
+            (
+                Viewport {
+                    width: 33,
+                    height: 17,
+                    msaa: false,
+                },
+                CullMode::Front,
+            ),
+        ] {
+            let corners = corners_all_of(&clip, vp);
+            let mut place = Placer {
+                clip: &clip,
+                corners: &corners,
+                vp,
+                cull,
+                draw: 7,
+            };
+            for prim in 0..20_000u32 {
+                let r = |k: u32| (prim.wrapping_mul(2_654_435_761).rotate_left(k * 11)) % n;
+                let idx = [r(0), r(1), r(2)];
+                let mut got = Vec::new();
+                place.triangle(idx, prim, &mut got);
+                let want = clip_then_setup(idx.map(|i| clip[i as usize]), vp, cull, prim);
+                assert_eq!(got.len(), want.len(), "{idx:?}");
+                assert!(got.iter().zip(&want).all(|(a, b)| same(a, b)), "{idx:?}");
+                checked += 1;
+                let codes = idx.map(|i| corners[i as usize].code);
+                inside += usize::from(codes == [0; 3] && !want.is_empty());
+                cut += usize::from(want.len() > 1);
+            }
+        }
+        // Both paths were taken many times.
+        assert!(
+            checked == 60_000 && inside > 1000 && cut > 100,
+            "{inside} {cut}"
+        );
+    }
 
     #[test]
     fn a_quad_sets_up_two_triangles_binned_in_the_bands_it_covers() {
