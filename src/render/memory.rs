@@ -62,8 +62,9 @@ const FRAMES_IN_FLIGHT: u64 = 3;
 /// BVH bytes per triangle: a 48-byte precomputed triangle, a 4-byte
 /// index, about one 40-byte node, and the build's 48-byte references.
 const BVH_PER_TRIANGLE: u64 = 48 + 4 + 40 + 48;
-/// Transformed vertex bytes (clip position, world position and normal).
-const VERTEX: u64 = 64;
+/// Per-frame vertex bytes: the transformed vertex (clip position, world
+/// position and normal) and its projected corner for set-up.
+const VERTEX: u64 = 64 + 20;
 
 /// The estimate for rendering `scene` with `threads` workers.
 pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
@@ -74,10 +75,12 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
     // Meshes: each distinct one, and during loading its source copy too.
     let mut seen = HashSet::new();
     let (mut mesh_bytes, mut tris, mut verts) = (0u64, 0u64, 0u64);
+    let mut tangent_corners = 0u64;
     for m in &scene.models {
         let mesh = &m.mesh;
         verts += mesh.positions.len() as u64;
         tris += mesh.triangles.len() as u64;
+        tangent_corners += mesh.tangents.len() as u64;
         if !seen.insert(std::sync::Arc::as_ptr(mesh)) {
             continue;
         }
@@ -164,9 +167,15 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
         "bands",
         threads * w * k * band_rows * samples * (4 + 4 + size_of::<Vec4>() as u64),
     ));
+    // Set-up triangles twice (each chunk's list, and the frame's list they
+    // are gathered into: a 1M-triangle mesh peaked at 1.13 times an
+    // estimate that counted them once), a bin entry each, the vertices,
+    // and the tangents turned with the model, one per triangle corner.
     parts.push((
         "triangles",
-        tris * (size_of::<Tri>() as u64 + 8) + verts * VERTEX,
+        tris * (2 * size_of::<Tri>() as u64 + 8)
+            + verts * VERTEX
+            + tangent_corners * size_of::<Vec4>() as u64,
     ));
     if matches!(s.shadows, ShadowMethod::Hard | ShadowMethod::Pcf) {
         let side = s.shadow_map_size as u64 + 4;
