@@ -5,11 +5,11 @@
 //! measures the largest texel density of each texture-coordinate set, from
 //! which the frame decides which textures it minifies.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::setup::FrameSetup;
-use super::vertex::ModelVertices;
+use super::vertex::{self, ModelVertices};
 use crate::assets::mesh::Mesh;
 use crate::raster::CullMode;
 use crate::raster::bin::{TileGrid, bin};
@@ -61,9 +61,11 @@ impl Geometry {
 }
 
 /// `densities`: whether to measure texel densities (filters with mip maps).
+/// Also fills each model's per-corner tangents (`ModelVertices::tangent`)
+/// for the triangles it sets up.
 pub(super) fn setup_and_bin(
     fs: &FrameSetup,
-    verts: &[ModelVertices],
+    verts: &mut [ModelVertices],
     vp: Viewport,
     densities: bool,
 ) -> Geometry {
@@ -90,9 +92,20 @@ pub(super) fn setup_and_bin(
     }
     let grid = TileGrid::bands(vp.width, vp.height);
     let corners = corners_all(verts, vp);
+    let mut tangents: Vec<Vec<Vec4>> = (0..verts.len())
+        .map(|m| vec![Vec4::ZERO; vertex::tangent_source(fs, m).len()])
+        .collect();
+    let models: Vec<usize> = ranges.iter().map(|r| draws[r.0].model).collect();
+    let spans: Vec<(u32, u32)> = ranges.iter().map(|r| (r.1, r.2)).collect();
+    let slices = split_spans(&mut tangents, &models, &spans);
+    let owned: Vec<bool> = (0..verts.len())
+        .map(|m| (0..slices.len()).any(|k| models[k] == m && slices[k].is_some()))
+        .collect();
+    let verts_ro: &[ModelVertices] = verts;
     let per_chunk: Vec<(Vec<Tri>, Chunk)> = ranges
         .par_iter()
-        .map(|&(di, start, end)| {
+        .zip(slices)
+        .map(|(&(di, start, end), tangent_out)| {
             let d = draws[di];
             let material = &scene.models[d.model].materials[d.material];
             let model = &scene.models[d.model];
@@ -102,9 +115,10 @@ pub(super) fn setup_and_bin(
                 model.closed,
             );
             let measure = densities && material.maps().next().is_some();
+            let mv = &verts_ro[d.model];
             let (tris, density) = setup_range(
                 fs,
-                (&verts[d.model], &corners[d.model]),
+                (mv, &corners[d.model]),
                 d,
                 di,
                 start..end,
@@ -112,6 +126,22 @@ pub(super) fn setup_and_bin(
                 cull,
                 measure,
             );
+            if let Some(out) = tangent_out {
+                // Each mesh triangle's corners once, however many
+                // triangles its clipped polygon became.
+                let source = vertex::tangent_source(fs, d.model);
+                let mut last = None;
+                for t in &tris {
+                    if last != Some(t.prim) {
+                        let k = (t.prim - start) as usize * 3;
+                        let corner: &mut [Vec4; 3] = (&mut out[k..k + 3])
+                            .try_into()
+                            .expect("three corners per triangle");
+                        mv.turn_tangents(source, t.prim, corner);
+                        last = Some(t.prim);
+                    }
+                }
+            }
             let bins = bin(&tris, &grid, vp.msaa);
             let chunk = Chunk {
                 draw: di,
@@ -129,12 +159,62 @@ pub(super) fn setup_and_bin(
         tris.extend(t);
         chunks.push(c);
     }
+    for (m, (mv, mut t)) in verts.iter_mut().zip(tangents).enumerate() {
+        if !owned[m] && !t.is_empty() {
+            // Groups that overlap: every corner.
+            let source = vertex::tangent_source(fs, m);
+            t.par_chunks_mut(3).enumerate().for_each(|(prim, out)| {
+                if let Ok(out) = <&mut [Vec4; 3]>::try_from(out) {
+                    mv.turn_tangents(source, prim as u32, out);
+                }
+            });
+        }
+        mv.tangent = t;
+    }
     Geometry {
         draws,
         tris,
         chunks,
         grid,
     }
+}
+
+/// For each chunk `k` (model `models[k]`, mesh triangles `spans[k]`), the
+/// part of that model's per-corner buffer in `buffers` that holds its
+/// triangles' corners; None where the model has no such buffer (empty)
+/// or where its chunks overlap or reach past it (no chunk owns those
+/// triangles: `setup_and_bin` fills such a model's corners whole).
+fn split_spans<'a>(
+    buffers: &'a mut [Vec<Vec4>],
+    models: &[usize],
+    spans: &[(u32, u32)],
+) -> Vec<Option<&'a mut [Vec4]>> {
+    let mut out: Vec<Option<&'a mut [Vec4]>> = (0..spans.len()).map(|_| None).collect();
+    for (m, buffer) in buffers.iter_mut().enumerate() {
+        if buffer.is_empty() {
+            continue;
+        }
+        let mut mine: Vec<usize> = (0..spans.len()).filter(|&k| models[k] == m).collect();
+        mine.sort_by_key(|&k| spans[k].0);
+        let disjoint = mine.windows(2).all(|w| spans[w[0]].1 <= spans[w[1]].0);
+        let inside = mine
+            .iter()
+            .all(|&k| spans[k].1 as usize * 3 <= buffer.len());
+        if !(disjoint && inside) {
+            continue;
+        }
+        let mut rest: &'a mut [Vec4] = buffer.as_mut_slice();
+        let mut at = 0usize;
+        for k in mine {
+            let (lo, hi) = (spans[k].0 as usize * 3, spans[k].1 as usize * 3);
+            let (_, tail) = std::mem::take(&mut rest).split_at_mut(lo - at);
+            let (part, tail) = tail.split_at_mut(hi - lo);
+            out[k] = Some(part);
+            rest = tail;
+            at = hi;
+        }
+    }
+    out
 }
 
 /// A vertex as every triangle around it sees it: its outcode against
@@ -342,6 +422,124 @@ mod tests {
     }
 
     #[test]
+    fn spans_get_their_own_corners_and_overlapping_ones_none() {
+        let mut buffers = vec![vec![Vec4::ZERO; 15], Vec::new(), vec![Vec4::ZERO; 12]];
+        // Model 0: triangles 2..5 and 0..2 (out of order); model 1 has no
+        // corners; model 2's spans overlap.
+        let models = [0, 0, 1, 2, 2];
+        let spans = [(2, 5), (0, 2), (0, 3), (0, 3), (2, 4)];
+        let mut slices = split_spans(&mut buffers, &models, &spans);
+        let lens: Vec<Option<usize>> = slices.iter().map(|s| s.as_ref().map(|s| s.len())).collect();
+        assert_eq!(lens, [Some(9), Some(6), None, None, None]);
+        for (k, s) in slices.iter_mut().enumerate() {
+            if let Some(s) = s {
+                s.fill(Vec4::splat(k as f32 + 1.0));
+            }
+        }
+        let firsts: Vec<f32> = buffers[0].iter().map(|v| v.x).collect();
+        assert_eq!(firsts, [[2.0; 6].as_slice(), &[1.0; 9]].concat());
+        assert!(buffers[2].iter().all(|v| *v == Vec4::ZERO));
+    }
+
+    #[test]
+    fn set_up_triangles_get_their_corners_tangents() {
+        // A normal-mapped grid in front of the camera and a second group
+        // reaching behind it (cut by the near plane into several
+        // triangles per mesh triangle), drawn as is and mirrored (the
+        // bitangent flips); every triangle set-up keeps must find its
+        // corners' tangents turned as the vertex pass turned them.
+        let dir = std::env::temp_dir().join(format!("softraster-tangents-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([150, 140, 240, 255]))
+            .save(dir.join("nm.png"))
+            .unwrap();
+        let mut obj = String::from("mtllib m.mtl\nusemtl a\n");
+        let n = 8;
+        for j in 0..=n {
+            for i in 0..=n {
+                let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+                obj += &format!(
+                    "v {} {} {}\nvt {u} {v}\n",
+                    4.0 * u - 2.0,
+                    4.0 * v - 2.0,
+                    u * v
+                );
+            }
+        }
+        let at = |i: usize, j: usize| j * (n + 1) + i + 1;
+        for j in 0..n {
+            for i in 0..n {
+                if j == n / 2 && i == 0 {
+                    obj += "usemtl b\n";
+                }
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                obj += &format!("f {a}/{a} {b}/{b} {c}/{c}\nf {a}/{a} {c}/{c} {d}/{d}\n");
+            }
+        }
+        // Behind the eye (z = 5): cut by the near plane.
+        obj += "v 0 0 9\nvt 0.5 0.5\n";
+        let e = (n + 1) * (n + 1) + 1;
+        obj += &format!(
+            "f {e}/{e} {}/{} {}/{}\n",
+            at(2, 2),
+            at(2, 2),
+            at(6, 3),
+            at(6, 3)
+        );
+        std::fs::write(dir.join("g.obj"), obj).unwrap();
+        std::fs::write(
+            dir.join("m.mtl"),
+            "newmtl a\nKd 0.5 0.5 0.5\nnorm nm.png\nnewmtl b\nKd 0.5 0.5 0.5\nnorm nm.png\n",
+        )
+        .unwrap();
+        let text = "[output]\nwidth = 48\nheight = 40\n\
+                    [[model]]\npath = \"g.obj\"\n\
+                    [[model]]\npath = \"g.obj\"\nscale = [-1.0, 1.0, 1.0]\ntranslate = [0.5, 0.0, 0.0]\n\
+                    [[camera]]\neye = [0.3, -0.2, 5.0]\ntarget = [0.0, 0.0, 0.0]\nnear = 0.5\n\
+                    [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\n";
+        let opts = crate::scene::build::LoadOptions::default();
+        let scene = Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap();
+        let fs = FrameSetup::new(&scene, 0, 0);
+        let mut verts = super::super::vertex::transform_all(&fs);
+        let vp = Viewport {
+            width: 48,
+            height: 40,
+            msaa: false,
+        };
+        let geo = setup_and_bin(&fs, &mut verts, vp, true);
+        let (mut checked, mut cut) = (0, 0);
+        for c in &geo.chunks {
+            let d = geo.draws[c.draw];
+            let m = glam::Mat3::from_mat4(fs.world_from_object[d.model]);
+            let flip = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
+            let source = super::super::vertex::tangent_source(&fs, d.model);
+            let end = geo
+                .chunks
+                .iter()
+                .map(|o| o.first)
+                .filter(|&f| f > c.first)
+                .min();
+            let tris = &geo.tris[c.first as usize..end.map_or(geo.tris.len(), |e| e as usize)];
+            for t in tris {
+                for k in 0..3 {
+                    let s = source[t.prim as usize * 3 + k];
+                    let want = (m * s.truncate()).normalize_or(Vec3::X).extend(s.w * flip);
+                    let got = verts[d.model].tangent[t.prim as usize * 3 + k];
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.to_array().map(f32::to_bits)
+                    );
+                }
+                checked += 1;
+                // A corner of a cut polygon is not one of the mesh's.
+                cut += usize::from(t.bary.iter().any(|b| b.max_element() < 1.0));
+            }
+        }
+        assert!(checked > 100 && cut >= 2, "{checked} {cut}");
+        assert_eq!(geo.draws.len(), 4);
+    }
+
+    #[test]
     fn projected_corners_set_up_what_clip_and_setup_do() {
         // Vertices inside the view, beyond the screen edges, beyond the
         // guard band, behind the eye and beyond the far plane, on the
@@ -449,7 +647,8 @@ mod tests {
             height: 32,
             msaa: false,
         };
-        let geo = setup_and_bin(&fs, &verts, vp, false);
+        let mut verts = verts;
+        let geo = setup_and_bin(&fs, &mut verts, vp, false);
         assert_eq!(geo.draws.len(), 1);
         // The quad behind the camera is clipped away.
         assert_eq!(geo.tris.len(), 2);

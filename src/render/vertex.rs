@@ -15,9 +15,39 @@ pub(super) struct ModelVertices {
     /// Gouraud only: per-vertex (diffuse, specular) light sums.
     pub light: Vec<(Vec3, Vec3)>,
     /// Per triangle corner: world-space tangent and bitangent sign (empty
-    /// when the mesh has no tangents).
+    /// when the mesh has no tangents). Filled by the geometry pass for the
+    /// triangles it sets up (`turn_tangents`), the only ones shading reads:
+    /// at a million triangles most are culled or cover no pixel center,
+    /// and turning every corner was a tenth of the frame.
     pub tangent: Vec<Vec4>,
     pub normal_from_object: Mat3,
+    /// Tangents turn with the surface (not the inverse transpose); a
+    /// mirroring transform flips the bitangent.
+    tangent_from_object: Mat3,
+    tangent_flip: f32,
+}
+
+impl ModelVertices {
+    /// Writes the world-space tangents of mesh triangle `prim`'s three
+    /// corners, read from `source` (the model's per-corner tangents), to
+    /// `out`.
+    #[inline]
+    pub(super) fn turn_tangents(&self, source: &[Vec4], prim: u32, out: &mut [Vec4; 3]) {
+        let c = prim as usize * 3;
+        for (o, t) in out.iter_mut().zip(&source[c..c + 3]) {
+            *o = (self.tangent_from_object * t.truncate())
+                .normalize_or(Vec3::X)
+                .extend(t.w * self.tangent_flip);
+        }
+    }
+}
+
+/// Model `m`'s per-corner tangents (at rest or posed) in object space.
+pub(super) fn tangent_source<'a>(fs: &'a FrameSetup, m: usize) -> &'a [Vec4] {
+    match &fs.posed[m] {
+        Some((p, _)) => &p.tangents,
+        None => &fs.scene.models[m].mesh.tangents,
+    }
 }
 
 /// Every model of the frame, in scene order.
@@ -28,11 +58,11 @@ pub(super) fn transform_all(fs: &FrameSetup) -> Vec<ModelVertices> {
         .zip(&fs.world_from_object)
         .zip(&fs.posed)
         .map(|((m, world), posed)| {
-            let (positions, normals, tangents) = match posed {
-                Some((p, _)) => (&p.positions, &p.normals, &p.tangents),
-                None => (&m.mesh.positions, &m.mesh.normals, &m.mesh.tangents),
+            let (positions, normals) = match posed {
+                Some((p, _)) => (&p.positions, &p.normals),
+                None => (&m.mesh.positions, &m.mesh.normals),
             };
-            transform(fs.clip_from_world, positions, normals, tangents, *world)
+            transform(fs.clip_from_world, positions, normals, *world)
         })
         .collect()
 }
@@ -42,7 +72,6 @@ fn transform(
     clip_from_world: Mat4,
     positions: &[Vec3],
     normals: &[Vec3],
-    tangents: &[Vec4],
     world_from_object: Mat4,
 ) -> ModelVertices {
     let normal_from_object = Mat3::from_mat4(world_from_object).inverse().transpose();
@@ -65,20 +94,15 @@ fn transform(
                 cl[i] = clip_from_world * p.extend(1.0);
             }
         });
-    // Tangents follow the surface (not the inverse transpose); a mirroring
-    // transform flips the bitangent.
     let m3 = Mat3::from_mat4(world_from_object);
-    let flip = if m3.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let tangent = tangents
-        .par_iter()
-        .map(|t| (m3 * t.truncate()).normalize_or(Vec3::X).extend(t.w * flip))
-        .collect();
     ModelVertices {
         world,
         normal,
         clip,
         light: Vec::new(),
-        tangent,
+        tangent: Vec::new(),
         normal_from_object,
+        tangent_from_object: m3,
+        tangent_flip: if m3.determinant() < 0.0 { -1.0 } else { 1.0 },
     }
 }
