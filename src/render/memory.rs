@@ -168,7 +168,7 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
         threads * w * k * band_rows * samples * (4 + 4 + size_of::<Vec4>() as u64),
     ));
     // Set-up triangles twice (each chunk's list, and the frame's list they
-    // are gathered into: a 1M-triangle mesh peaked at 1.13 times an
+    // are gathered into: a 1M-triangle mesh peaked at 1.16 times an
     // estimate that counted them once), a bin entry each, the vertices,
     // and the tangents turned with the model, one per triangle corner.
     parts.push((
