@@ -766,9 +766,9 @@ impl<'a> FrameData<'a> {
             normal
         };
         let (_, uv, color) = self.material_uv(t, l);
-        let tangent = (!mv.tangent.is_empty()).then(|| {
+        let tt = &self.tangents[d.model];
+        let tangent = (!tt.is_empty()).then(|| {
             let c = t.prim as usize * 3;
-            let tt = &mv.tangent;
             let v = tt[c] * l.x + tt[c + 1] * l.y + tt[c + 2] * l.z;
             // The sign is per triangle (MikkTSpace keeps it constant).
             v.truncate().extend(tt[c].w)

@@ -31,6 +31,8 @@ pub(super) struct FrameData<'a> {
     /// Per draw.
     pub alpha: Vec<AlphaMode>,
     pub tris: &'a [Tri],
+    /// Per model, per mesh triangle corner: tangents (`Geometry::tangents`).
+    pub tangents: &'a [Vec<Vec4>],
     /// Sample offsets in 1/16 pixel; one entry without MSAA.
     pub pattern: &'static [(i8, i8)],
     pub reverse: bool,
@@ -94,7 +96,7 @@ impl<'a> FrameData<'a> {
             .map(|d| {
                 let model = &fs.scene.models[d.model];
                 let uvs = !model.mesh.uvs.is_empty();
-                let tangents = !verts[d.model].tangent.is_empty();
+                let tangents = !geo.tangents[d.model].is_empty();
                 let m = &model.materials[d.material];
                 paths
                     .lanes
@@ -119,6 +121,7 @@ impl<'a> FrameData<'a> {
             draws: &geo.draws,
             alpha,
             tris: &geo.tris,
+            tangents: &geo.tangents,
             pattern,
             reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),

@@ -45,6 +45,12 @@ pub(super) struct Chunk {
 pub(super) struct Geometry {
     pub draws: Vec<Draw>,
     pub tris: Vec<Tri>,
+    /// Per model, per mesh triangle corner: the world-space tangent and
+    /// bitangent sign, filled for the triangles set up here (the only
+    /// ones shading reads: at a million triangles most are culled or
+    /// cover no pixel center, and turning every corner in the vertex
+    /// pass was a tenth of the frame); empty for a model without tangents.
+    pub tangents: Vec<Vec<Vec4>>,
     pub chunks: Vec<Chunk>,
     pub grid: TileGrid,
 }
@@ -61,11 +67,9 @@ impl Geometry {
 }
 
 /// `densities`: whether to measure texel densities (filters with mip maps).
-/// Also fills each model's per-corner tangents (`ModelVertices::tangent`)
-/// for the triangles it sets up.
 pub(super) fn setup_and_bin(
     fs: &FrameSetup,
-    verts: &mut [ModelVertices],
+    verts: &[ModelVertices],
     vp: Viewport,
     densities: bool,
 ) -> Geometry {
@@ -101,7 +105,6 @@ pub(super) fn setup_and_bin(
     let owned: Vec<bool> = (0..verts.len())
         .map(|m| (0..slices.len()).any(|k| models[k] == m && slices[k].is_some()))
         .collect();
-    let verts_ro: &[ModelVertices] = verts;
     let per_chunk: Vec<(Vec<Tri>, Chunk)> = ranges
         .par_iter()
         .zip(slices)
@@ -115,7 +118,7 @@ pub(super) fn setup_and_bin(
                 model.closed,
             );
             let measure = densities && material.maps().next().is_some();
-            let mv = &verts_ro[d.model];
+            let mv = &verts[d.model];
             let (tris, density) = setup_range(
                 fs,
                 (mv, &corners[d.model]),
@@ -159,7 +162,7 @@ pub(super) fn setup_and_bin(
         tris.extend(t);
         chunks.push(c);
     }
-    for (m, (mv, mut t)) in verts.iter_mut().zip(tangents).enumerate() {
+    for (m, (mv, t)) in verts.iter().zip(&mut tangents).enumerate() {
         if !owned[m] && !t.is_empty() {
             // Groups that overlap: every corner.
             let source = vertex::tangent_source(fs, m);
@@ -169,11 +172,11 @@ pub(super) fn setup_and_bin(
                 }
             });
         }
-        mv.tangent = t;
     }
     Geometry {
         draws,
         tris,
+        tangents,
         chunks,
         grid,
     }
@@ -225,6 +228,9 @@ struct Corner {
     screen: Projected,
 }
 
+/// Bytes per vertex of the frame's `Corner`s (for the memory estimate).
+pub(super) const CORNER_BYTES: usize = std::mem::size_of::<Corner>();
+
 /// Every model's `Corner`s, computed once per vertex (a mesh's vertex is
 /// a corner of about six triangles), in parallel.
 fn corners_all(verts: &[ModelVertices], vp: Viewport) -> Vec<Vec<Corner>> {
@@ -235,7 +241,7 @@ fn corners_all(verts: &[ModelVertices], vp: Viewport) -> Vec<Vec<Corner>> {
 }
 
 /// The `Corner`s of clip-space positions `clip`.
-fn corners_all_of(clip: &[glam::Vec4], vp: Viewport) -> Vec<Corner> {
+fn corners_all_of(clip: &[Vec4], vp: Viewport) -> Vec<Corner> {
     const V_CHUNK: usize = 8192;
     let (gx, gy) = vp.guard_band();
     let mut out = vec![Corner::default(); clip.len()];
@@ -289,7 +295,7 @@ fn setup_range(
 
 /// What setting up one draw's triangles needs.
 struct Placer<'a> {
-    clip: &'a [glam::Vec4],
+    clip: &'a [Vec4],
     corners: &'a [Corner],
     vp: Viewport,
     cull: CullMode,
@@ -384,7 +390,6 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
     use crate::testing::xorshift;
-    use glam::Vec4;
 
     /// `clip_triangle` then `setup` on every triangle, as before corners
     /// were projected once per vertex.
@@ -500,13 +505,13 @@ mod tests {
         let opts = crate::scene::build::LoadOptions::default();
         let scene = Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap();
         let fs = FrameSetup::new(&scene, 0, 0);
-        let mut verts = super::super::vertex::transform_all(&fs);
+        let verts = super::super::vertex::transform_all(&fs);
         let vp = Viewport {
             width: 48,
             height: 40,
             msaa: false,
         };
-        let geo = setup_and_bin(&fs, &mut verts, vp, true);
+        let geo = setup_and_bin(&fs, &verts, vp, true);
         let (mut checked, mut cut) = (0, 0);
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
@@ -524,7 +529,7 @@ mod tests {
                 for k in 0..3 {
                     let s = source[t.prim as usize * 3 + k];
                     let want = (m * s.truncate()).normalize_or(Vec3::X).extend(s.w * flip);
-                    let got = verts[d.model].tangent[t.prim as usize * 3 + k];
+                    let got = geo.tangents[d.model][t.prim as usize * 3 + k];
                     assert_eq!(
                         got.to_array().map(f32::to_bits),
                         want.to_array().map(f32::to_bits)
@@ -647,8 +652,7 @@ mod tests {
             height: 32,
             msaa: false,
         };
-        let mut verts = verts;
-        let geo = setup_and_bin(&fs, &mut verts, vp, false);
+        let geo = setup_and_bin(&fs, &verts, vp, false);
         assert_eq!(geo.draws.len(), 1);
         // The quad behind the camera is clipped away.
         assert_eq!(geo.tris.len(), 2);

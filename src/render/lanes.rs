@@ -244,11 +244,12 @@ impl<'a> FrameData<'a> {
         let mesh = &self.fs.scene.models[d.model].mesh;
         let mv = &self.verts[d.model];
         let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
-        let tangent = if mv.tangent.is_empty() {
+        let tt = &self.tangents[d.model];
+        let tangent = if tt.is_empty() {
             [Vec4::ZERO; 3]
         } else {
             let c = t.prim as usize * 3;
-            [mv.tangent[c], mv.tangent[c + 1], mv.tangent[c + 2]]
+            [tt[c], tt[c + 1], tt[c + 2]]
         };
         Corners {
             world: idx.map(|i| mv.world[i]),

@@ -64,7 +64,7 @@ const FRAMES_IN_FLIGHT: u64 = 3;
 const BVH_PER_TRIANGLE: u64 = 48 + 4 + 40 + 48;
 /// Per-frame vertex bytes: the transformed vertex (clip position, world
 /// position and normal) and its projected corner for set-up.
-const VERTEX: u64 = 64 + 20;
+const VERTEX: u64 = 64 + super::geometry::CORNER_BYTES as u64;
 
 /// The estimate for rendering `scene` with `threads` workers.
 pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {

@@ -416,7 +416,7 @@ impl Renderer {
             s.texture_filter,
             TextureFilter::Trilinear | TextureFilter::Anisotropic
         ) && !self.textures.is_empty();
-        let geo = geometry::setup_and_bin(fs, &mut verts, vp, filtered);
+        let geo = geometry::setup_and_bin(fs, &verts, vp, filtered);
         let mips = self.frame_mips(fs, &geo);
 
         let mut ctx = shade_context(fs, &mips, &shadows, env);

@@ -14,15 +14,11 @@ pub(super) struct ModelVertices {
     pub clip: Vec<Vec4>,
     /// Gouraud only: per-vertex (diffuse, specular) light sums.
     pub light: Vec<(Vec3, Vec3)>,
-    /// Per triangle corner: world-space tangent and bitangent sign (empty
-    /// when the mesh has no tangents). Filled by the geometry pass for the
-    /// triangles it sets up (`turn_tangents`), the only ones shading reads:
-    /// at a million triangles most are culled or cover no pixel center,
-    /// and turning every corner was a tenth of the frame.
-    pub tangent: Vec<Vec4>,
     pub normal_from_object: Mat3,
     /// Tangents turn with the surface (not the inverse transpose); a
-    /// mirroring transform flips the bitangent.
+    /// mirroring transform flips the bitangent. The geometry pass turns
+    /// the corners of the triangles it keeps (`turn_tangents`,
+    /// `Geometry::tangents`).
     tangent_from_object: Mat3,
     tangent_flip: f32,
 }
@@ -100,7 +96,6 @@ fn transform(
         normal,
         clip,
         light: Vec::new(),
-        tangent: Vec::new(),
         normal_from_object,
         tangent_from_object: m3,
         tangent_flip: if m3.determinant() < 0.0 { -1.0 } else { 1.0 },
