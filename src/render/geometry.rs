@@ -391,6 +391,23 @@ mod tests {
     use crate::scene::Scene;
     use crate::testing::xorshift;
 
+    /// The scene `text` loaded as if from a file in `dir`.
+    fn scene_in(dir: &std::path::Path, text: &str) -> Scene {
+        let opts = crate::scene::build::LoadOptions::default();
+        Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap()
+    }
+
+    /// Frame `fs` transformed, set up and binned at `width` x `height`.
+    fn geometry_of(fs: &FrameSetup, width: u32, height: u32, densities: bool) -> Geometry {
+        let verts = super::super::vertex::transform_all(fs);
+        let vp = Viewport {
+            width,
+            height,
+            msaa: false,
+        };
+        setup_and_bin(fs, &verts, vp, densities)
+    }
+
     /// `clip_triangle` then `setup` on every triangle, as before corners
     /// were projected once per vertex.
     fn clip_then_setup(v: [Vec4; 3], vp: Viewport, cull: CullMode, prim: u32) -> Vec<Tri> {
@@ -502,16 +519,9 @@ mod tests {
                     [[model]]\npath = \"g.obj\"\nscale = [-1.0, 1.0, 1.0]\ntranslate = [0.5, 0.0, 0.0]\n\
                     [[camera]]\neye = [0.3, -0.2, 5.0]\ntarget = [0.0, 0.0, 0.0]\nnear = 0.5\n\
                     [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\n";
-        let opts = crate::scene::build::LoadOptions::default();
-        let scene = Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap();
+        let scene = scene_in(&dir, text);
         let fs = FrameSetup::new(&scene, 0, 0);
-        let verts = super::super::vertex::transform_all(&fs);
-        let vp = Viewport {
-            width: 48,
-            height: 40,
-            msaa: false,
-        };
-        let geo = setup_and_bin(&fs, &verts, vp, true);
+        let geo = geometry_of(&fs, 48, 40, true);
         let (mut checked, mut cut) = (0, 0);
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
@@ -643,16 +653,9 @@ mod tests {
         let text = "[output]\nwidth = 32\nheight = 32\n[[model]]\npath = \"quad.obj\"\n\
                     [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
                     projection = \"orthographic\"\nheight = 2.0\nnear = 0.1\nfar = 10.0\n";
-        let opts = crate::scene::build::LoadOptions::default();
-        let scene = Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap();
+        let scene = scene_in(&dir, text);
         let fs = FrameSetup::new(&scene, 0, 0);
-        let verts = super::super::vertex::transform_all(&fs);
-        let vp = Viewport {
-            width: 32,
-            height: 32,
-            msaa: false,
-        };
-        let geo = setup_and_bin(&fs, &verts, vp, false);
+        let geo = geometry_of(&fs, 32, 32, false);
         assert_eq!(geo.draws.len(), 1);
         // The quad behind the camera is clipped away.
         assert_eq!(geo.tris.len(), 2);
