@@ -71,6 +71,18 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// Whether some placed mesh's bounds come within `r` of `p` (where
+    /// none does, no ray from `p` shorter than `r` meets anything).
+    pub fn any_within(&self, p: Vec3, r: f32) -> bool {
+        let p = Vec3A::from(p);
+        self.instances.iter().any(|i| {
+            let nearest = p.clamp(i.lo, i.hi);
+            // NaN bounds or points count as near.
+            let d2 = (nearest - p).length_squared();
+            d2 <= r * r || d2.is_nan()
+        })
+    }
+
     /// Whether anything lies on `o + t d` for t in (0, t_max).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
         let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());

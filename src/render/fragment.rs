@@ -1,24 +1,22 @@
 //! What a frame's bands share and how a fragment's result reaches its
 //! pixel: the frame's data (`FrameData`, built once per frame: set-up,
-//! shading context, vertices, draws, per-draw lane materials), the
-//! environment background, and the sink that takes shaded fragments
+//! shading context, vertices, draws, per-draw lane materials, the
+//! backgrounds) and the sink that takes shaded fragments
 //! (`Sink`, `Part`, `resolve`). The band loop (`band`) and the four-lane
 //! shading (`lanes`) both build on it; it depends on neither.
 
 use glam::{Vec3, Vec4};
 
+use super::backdrop::EnvBackground;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
 use super::light_tiles::Culling;
-use super::rays::CameraRays;
 use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::setup::Tri;
 use crate::raytrace::Tracer;
 use crate::scene::material::AlphaMode;
-use crate::scene::settings::Background;
 use crate::scene::settings::{AoMethod, DepthMode, ShadingMode};
-use crate::shade::env::EnvLight;
 use crate::shade::lanes::LaneMaterial;
 use crate::shade::{ShadeContext, background};
 
@@ -125,7 +123,7 @@ impl<'a> FrameData<'a> {
             pattern,
             reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),
-            env_bg: EnvBackground::new(fs, &ctx, geo.grid.width, geo.grid.height),
+            env_bg: EnvBackground::new(fs, ctx.env, geo.grid.width, geo.grid.height),
             ground: Ground::new(fs, &ctx, tracer, geo.grid.width, geo.grid.height),
             grads,
             geo_normal,
@@ -142,48 +140,6 @@ impl<'a> FrameData<'a> {
     }
 }
 
-/// The environment behind the models: the radiance along each pixel's
-/// view ray (the pixel center's), sharp or prefiltered.
-pub(super) struct EnvBackground<'a> {
-    env: &'a EnvLight,
-    /// Prefiltering roughness; 0: the image itself.
-    blur: f32,
-    rays: CameraRays,
-}
-
-impl<'a> EnvBackground<'a> {
-    pub fn new(
-        fs: &FrameSetup,
-        ctx: &ShadeContext<'a>,
-        width: u32,
-        height: u32,
-    ) -> Option<EnvBackground<'a>> {
-        let blur = match fs.scene.settings.background {
-            Background::Environment => 0.0,
-            Background::Blurred(b) => b,
-            _ => return None,
-        };
-        // The data views show values, not radiance: no environment there.
-        if fs.scene.settings.shading.is_data_view() {
-            return None;
-        }
-        Some(EnvBackground {
-            env: ctx.env?,
-            blur,
-            rays: CameraRays::new(&fs.camera, width, height),
-        })
-    }
-
-    pub fn at(&self, px: i32, py: i32) -> Vec4 {
-        let (_, d) = self.rays.ray(px, py);
-        let c = if self.blur > 0.0 {
-            self.env.prefiltered(d, self.blur)
-        } else {
-            self.env.radiance(d)
-        };
-        c.extend(1.0)
-    }
-}
 /// The pixel of a lane result that is resolved from its slot, after the
 /// lanes (MSAA pixels with several fragments).
 pub(super) const LANE_SLOT: u32 = u32::MAX;

@@ -15,6 +15,8 @@
 //! center (1 beyond) and interpolated bilinearly. The catcher fades out
 //! between 2 and 3 radii from the center.
 
+use std::sync::OnceLock;
+
 use glam::{Vec3, Vec4};
 
 use super::rays::CameraRays;
@@ -23,7 +25,7 @@ use crate::raytrace::Tracer;
 use crate::scene::Light;
 use crate::scene::settings::Background;
 use crate::shade::ShadeContext;
-use crate::shade::ao::{occlusion_at, pixel_hash};
+use crate::shade::ao::{for_each_ray, pixel_hash};
 use crate::shade::light::incidence;
 
 /// Rays of contact occlusion per grid point.
@@ -174,11 +176,18 @@ impl Ground<'_> {
 }
 
 /// Contact occlusion on the grid: rays of half a radius from farther than
-/// 1.5 radii cannot meet the models, so the grid covers the rest.
+/// 1.5 radii cannot meet the models, so the grid covers the rest. Each
+/// point casts `occlusion_at`'s rays (their directions depend only on the
+/// point's place in the grid, so they are made once per process); a point
+/// whose rays cannot reach any model's bounds is open without casting.
 fn contact_grid(tracer: &Tracer, height: f32, center: Vec3, radius: f32) -> Vec<f32> {
     use rayon::prelude::*;
     let half = AO_EXTENT * radius;
     let step = 2.0 * half / AO_GRID as f32;
+    let t_max = radius * 0.5;
+    // The rays' directions are unit to within a few ulps: 1% is room.
+    let reach = t_max * 1.01 + tracer.epsilon;
+    let dirs = contact_rays();
     let mut grid = vec![1.0f32; AO_GRID * AO_GRID];
     grid.par_chunks_mut(AO_GRID)
         .enumerate()
@@ -189,14 +198,110 @@ fn contact_grid(tracer: &Tracer, height: f32, center: Vec3, radius: f32) -> Vec<
                     height + tracer.epsilon,
                     center.z - half + (z as f32 + 0.5) * step,
                 );
-                let seed = pixel_hash(x as u32, z as u32);
-                *v = occlusion_at(tracer, p, Vec3::Y, AO_SAMPLES, radius * 0.5, seed);
+                if !tracer.any_within(p, reach) {
+                    continue;
+                }
+                let at = (z * AO_GRID + x) * AO_SAMPLES as usize;
+                let rays = &dirs[at..at + AO_SAMPLES as usize];
+                let open = rays
+                    .iter()
+                    .filter(|&&d| !tracer.occluded(p, d, t_max))
+                    .count();
+                // As `occlusion_at` divides.
+                *v = open as u32 as f32 / AO_SAMPLES as f32;
             }
         });
     grid
 }
 
+/// Per grid point (rows along +Z), the directions of its contact rays:
+/// `occlusion_at`'s, around +Y with the point's `pixel_hash` seed.
+fn contact_rays() -> &'static [Vec3] {
+    static RAYS: OnceLock<Vec<Vec3>> = OnceLock::new();
+    RAYS.get_or_init(|| {
+        let mut dirs = Vec::with_capacity(AO_GRID * AO_GRID * AO_SAMPLES as usize);
+        for z in 0..AO_GRID {
+            for x in 0..AO_GRID {
+                let seed = pixel_hash(x as u32, z as u32);
+                for_each_ray(Vec3::Y, AO_SAMPLES, seed, |d| dirs.push(d));
+            }
+        }
+        dirs
+    })
+}
+
 fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raytrace::Placed;
+    use crate::raytrace::bvh::Bvh;
+    use crate::shade::ao::occlusion_at;
+    use glam::Mat4;
+
+    /// The grid (its kept ray table and the skip of points far from every
+    /// model) equals `occlusion_at` at every point, bit for bit: a box
+    /// standing on the plane off the center, so that some points are near
+    /// it, some under its overhang and most far from it.
+    #[test]
+    fn the_contact_grid_is_occlusion_at_every_point() {
+        let (lo, hi) = (Vec3::new(0.2, 0.0, -0.4), Vec3::new(0.9, 0.6, 0.1));
+        let corner = |k: u32| {
+            Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        let positions: Vec<Vec3> = (0..8).map(corner).collect();
+        let quads = [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ];
+        let triangles: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let bvh = Bvh::build(&positions, &triangles);
+        let tracer = Tracer::new(
+            [Placed {
+                bvh: &bvh,
+                bounds: (lo, hi),
+                world_from_object: Mat4::from_rotation_y(0.3),
+            }],
+            1.0,
+        );
+        let (height, center, radius) = (0.0, Vec3::new(0.1, 0.0, 0.0), 1.2);
+        let grid = contact_grid(&tracer, height, center, radius);
+        let half = AO_EXTENT * radius;
+        let step = 2.0 * half / AO_GRID as f32;
+        let mut shaded = 0;
+        for z in 0..AO_GRID {
+            for x in 0..AO_GRID {
+                let p = Vec3::new(
+                    center.x - half + (x as f32 + 0.5) * step,
+                    height + tracer.epsilon,
+                    center.z - half + (z as f32 + 0.5) * step,
+                );
+                let seed = pixel_hash(x as u32, z as u32);
+                let want = occlusion_at(&tracer, p, Vec3::Y, AO_SAMPLES, radius * 0.5, seed);
+                let got = grid[z * AO_GRID + x];
+                assert_eq!(got.to_bits(), want.to_bits(), "point ({x}, {z})");
+                shaded += (want < 1.0) as u32;
+            }
+        }
+        // The box darkens part of the grid, and not all of it.
+        assert!(
+            shaded > 100 && shaded < (AO_GRID * AO_GRID) as u32 / 2,
+            "{shaded}"
+        );
+    }
 }

@@ -14,7 +14,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::raster::setup::Tri;
 use crate::scene::Scene;
-use crate::scene::settings::{AoMethod, ShadowMethod, TextureFilter};
+use crate::scene::settings::{AoMethod, Background, ShadowMethod, TextureFilter};
 
 /// The parts of the estimate, in bytes.
 #[derive(Debug, Clone, Default)]
@@ -157,6 +157,14 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
         frame += w * h * px;
     }
     parts.push(("frame", frame));
+    if matches!(
+        s.background,
+        Background::Environment | Background::Blurred(_)
+    ) && scene.environment.is_some()
+    {
+        // The kept backdrop of a camera that stays (`render::backdrop`).
+        parts.push(("backdrop", w * k * h * k * size_of::<Vec4>() as u64));
+    }
     if s.ao.method != AoMethod::Off {
         let g = size_of::<crate::shade::ao::GPixel>() as u64;
         parts.push(("AO buffers", w * k * h * k * (g + 4)));

@@ -23,6 +23,7 @@
 //! `Renderer::render` is the one entry for a frame.
 
 mod ao_pass;
+mod backdrop;
 mod band;
 pub mod display;
 mod exposure;
@@ -94,6 +95,9 @@ pub struct Renderer {
     /// The last frame's shadow maps (reused while nothing they depend on
     /// moves).
     shadow_maps: shadow_pass::MapCache,
+    /// The last camera's environment backdrop (reused while the view
+    /// stays).
+    backdrops: backdrop::BackdropCache,
     /// Shade the materials that allow it four fragments at a time
     /// (`shade::lanes`); off only to compare the two paths.
     lanes: bool,
@@ -132,6 +136,7 @@ impl Renderer {
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
+            backdrops: Default::default(),
             lanes: true,
             light_culling: true,
         }
@@ -423,7 +428,7 @@ impl Renderer {
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
-        let data = fragment::FrameData::new(
+        let mut data = fragment::FrameData::new(
             fs,
             ctx,
             &verts,
@@ -436,6 +441,9 @@ impl Renderer {
                 light_culling: self.light_culling,
             },
         );
+        if let Some(bg) = &mut data.env_bg {
+            self.backdrops.attach(bg);
+        }
         let overlay = !s.shading.is_data_view() && lines::any(fs);
         let fused = if overlay {
             None

@@ -5,6 +5,7 @@ use glam::Vec3;
 
 use crate::scene::camera::{Camera, Projection};
 
+#[derive(Clone, PartialEq)]
 pub(super) struct CameraRays {
     eye: Vec3,
     forward: Vec3,
@@ -34,6 +35,11 @@ impl CameraRays {
             orthographic,
             size: (width as f32, height as f32),
         }
+    }
+
+    /// The image's height in pixels.
+    pub fn height(&self) -> u32 {
+        self.size.1 as u32
     }
 
     /// Origin and unit direction of the ray through pixel (px, py)'s center.

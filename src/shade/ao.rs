@@ -175,21 +175,30 @@ pub fn occlusion_at(
     normal: Vec3,
     n: u32,
     t_max: f32,
-    (su, sv): (f32, f32),
+    seed: (f32, f32),
 ) -> f32 {
-    let (tx, ty) = normal.any_orthonormal_pair();
     let mut open = 0u32;
+    for_each_ray(normal, n, seed, |dir| {
+        if !tracer.occluded(origin, dir, t_max) {
+            open += 1;
+        }
+    });
+    open as f32 / n as f32
+}
+
+/// The directions `occlusion_at` casts, in its order: `n` cosine-weighted
+/// directions around unit `normal`, a stratified pattern shifted by
+/// `seed`.
+#[inline]
+pub fn for_each_ray(normal: Vec3, n: u32, (su, sv): (f32, f32), mut f: impl FnMut(Vec3)) {
+    let (tx, ty) = normal.any_orthonormal_pair();
     for i in 0..n {
         let u = ((i as f32 + 0.5) / n as f32 + su).fract();
         let v = (radical_inverse(i) + sv).fract();
         let r = u.sqrt();
         let phi = TAU * v;
-        let dir = tx * (r * phi.cos()) + ty * (r * phi.sin()) + normal * (1.0 - u).max(0.0).sqrt();
-        if !tracer.occluded(origin, dir, t_max) {
-            open += 1;
-        }
+        f(tx * (r * phi.cos()) + ty * (r * phi.sin()) + normal * (1.0 - u).max(0.0).sqrt());
     }
-    open as f32 / n as f32
 }
 
 /// 4x4 ordered pattern (0..16), for the per-pixel slice rotation and step

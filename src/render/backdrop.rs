@@ -1,0 +1,207 @@
+//! The environment behind the models (`output.background = "environment"`
+//! or `"blurred"`): the radiance along each pixel center's view ray, sharp
+//! or prefiltered.
+//!
+//! A camera that stays put sees the same backdrop every frame (a
+//! turntable turns the models, not the camera), so the renderer keeps
+//! the last one (`BackdropCache`): the first frame of a camera looks up
+//! only the pixels where the background shows; when the next frame has
+//! the same camera, size, blur and environment, the whole image is
+//! computed once and read by every frame after it. The values are the
+//! lookups' own, so frames are the same bytes with or without it.
+
+use std::sync::{Arc, Mutex};
+
+use glam::Vec4;
+use rayon::prelude::*;
+
+use super::rays::CameraRays;
+use super::setup::FrameSetup;
+use crate::scene::settings::Background;
+use crate::shade::env::EnvLight;
+
+/// The environment seen through the camera, where the background shows
+/// it.
+pub(super) struct EnvBackground<'a> {
+    env: &'a EnvLight,
+    /// Prefiltering roughness; 0: the image itself.
+    blur: f32,
+    rays: CameraRays,
+    width: u32,
+    /// Every pixel's value, when the cache holds them for this view.
+    cached: Option<Image>,
+}
+
+/// What a backdrop depends on: the view rays, the blur and the
+/// environment's lighting (by address: one renderer's, built once).
+#[derive(PartialEq)]
+struct Key {
+    rays: CameraRays,
+    blur: u32,
+    env: usize,
+}
+
+impl<'a> EnvBackground<'a> {
+    /// The backdrop of the frame `fs` at `width` x `height` pixels, or
+    /// None where the background is not the environment.
+    pub fn new(
+        fs: &FrameSetup,
+        env: Option<&'a EnvLight>,
+        width: u32,
+        height: u32,
+    ) -> Option<EnvBackground<'a>> {
+        let blur = match fs.scene.settings.background {
+            Background::Environment => 0.0,
+            Background::Blurred(b) => b,
+            _ => return None,
+        };
+        // The data views show values, not radiance: no environment there.
+        if fs.scene.settings.shading.is_data_view() {
+            return None;
+        }
+        Some(EnvBackground {
+            env: env?,
+            blur,
+            rays: CameraRays::new(&fs.camera, width, height),
+            width,
+            cached: None,
+        })
+    }
+
+    /// The radiance behind pixel (px, py), opaque.
+    #[inline]
+    pub fn at(&self, px: i32, py: i32) -> Vec4 {
+        if let Some(c) = &self.cached {
+            return c[py as usize * self.width as usize + px as usize];
+        }
+        self.look_up(px, py)
+    }
+
+    fn look_up(&self, px: i32, py: i32) -> Vec4 {
+        let (_, d) = self.rays.ray(px, py);
+        let c = if self.blur > 0.0 {
+            self.env.prefiltered(d, self.blur)
+        } else {
+            self.env.radiance(d)
+        };
+        c.extend(1.0)
+    }
+
+    fn key(&self) -> Key {
+        Key {
+            rays: self.rays.clone(),
+            blur: self.blur.to_bits(),
+            env: self.env as *const EnvLight as usize,
+        }
+    }
+
+    /// Every pixel's `look_up`, rows in parallel.
+    fn image(&self) -> Vec<Vec4> {
+        let w = self.width as usize;
+        let h = self.rays.height() as usize;
+        let mut out = vec![Vec4::ZERO; w * h];
+        out.par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, o) in row.iter_mut().enumerate() {
+                    *o = self.look_up(x as i32, y as i32);
+                }
+            });
+        out
+    }
+}
+
+/// A whole backdrop, rows of the frame's width.
+type Image = Arc<Vec<Vec4>>;
+
+/// The last backdrop a renderer drew, kept while its view stays.
+#[derive(Default)]
+pub(super) struct BackdropCache {
+    last: Mutex<Option<(Key, Option<Image>)>>,
+}
+
+impl BackdropCache {
+    /// Gives `bg` the whole image where the previous frame had the same
+    /// view (computing it on the second frame of a view); remembers the
+    /// view otherwise.
+    pub fn attach(&self, bg: &mut EnvBackground) {
+        let key = bg.key();
+        // A poisoned lock (a panic in another frame) only loses the cache.
+        let Ok(mut last) = self.last.lock() else {
+            return;
+        };
+        match &mut *last {
+            Some((k, image)) if *k == key => {
+                let image = image.get_or_insert_with(|| Arc::new(bg.image()));
+                bg.cached = Some(image.clone());
+            }
+            _ => *last = Some((key, None)),
+        }
+    }
+
+    /// The bytes the kept image holds.
+    #[cfg(test)]
+    fn bytes(&self) -> usize {
+        self.last
+            .lock()
+            .ok()
+            .and_then(|l| {
+                l.as_ref()
+                    .and_then(|(_, i)| i.as_ref().map(|i| i.len() * 16))
+            })
+            .unwrap_or(0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assets::environment::EnvImage;
+    use crate::scene::camera::Camera;
+    use glam::Vec3;
+
+    fn backdrop<'a>(env: &'a EnvLight, eye: Vec3, blur: f32) -> EnvBackground<'a> {
+        let cam = Camera {
+            eye,
+            ..Camera::framing("c".into(), Vec3::ZERO, 1.0, 40.0)
+        };
+        EnvBackground {
+            env,
+            blur,
+            rays: CameraRays::new(&cam, 37, 23),
+            width: 37,
+            cached: None,
+        }
+    }
+
+    #[test]
+    fn the_kept_image_is_every_lookup_bit_for_bit() {
+        let env = EnvLight::with_size(&EnvImage::studio(), 1.0, 30.0, 32);
+        let cache = BackdropCache::default();
+        for blur in [0.0, 0.5] {
+            let eye = Vec3::new(1.0, 0.5, 3.0);
+            // First frame of the view: nothing kept.
+            let mut first = backdrop(&env, eye, blur);
+            cache.attach(&mut first);
+            assert!(first.cached.is_none());
+            // Second: the whole image, equal to the lookups.
+            let mut second = backdrop(&env, eye, blur);
+            cache.attach(&mut second);
+            assert!(second.cached.is_some());
+            assert_eq!(cache.bytes(), 37 * 23 * 16);
+            for y in 0..23 {
+                for x in 0..37 {
+                    let (a, b) = (second.at(x, y), first.at(x, y));
+                    assert_eq!(
+                        a.to_array().map(f32::to_bits),
+                        b.to_array().map(f32::to_bits)
+                    );
+                }
+            }
+            // Another view is not served the kept image.
+            let mut moved = backdrop(&env, eye + Vec3::X * 0.01, blur);
+            cache.attach(&mut moved);
+            assert!(moved.cached.is_none());
+        }
+    }
+}
