@@ -4,6 +4,10 @@ fn main() {
     if let Some(missing) = missing_cpu_feature() {
         refuse(missing);
     }
+    if let Err(e) = softraster::simd::lane_width() {
+        eprintln!("error: {e}");
+        std::process::exit(2);
+    }
     keep_freed_memory();
     std::process::exit(cli::main());
 }

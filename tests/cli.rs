@@ -667,3 +667,85 @@ fn texture_cache_gives_the_same_frames_and_survives_damage() {
         "{err}"
     );
 }
+
+/// `SOFTRASTER_LANES` forces a lane width: every width this build has
+/// gives the same PNG bytes (the showcase with MSAA and SSAO, and
+/// diablo3's maps under a spot light with a shadow map, where the shared
+/// assets are); any other value exits 2 before anything is read, naming
+/// the variable and the widths there are.
+#[test]
+fn every_lane_width_gives_the_same_bytes_and_others_exit_2() {
+    let dir = common::scratch("lane-widths");
+    let scene = root().join("scenes/showcase.toml");
+    let run_with = |lanes: &str, out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--frames",
+            "0..2",
+            "--quiet",
+            "--set",
+            "output.width=240",
+            "--set",
+            "output.height=180",
+            "--set",
+            "render.msaa=4",
+        ];
+        args.extend(extra.iter().flat_map(|s| ["--set", s]));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_softraster"))
+            .args(&args)
+            .env("SOFTRASTER_LANES", lanes)
+            .output()
+            .unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for bad in ["3", "16", "0", "eight", ""] {
+        let (code, err) = run_with(bad, &dir.join("bad"), &[]);
+        assert_eq!(code, 2, "SOFTRASTER_LANES={bad}: {err}");
+        let widths = softraster::simd::widths();
+        assert!(
+            err.contains(&format!("SOFTRASTER_LANES={bad}:"))
+                && err.contains("lane width")
+                && widths.iter().all(|w| err.contains(&w.to_string())),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("bad").exists(), "nothing is rendered");
+    for (variant, extra) in [
+        ("plain", vec![]),
+        (
+            "ssao-spot-pcf",
+            vec![
+                "render.ao={method=\"ssao\"}",
+                "light.2.shadows=true",
+                "render.shadows=\"pcf\"",
+            ],
+        ),
+    ] {
+        let mut frames: Vec<Vec<Vec<u8>>> = Vec::new();
+        for &w in softraster::simd::widths() {
+            let out = dir.join(variant).join(w.to_string());
+            let (code, err) = run_with(&w.to_string(), &out, &extra);
+            assert_eq!(code, 0, "{variant}, {w} lanes: {err}");
+            let mut files: Vec<_> = std::fs::read_dir(&out)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .collect();
+            files.sort();
+            assert_eq!(files.len(), 2);
+            frames.push(files.iter().map(|f| std::fs::read(f).unwrap()).collect());
+        }
+        for (k, f) in frames.iter().enumerate().skip(1) {
+            assert!(
+                *f == frames[0],
+                "{variant}: {} lanes differ from 1",
+                softraster::simd::widths()[k]
+            );
+        }
+    }
+}

@@ -1,5 +1,6 @@
-//! Shading four fragments at a time (`shade::lanes`: `blinn_phong4` and
-//! `pbr4`) gives the frames of the one-fragment path bit for bit: colour
+//! Shading a lane group at a time (`shade::lanes`: `blinn_phong4` and
+//! `pbr4`), at every lane width this build has (1, 4 and 8 lanes on
+//! x86-64-v3), gives the frames of the one-fragment path bit for bit: colour
 //! and depth of every pixel, over scenes that reach each of its branches
 //! (maps, normal maps, vertex colours, every light kind with ranges and
 //! shadows, the environment, AO, MSAA, anisotropic and trilinear
@@ -13,11 +14,20 @@ use common::{load_with, same_frames, scene_in, scratch, shared_assets};
 use softraster::render::Renderer;
 use softraster::scene::Scene;
 
-/// Frames `frames` of camera 0 with and without the lanes; panics at the
-/// first pixel that differs in any bit.
+/// Frames `frames` of camera 0 without the lanes and with them at every
+/// lane width; panics at the first pixel that differs in any bit.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
     let single = Renderer::new(scene).with_lanes(false);
-    same_frames(scene, &Renderer::new(scene), &single, frames, what);
+    for &width in softraster::simd::widths() {
+        let lanes = Renderer::new(scene).with_lane_width(width);
+        same_frames(
+            scene,
+            &lanes,
+            &single,
+            frames,
+            &format!("{what}, {width} lanes"),
+        );
+    }
 }
 
 use std::path::Path;

@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3, Vec4};
 use super::display::PlainBackground;
 use super::fragment::{FrameData, LANE_SLOT, Part, Point, Sink, resolve};
 use super::frame::AovPixel;
-use super::lanes::{LaneBatches, Pending};
+use super::lanes::{LaneBatches, Pending, QuadAt};
 use crate::assets::texture::{Footprint, Gradients};
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
@@ -400,7 +400,7 @@ impl<'a> FrameData<'a> {
             .lanes
             .iter()
             .any(|l| l.is_some())
-            .then(|| LaneBatches::new(self.draws.len()));
+            .then(|| LaneBatches::new(self.draws.len(), self.lane_width));
         let mut shaded = Vec::new();
         let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
         for qy in (0..th).step_by(2) {
@@ -428,15 +428,16 @@ impl<'a> FrameData<'a> {
                         if let (Some(lm), Some(b)) =
                             (self.lane_material(t.draw as usize), lanes.as_mut())
                         {
-                            let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
-                            let it = cache.get(id, t);
-                            let ao = ao.map_or([1.0; 4], |a| quad.map(|i| a[i]));
-                            let corners = b.corners.get(self, t.draw as usize, id, t);
-                            let shaded = self.shade_quad(t, it, lm, q0, ao, lights_at(qx), corners);
-                            for (k, &i) in quad.iter().enumerate() {
-                                (color[i], depth[i]) =
-                                    resolve(&[Part::Queued(0, n as f32)], &shaded[k..k + 1], inv_n);
-                            }
+                            let q = QuadAt {
+                                t,
+                                id,
+                                it: cache.get(id, t),
+                                lm,
+                                q0: (rect.x0 + qx as i32, rect.y0 + qy as i32),
+                                ao: ao.map_or([1.0; 4], |a| quad.map(|i| a[i])),
+                                lights: lights_at(qx),
+                            };
+                            b.quad(self, q, quad, (&mut *color, &mut *depth), n);
                             continue;
                         }
                     }

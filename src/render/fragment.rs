@@ -50,6 +50,8 @@ pub(super) struct FrameData<'a> {
     pub lanes: Vec<Option<LaneMaterial<'a>>>,
     /// Per-tile light culling, where some light can be culled.
     pub culling: Option<Culling>,
+    /// Lanes per lane call: 1, 4 or 8 (the same pixels at every width).
+    pub lane_width: usize,
 }
 
 /// Which of the equivalent shading paths a frame takes (both default on;
@@ -60,6 +62,8 @@ pub(super) struct Paths {
     pub lanes: bool,
     /// Skip per tile the lights that cannot reach it.
     pub light_culling: bool,
+    /// Lanes per lane call (1, 4 or 8).
+    pub lane_width: usize,
 }
 
 impl<'a> FrameData<'a> {
@@ -129,6 +133,7 @@ impl<'a> FrameData<'a> {
             geo_normal,
             lanes,
             culling,
+            lane_width: paths.lane_width,
             ctx,
         }
     }

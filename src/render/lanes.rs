@@ -1,12 +1,11 @@
-//! The fragments of a band whose materials are shaded four at a time
-//! (`ShadeContext::shade_lanes`): queued per draw while the band's quads
-//! are walked, then gathered into groups of four of one draw and shaded
-//! together. Each fragment's result is what the one-fragment path gives
-//! it, so the band resolves its pixels in the same order with the same
-//! values either way.
-
-// Loops over the four lanes index several per-lane arrays at once.
-#![allow(clippy::needless_range_loop)]
+//! The fragments of a band whose materials are shaded a lane group at a
+//! time (`ShadeContext::shade_lanes`, 1, 4 or 8 lanes: `Renderer`'s
+//! lane width): queued per draw while the band's quads are walked, then
+//! gathered into groups of one draw and shaded together; a quad covered
+//! by one triangle is shaded at once (with eight lanes, two such quads of
+//! one draw together). Each fragment's result is the same bits at every
+//! width, so the band resolves its pixels in the same order with the
+//! same values whatever the width.
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -16,9 +15,9 @@ use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
 use crate::shade::lanes::LaneMaterial;
-use crate::shade::lanes::{Lanes, MAX_SIZES};
+use crate::shade::lanes::{Lanes, MAX_LANES, MAX_SIZES};
 use crate::shade::light::LightMask;
-use crate::simd::{V3, lanes4, lerp3};
+use crate::simd::{F8, Lane, V3, lerp3};
 
 /// A fragment waiting for its lane.
 #[derive(Clone, Copy)]
@@ -41,14 +40,20 @@ pub(super) struct Pending {
     pub lights: LightMask,
 }
 
-/// A band's lane fragments waiting for their group of four: per draw, up
-/// to three of them; the fourth shades the group at once.
+/// A band's lane fragments waiting for their group: per draw, up to one
+/// less than the lane width; the last shades the group at once.
 pub(super) struct LaneBatches {
     waiting: Vec<Waiting>,
     /// The slot of the next fragment.
     next: u32,
     /// The corners of the band's recent triangles.
     pub corners: CornerCache,
+    /// Lanes per group: 1, 4 or 8.
+    width: usize,
+    /// With eight lanes: a quad of one triangle waiting for a second of
+    /// its draw, with its triangle's corners, the band pixels its
+    /// results go to and their samples.
+    quad: Option<WaitingQuad>,
 }
 
 /// How many triangles' corners a band keeps at hand.
@@ -104,11 +109,11 @@ impl CornerCache {
     }
 }
 
-/// Up to four fragments of one draw, with their slots.
+/// Up to a group of fragments of one draw, with their slots.
 #[derive(Clone, Copy)]
 struct Waiting {
-    group: [Pending; 4],
-    slots: [u32; 4],
+    group: [Pending; MAX_LANES],
+    slots: [u32; MAX_LANES],
     len: usize,
 }
 
@@ -126,18 +131,22 @@ impl Pending {
 }
 
 impl LaneBatches {
-    pub fn new(draws: usize) -> LaneBatches {
+    /// Batches for `draws` draws, shading `width` lanes at a time (1, 4
+    /// or 8).
+    pub fn new(draws: usize, width: usize) -> LaneBatches {
         LaneBatches {
             waiting: vec![
                 Waiting {
-                    group: [Pending::NONE; 4],
-                    slots: [0; 4],
+                    group: [Pending::NONE; MAX_LANES],
+                    slots: [0; MAX_LANES],
                     len: 0,
                 };
                 draws
             ],
             next: 0,
             corners: CornerCache::new(),
+            width,
+            quad: None,
         }
     }
 
@@ -151,46 +160,216 @@ impl LaneBatches {
         w.group[w.len] = p;
         w.slots[w.len] = slot;
         w.len += 1;
-        if w.len == 4 {
-            shade_group(data, draw as usize, w, &mut self.corners, sink);
+        if w.len == self.width {
+            shade_group(data, draw as usize, w, &mut self.corners, sink, self.width);
             w.len = 0;
         }
         slot
     }
 
-    /// Shades every group that is not full (its last fragment repeated).
+    /// Shades every group that is not full (its last fragment repeated),
+    /// and a quad still waiting.
     pub fn finish(&mut self, data: &FrameData, sink: &mut Sink) {
+        self.flush_quad(data, sink.color, sink.depth);
         for (draw, w) in self.waiting.iter_mut().enumerate() {
             if w.len > 0 {
-                for k in w.len..4 {
+                for k in w.len..MAX_LANES {
                     w.group[k] = w.group[w.len - 1];
                 }
-                shade_group(data, draw, w, &mut self.corners, sink);
+                shade_group(data, draw, w, &mut self.corners, sink, self.width);
                 w.len = 0;
             }
         }
     }
+
+    /// Shades the quad `q` of one triangle (band pixels `pixels`, `n`
+    /// samples each, all covered) into the band's `color` and `depth`: at
+    /// once, or with eight lanes when a second quad of its draw comes (or
+    /// the band ends: `finish`).
+    pub fn quad(
+        &mut self,
+        data: &FrameData,
+        q: QuadAt,
+        pixels: [usize; 4],
+        (color, depth): (&mut [glam::Vec4], &mut [f32]),
+        n: usize,
+    ) {
+        let (draw, id) = (q.t.draw as usize, q.id);
+        if self.width != 8 {
+            let c = self.corners.get(data, draw, id, q.t);
+            let p = data.prepare_quad(&q, c);
+            let out = data.shade_prepared(&p, &[c; MAX_LANES], self.width);
+            put_quad(&out[..4], pixels, color, depth, n);
+            return;
+        }
+        match self.quad.take() {
+            Some(mut first) if first.prepared.draw == draw => {
+                let c = self.corners.get(data, draw, id, q.t);
+                let p = data.prepare_quad(&q, c);
+                first.prepared.append(&p);
+                let a = &first.corners;
+                let refs = [a, a, a, a, c, c, c, c];
+                let out = data.shade_prepared(&first.prepared, &refs, 8);
+                put_quad(&out[..4], first.pixels, color, depth, first.samples);
+                put_quad(&out[4..], pixels, color, depth, n);
+            }
+            other => {
+                if let Some(first) = other {
+                    first.shade(data, color, depth);
+                }
+                let c = self.corners.get(data, draw, id, q.t);
+                self.quad = Some(WaitingQuad {
+                    prepared: data.prepare_quad(&q, c),
+                    corners: *c,
+                    pixels,
+                    samples: n,
+                });
+            }
+        }
+    }
+
+    /// Shades a quad still waiting for a second.
+    fn flush_quad(&mut self, data: &FrameData, color: &mut [glam::Vec4], depth: &mut [f32]) {
+        if let Some(first) = self.quad.take() {
+            first.shade(data, color, depth);
+        }
+    }
 }
 
-/// Shades the four fragments of draw `draw` in `w` and hands those it
-/// holds to `sink` (linear colour, zero where not finite as the
-/// one-fragment path has it).
+/// A quad of one triangle waiting for a second of its draw (eight
+/// lanes).
+struct WaitingQuad {
+    prepared: Prepared,
+    corners: Corners,
+    pixels: [usize; 4],
+    samples: usize,
+}
+
+impl WaitingQuad {
+    /// Shades it alone.
+    fn shade(&self, data: &FrameData, color: &mut [glam::Vec4], depth: &mut [f32]) {
+        let c = &self.corners;
+        let out = data.shade_prepared(&self.prepared, &[c; MAX_LANES], 8);
+        put_quad(&out[..4], self.pixels, color, depth, self.samples);
+    }
+}
+
+/// A quad's four results to its band pixels (`n` samples each, all of
+/// them covered), as the band resolves such pixels.
+fn put_quad(
+    out: &[(Vec3, f32)],
+    pixels: [usize; 4],
+    color: &mut [glam::Vec4],
+    depth: &mut [f32],
+    n: usize,
+) {
+    let inv_n = 1.0 / n as f32;
+    for (k, &i) in pixels.iter().enumerate() {
+        (color[i], depth[i]) = super::fragment::resolve(
+            &[super::fragment::Part::Queued(0, n as f32)],
+            &out[k..k + 1],
+            inv_n,
+        );
+    }
+}
+
+/// A quad covered by one triangle, as the band hands it to the lanes.
+pub(super) struct QuadAt<'q, 'a> {
+    pub t: &'q Tri,
+    pub id: u32,
+    pub it: &'q Interpolator,
+    pub lm: &'q LaneMaterial<'a>,
+    /// Its top-left pixel.
+    pub q0: (i32, i32),
+    pub ao: [f32; 4],
+    pub lights: LightMask,
+}
+
+/// Shades the group of draw `draw` in `w` (`width` lanes at a time) and
+/// hands the fragments it holds to `sink` (linear colour, zero where not
+/// finite as the one-fragment path has it).
 fn shade_group(
     data: &FrameData,
     draw: usize,
     w: &Waiting,
     corners: &mut CornerCache,
     sink: &mut Sink,
+    width: usize,
 ) {
-    let Some(lm) = data.lane_material(draw) else {
+    if data.lane_material(draw).is_none() {
         return;
+    }
+    let mut p = data.prepare_group(&w.group, width);
+    p.draw = draw;
+    let id = |k: usize| w.group[k].id;
+    let tri = |k: usize| &data.tris[id(k) as usize];
+    for k in 0..width {
+        corners.fill(data, draw, id(k), tri(k));
+    }
+    // Two of the lanes' triangles may share a slot; then their corners
+    // are gathered here.
+    let mut refs: [&Corners; MAX_LANES] = [&Corners::NONE; MAX_LANES];
+    let mut cached = true;
+    for (k, r) in refs.iter_mut().enumerate().take(width) {
+        match corners.peek(id(k)) {
+            Some(c) => *r = c,
+            None => {
+                cached = false;
+                break;
+            }
+        }
+    }
+    let out = if cached {
+        for k in width..MAX_LANES {
+            refs[k] = refs[width - 1];
+        }
+        data.shade_prepared(&p, &refs, width)
+    } else {
+        let mut own = [Corners::NONE; MAX_LANES];
+        for k in 0..width {
+            // Neighbouring fragments mostly share a triangle.
+            own[k] = if k > 0 && id(k) == id(k - 1) {
+                own[k - 1]
+            } else {
+                data.corners(draw, tri(k))
+            };
+        }
+        let own = &own;
+        let refs = std::array::from_fn(|k| &own[k.min(width - 1)]);
+        data.shade_prepared(&p, &refs, width)
     };
-    let (lanes, depth) = data.gather(draw, &w.group, corners);
-    let c = data.ctx.shade_lanes(lm, &lanes);
-    for k in 0..w.len {
-        let c = c.lane(k);
-        let c = if c.is_finite() { c } else { Vec3::ZERO };
-        sink.put(w.slots[k], w.group[k].pixel, w.group[k].count, c, depth[k]);
+    for (k, &(c, d)) in out.iter().enumerate().take(w.len) {
+        sink.put(w.slots[k], w.group[k].pixel, w.group[k].count, c, d);
+    }
+}
+
+/// Up to eight fragments of one draw, ready for the lanes: where each
+/// lane interpolates its triangle's corners (which come beside it) and
+/// what it looks up.
+#[derive(Clone, Copy)]
+pub(super) struct Prepared {
+    draw: usize,
+    /// How many lanes hold fragments (the rest repeat the last).
+    len: usize,
+    /// Per lane: barycentrics and w, AO, footprints.
+    lambda: [Vec3; MAX_LANES],
+    w: [f32; MAX_LANES],
+    ao: [f32; MAX_LANES],
+    footprints: [[Footprint; MAX_LANES]; MAX_SIZES],
+    lights: LightMask,
+}
+
+impl Prepared {
+    /// `other`'s first four lanes after this one's first four.
+    fn append(&mut self, other: &Prepared) {
+        self.lambda[4..].copy_from_slice(&other.lambda[..4]);
+        self.w[4..].copy_from_slice(&other.w[..4]);
+        self.ao[4..].copy_from_slice(&other.ao[..4]);
+        for s in 0..MAX_SIZES {
+            self.footprints[s][4..].copy_from_slice(&other.footprints[s][..4]);
+        }
+        self.len = 8;
+        self.lights = self.lights.union(other.lights);
     }
 }
 
@@ -217,23 +396,6 @@ impl Corners {
         color: [Vec4::ZERO; 3],
         front: false,
     };
-}
-
-/// Corner `j`'s `f` of four triangles, one per lane.
-#[inline(always)]
-fn corner3(c: &[&Corners; 4], j: usize, f: impl Fn(&Corners) -> [Vec3; 3]) -> V3 {
-    V3::from_lanes([f(c[0])[j], f(c[1])[j], f(c[2])[j], f(c[3])[j]])
-}
-
-/// Corner `j`'s `f` (a 4-vector, of which xyz) of four triangles.
-#[inline(always)]
-fn corner4(c: &[&Corners; 4], j: usize, f: impl Fn(&Corners) -> [Vec4; 3]) -> V3 {
-    V3::from_lanes([
-        f(c[0])[j].truncate(),
-        f(c[1])[j].truncate(),
-        f(c[2])[j].truncate(),
-        f(c[3])[j].truncate(),
-    ])
 }
 
 impl<'a> FrameData<'a> {
@@ -269,60 +431,41 @@ impl<'a> FrameData<'a> {
         }
     }
 
-    /// Four fragments of draw `draw` as the lanes take them: lane k at
-    /// barycentrics (`lx`, `ly`, `lz`)[k] and w `w`[k] of the triangle
-    /// with `corners[k]`, interpolated as `point` and `surface` interpolate
-    /// one fragment (the same operations in the same order, four at a
-    /// time); and their view depths.
-    #[allow(clippy::too_many_arguments)]
+    /// The fragments of `p` as `L`'s lanes take them (lanes `at` ..
+    /// `at + L::WIDTH`), interpolated as `point` and `surface`
+    /// interpolate one fragment (the same operations in the same order,
+    /// lane by lane); and their view depths.
     #[inline(always)]
-    pub(super) fn lanes(
+    fn lanes<'p, L: Lane>(
         &self,
-        draw: usize,
-        corners: &[&Corners; 4],
-        l: V3,
-        w: Vec4,
-        ao: Vec4,
-        footprints: [[Footprint; 4]; MAX_SIZES],
-        lights: LightMask,
-    ) -> (Lanes, Vec4) {
-        let d = self.draws[draw];
+        p: &'p Prepared,
+        corners: &[&Corners; MAX_LANES],
+        at: usize,
+    ) -> (Lanes<'p, L>, L) {
+        let d = self.draws[p.draw];
         let mesh = &self.fs.scene.models[d.model].mesh;
         let ctx = &self.ctx;
-        let world = |k: &Corners| k.world;
-        let position = lerp3(
-            corner3(corners, 0, world),
-            corner3(corners, 1, world),
-            corner3(corners, 2, world),
-            l,
-        );
+        let c = |k: usize| corners[at + k];
+        let l = V3::<L>::from_fn(|k| p.lambda[at + k]);
+        let corner3 = |j: usize, f: fn(&Corners) -> [Vec3; 3]| V3::<L>::from_fn(|k| f(c(k))[j]);
+        let lerp =
+            |f: fn(&Corners) -> [Vec3; 3]| lerp3(corner3(0, f), corner3(1, f), corner3(2, f), l);
+        let position = lerp(|k| k.world);
+        let w = L::from_fn(|k| p.w[at + k]);
         let depth = if ctx.orthographic {
             (position - V3::splat(ctx.eye)).dot(V3::splat(ctx.forward))
         } else {
             w
         };
-        let nrm = |k: &Corners| k.normal;
-        let n = lerp3(
-            corner3(corners, 0, nrm),
-            corner3(corners, 1, nrm),
-            corner3(corners, 2, nrm),
-            l,
-        )
-        .normalize_or(V3::splat(Vec3::Y));
-        let front = lanes4(
-            corners[0].front as u32 as f32,
-            corners[1].front as u32 as f32,
-            corners[2].front as u32 as f32,
-            corners[3].front as u32 as f32,
-        )
-        .cmpgt(Vec4::ZERO);
+        let n = lerp(|k| k.normal).normalize_or(V3::splat(Vec3::Y));
+        let front = L::from_fn(|k| c(k).front as u32 as f32).cmpgt(L::splat(0.0));
         let normal = V3::select(front, n, -n);
-        let mut geo_normal = [Vec3::ZERO; 4];
-        for k in 0..4 {
+        let mut geo_normal = [Vec3::ZERO; MAX_LANES];
+        for (k, g) in geo_normal.iter_mut().enumerate().take(L::WIDTH) {
             let n = normal.lane(k);
-            geo_normal[k] = if self.geo_normal {
-                let [a, b, c] = corners[k].world;
-                let g = (b - a).cross(c - a).normalize_or(n);
+            *g = if self.geo_normal {
+                let [a, b, cc] = c(k).world;
+                let g = (b - a).cross(cc - a).normalize_or(n);
                 if g.dot(ctx.view_vector(position.lane(k))) < 0.0 {
                     -g
                 } else {
@@ -332,76 +475,76 @@ impl<'a> FrameData<'a> {
                 n
             };
         }
-        let uv = |j: usize| {
-            let p = [
-                corners[0].uv[j],
-                corners[1].uv[j],
-                corners[2].uv[j],
-                corners[3].uv[j],
-            ];
-            (
-                lanes4(p[0].x, p[1].x, p[2].x, p[3].x),
-                lanes4(p[0].y, p[1].y, p[2].y, p[3].y),
-            )
-        };
+        let uv = |j: usize| (L::from_fn(|k| c(k).uv[j].x), L::from_fn(|k| c(k).uv[j].y));
         let ((u0, v0), (u1, v1), (u2, v2)) = (uv(0), uv(1), uv(2));
-        let tan = |k: &Corners| k.tangent;
-        let tangent = lerp3(
-            corner4(corners, 0, tan),
-            corner4(corners, 1, tan),
-            corner4(corners, 2, tan),
-            l,
-        );
-        let color = (!mesh.colors.is_empty()).then(|| {
-            let col = |k: &Corners| k.color;
-            lerp3(
-                corner4(corners, 0, col),
-                corner4(corners, 1, col),
-                corner4(corners, 2, col),
-                l,
-            )
-        });
-        let sign = lanes4(
-            corners[0].tangent[0].w,
-            corners[1].tangent[0].w,
-            corners[2].tangent[0].w,
-            corners[3].tangent[0].w,
-        );
+        let tangent = lerp(|k| k.tangent.map(|t| t.truncate()));
+        let color = (!mesh.colors.is_empty()).then(|| lerp(|k| k.color.map(|c| c.truncate())));
         let lanes = Lanes {
             position,
             normal,
             u: u0 * l.x + u1 * l.y + u2 * l.z,
             v: v0 * l.x + v1 * l.y + v2 * l.z,
             tangent,
-            sign,
+            sign: L::from_fn(|k| c(k).tangent[0].w),
             color,
             geo_normal,
-            ao,
-            footprints,
-            lights,
+            ao: L::from_fn(|k| p.ao[at + k]),
+            footprints: &p.footprints,
+            first: at,
+            lights: p.lights,
         };
         (lanes, depth)
     }
 
-    /// The four pixels of the quad whose top-left pixel is `q0`, all of
-    /// triangle `t` (interpolated by `it`) of lane material `lm`, one
-    /// sample each: per pixel in reading order, the linear colour (zero
-    /// where not finite) and view depth, as `fragment` and the lanes give
-    /// them pixel by pixel. The quad's texture derivatives are its lanes'
-    /// differences (what `gradients0` computes).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn shade_quad(
+    /// Shades the fragments of `p`, `width` lanes at a time: per lane,
+    /// the linear colour (zero where not finite) and view depth.
+    pub(super) fn shade_prepared(
         &self,
-        t: &Tri,
-        it: &Interpolator,
+        p: &Prepared,
+        corners: &[&Corners; MAX_LANES],
+        width: usize,
+    ) -> [(Vec3, f32); MAX_LANES] {
+        let mut out = [(Vec3::ZERO, 0.0); MAX_LANES];
+        let Some(lm) = self.lane_material(p.draw) else {
+            return out;
+        };
+        let mut at = 0;
+        while at < p.len {
+            match width {
+                8 => self.shade_at::<F8>(lm, (p, corners), at, &mut out),
+                4 => self.shade_at::<Vec4>(lm, (p, corners), at, &mut out),
+                _ => self.shade_at::<f32>(lm, (p, corners), at, &mut out),
+            }
+            at += width;
+        }
+        out
+    }
+
+    /// `shade_prepared` of lanes `at` .. `at + L::WIDTH`.
+    #[inline(never)]
+    fn shade_at<L: Lane>(
+        &self,
         lm: &LaneMaterial<'a>,
-        q0: (i32, i32),
-        ao: [f32; 4],
-        lights: LightMask,
-        corners: &Corners,
-    ) -> [(Vec3, f32); 4] {
-        let draw = t.draw as usize;
-        let (x, y) = q0;
+        (p, corners): (&Prepared, &[&Corners; MAX_LANES]),
+        at: usize,
+        out: &mut [(Vec3, f32); MAX_LANES],
+    ) {
+        let (lanes, depth) = self.lanes::<L>(p, corners, at);
+        let c = self.ctx.shade_lanes(lm, &lanes);
+        for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
+            let c = c.lane(k);
+            *o = (if c.is_finite() { c } else { Vec3::ZERO }, depth.lane(k));
+        }
+    }
+
+    /// The four pixels of the quad `q`, all of one triangle, one sample
+    /// each, in reading order, ready for the lanes (lanes 4 .. 8 repeat
+    /// them). The quad's texture derivatives are its lanes' differences
+    /// (what `gradients0` computes).
+    #[inline(always)]
+    pub(super) fn prepare_quad(&self, q: &QuadAt, corners: &Corners) -> Prepared {
+        let (it, t) = (q.it, q.t);
+        let (x, y) = q.q0;
         let px = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
         let centers = px.map(|(x, y)| it.at_pixel(x, y));
         // With MSAA the shading point leaves a center the triangle does not
@@ -421,7 +564,6 @@ impl<'a> FrameData<'a> {
                 }
             })
         };
-        let l = V3::from_lanes([f[0].lambda, f[1].lambda, f[2].lambda, f[3].lambda]);
         let uv = |k: usize| {
             let c = &corners.uv;
             let l = centers[k].lambda;
@@ -436,86 +578,41 @@ impl<'a> FrameData<'a> {
         } else {
             Gradients::default()
         };
-        let fp = lm.footprints(&self.ctx, grads);
-        let footprints = [[fp[0]; 4], [fp[1]; 4], [fp[2]; 4]];
-        let (lanes, depth) = self.lanes(
-            draw,
-            &[corners; 4],
-            l,
-            lanes4(f[0].w, f[1].w, f[2].w, f[3].w),
-            lanes4(ao[0], ao[1], ao[2], ao[3]),
-            footprints,
-            lights,
-        );
-        let c = self.ctx.shade_lanes(lm, &lanes);
-        let out = |k: usize| {
-            let c = c.lane(k);
-            (if c.is_finite() { c } else { Vec3::ZERO }, depth[k])
-        };
-        [out(0), out(1), out(2), out(3)]
+        let fp = q.lm.footprints(&self.ctx, grads);
+        let pick = |k: usize| k.min(3);
+        Prepared {
+            draw: t.draw as usize,
+            len: 4,
+            lambda: std::array::from_fn(|k| f[pick(k)].lambda),
+            w: std::array::from_fn(|k| f[pick(k)].w),
+            ao: std::array::from_fn(|k| q.ao[pick(k)]),
+            footprints: fp.map(|f| [f; MAX_LANES]),
+            lights: q.lights,
+        }
     }
 
-    /// Four queued fragments of draw `draw` as the lanes take them, and
-    /// their view depths.
-    fn gather(
-        &self,
-        draw: usize,
-        frags: &[Pending; 4],
-        cache: &mut CornerCache,
-    ) -> (Lanes, [f32; 4]) {
-        let tri = |k: usize| &self.tris[frags[k].id as usize];
-        for f in frags {
-            cache.fill(self, draw, f.id, &self.tris[f.id as usize]);
-        }
-        // Two of the lanes' triangles may share a slot; then the corners
-        // are gathered here.
-        let cached = frags.map(|f| cache.peek(f.id));
-        if let [Some(a), Some(b), Some(c), Some(d)] = cached {
-            return self.gather_from(draw, frags, &[a, b, c, d]);
-        }
-        let c0 = self.corners(draw, tri(0));
-        // Neighbouring fragments mostly share a triangle.
-        let c1 = if frags[1].id == frags[0].id {
-            c0
-        } else {
-            self.corners(draw, tri(1))
+    /// The queued fragments `frags` (`width` of them, the last repeated
+    /// where fewer wait), ready for the lanes.
+    #[inline(always)]
+    fn prepare_group(&self, frags: &[Pending; MAX_LANES], width: usize) -> Prepared {
+        let mut p = Prepared {
+            draw: 0,
+            len: width,
+            lambda: [Vec3::ZERO; MAX_LANES],
+            w: [0.0; MAX_LANES],
+            ao: [1.0; MAX_LANES],
+            footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
+            lights: LightMask::NONE,
         };
-        let c2 = if frags[2].id == frags[1].id {
-            c1
-        } else {
-            self.corners(draw, tri(2))
-        };
-        let c3 = if frags[3].id == frags[2].id {
-            c2
-        } else {
-            self.corners(draw, tri(3))
-        };
-        self.gather_from(draw, frags, &[&c0, &c1, &c2, &c3])
-    }
-
-    /// `gather` with the lanes' triangles' corners at hand.
-    fn gather_from(
-        &self,
-        draw: usize,
-        frags: &[Pending; 4],
-        corners: &[&Corners; 4],
-    ) -> (Lanes, [f32; 4]) {
-        let mut footprints = [[Footprint::Lod(0.0); 4]; MAX_SIZES];
-        for (k, f) in frags.iter().enumerate() {
-            for (s, fp) in footprints.iter_mut().enumerate() {
+        for (k, f) in frags.iter().enumerate().take(width) {
+            p.lambda[k] = f.lambda;
+            p.w[k] = f.w;
+            p.ao[k] = f.ao;
+            for (s, fp) in p.footprints.iter_mut().enumerate() {
                 fp[k] = f.footprints[s];
             }
+            p.lights = p.lights.union(f.lights);
         }
-        let f = |k: usize| &frags[k];
-        let (lanes, depth) = self.lanes(
-            draw,
-            corners,
-            V3::from_lanes([f(0).lambda, f(1).lambda, f(2).lambda, f(3).lambda]),
-            lanes4(f(0).w, f(1).w, f(2).w, f(3).w),
-            lanes4(f(0).ao, f(1).ao, f(2).ao, f(3).ao),
-            footprints,
-            frags.iter().fold(LightMask::NONE, |m, f| m.union(f.lights)),
-        );
-        (lanes, depth.to_array())
+        p
     }
 }

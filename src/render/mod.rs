@@ -104,6 +104,8 @@ pub struct Renderer {
     /// Skip, per tile, the lights that cannot reach it (`light_tiles`);
     /// off only to compare.
     light_culling: bool,
+    /// Lanes per lane call: 1, 4 or 8 (`simd::lane_width`).
+    lane_width: usize,
 }
 
 impl Renderer {
@@ -139,6 +141,10 @@ impl Renderer {
             backdrops: Default::default(),
             lanes: true,
             light_culling: true,
+            lane_width: crate::simd::lane_width()
+                .ok()
+                .flatten()
+                .unwrap_or(crate::simd::widest()),
         }
     }
 
@@ -147,6 +153,18 @@ impl Renderer {
     /// byte for byte); the switch is for those tests and for measuring.
     pub fn with_lanes(mut self, on: bool) -> Renderer {
         self.lanes = on;
+        self
+    }
+
+    /// Shades `width` lanes at a time (1, 4 or 8; a width this build
+    /// lacks (`simd::widths`) takes the widest it has). The frames are
+    /// the same bytes at every width (tests compare them).
+    pub fn with_lane_width(mut self, width: usize) -> Renderer {
+        self.lane_width = if crate::simd::widths().contains(&width) {
+            width
+        } else {
+            crate::simd::widest()
+        };
         self
     }
 
@@ -199,6 +217,7 @@ impl Renderer {
             return Renderer::new(scene)
                 .with_lanes(self.lanes)
                 .with_light_culling(self.light_culling)
+                .with_lane_width(self.lane_width)
                 .render_frame(scene, camera, frame, out, display);
         }
         let fs = FrameSetup::new(scene, camera, frame);
@@ -439,6 +458,7 @@ impl Renderer {
             fragment::Paths {
                 lanes: self.lanes,
                 light_culling: self.light_culling,
+                lane_width: self.lane_width,
             },
         );
         if let Some(bg) = &mut data.env_bg {

@@ -34,7 +34,7 @@ use crate::scene::Material;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
-use crate::simd::{V3, clamp01};
+use crate::simd::{Lane, Mask, V3, clamp01};
 
 /// At most this many distinct texture sizes (and mip chains) among a lane
 /// material's maps: each fragment carries one filter footprint per size,
@@ -87,31 +87,38 @@ pub(super) struct PbrMaps<'a> {
     pub normal: Option<(Map<'a>, f32)>,
 }
 
-/// Four fragments of one material, one lane each, as `Surface` holds one.
-pub struct Lanes {
-    pub position: V3,
+/// The most lanes a call shades (`simd::F8`).
+pub const MAX_LANES: usize = 8;
+
+/// Fragments of one material, one per lane of `L`, as `Surface` holds
+/// one.
+pub struct Lanes<'p, L: Lane = Vec4> {
+    pub position: V3<L>,
     /// Unit interpolated normal, on the side the camera sees.
-    pub normal: V3,
+    pub normal: V3<L>,
     /// Texture coordinates (set 0).
-    pub u: Vec4,
-    pub v: Vec4,
+    pub u: L,
+    pub v: L,
     /// Interpolated tangent and its bitangent sign (when the material has
     /// a normal map).
-    pub tangent: V3,
-    pub sign: Vec4,
+    pub tangent: V3<L>,
+    pub sign: L,
     /// Vertex colour (RGB), where the mesh has one.
-    pub color: Option<V3>,
-    /// The triangles' plane normals (shadow lookups).
-    pub geo_normal: [Vec3; 4],
-    pub ao: Vec4,
-    /// Per texture size of the material (`LaneMaterial::footprints`).
-    pub footprints: [[Footprint; 4]; MAX_SIZES],
+    pub color: Option<V3<L>>,
+    /// The triangles' plane normals (shadow lookups), per lane (the
+    /// first `L::WIDTH`).
+    pub geo_normal: [Vec3; MAX_LANES],
+    pub ao: L,
+    /// Per texture size of the material (`LaneMaterial::footprints`), per
+    /// lane from lane `first`.
+    pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
+    pub first: usize,
     /// The lights that may reach some lane (the union of the lanes'
     /// tiles'); the others give every lane nothing.
     pub lights: LightMask,
 }
 
-impl Lanes {
+impl<L: Lane> Lanes<'_, L> {
     /// The frame's `lights` that may reach the lanes.
     #[inline(always)]
     pub fn light_set<'l>(&self, lights: &'l [Light]) -> LightSet<'l> {
@@ -119,6 +126,26 @@ impl Lanes {
             lights,
             mask: self.lights,
         }
+    }
+
+    /// Quad `q`'s footprints of slot `slot`.
+    #[inline(always)]
+    fn footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
+        let f = &self.footprints[slot][self.first..];
+        if L::WIDTH == 1 {
+            return [f[0]; 4];
+        }
+        [f[4 * q], f[4 * q + 1], f[4 * q + 2], f[4 * q + 3]]
+    }
+
+    /// Quad `q`'s plane normals.
+    #[inline(always)]
+    pub(super) fn geo_normal4(&self, q: usize) -> [Vec3; 4] {
+        let g = &self.geo_normal;
+        if L::WIDTH == 1 {
+            return [g[0]; 4];
+        }
+        [g[4 * q], g[4 * q + 1], g[4 * q + 2], g[4 * q + 3]]
     }
 }
 
@@ -287,9 +314,9 @@ impl<'a> ShadeContext<'a> {
         })
     }
 
-    /// Linear RGB of four fragments of `lm`'s material, lane by lane
-    /// `shade` of each (before its non-finite guard).
-    pub fn shade_lanes(&self, lm: &LaneMaterial<'a>, f: &Lanes) -> V3 {
+    /// Linear RGB of the fragments of `lm`'s material in `f`'s lanes,
+    /// lane by lane `shade` of each (before its non-finite guard).
+    pub fn shade_lanes<L: Lane>(&self, lm: &LaneMaterial<'a>, f: &Lanes<'_, L>) -> V3<L> {
         let mut lookups = Lookups::new(f);
         lm.kind
             .for_each_map(lm.material, |map| lookups.prefetch(map));
@@ -301,36 +328,39 @@ impl<'a> ShadeContext<'a> {
         }
     }
 
-    /// `apply_normal_map` of a tangent-space map whose four texels are
-    /// `c` (RGB).
-    pub(super) fn normal_map_lanes(&self, f: &Lanes, c: V3, scale: f32) -> V3 {
+    /// `apply_normal_map` of a tangent-space map whose texels are `c`
+    /// (RGB).
+    pub(super) fn normal_map_lanes<L: Lane>(
+        &self,
+        f: &Lanes<'_, L>,
+        c: V3<L>,
+        scale: f32,
+    ) -> V3<L> {
         let n = f.normal;
+        let (one, two) = (L::splat(1.0), L::splat(2.0));
         let c = V3 {
-            x: c.x * Vec4::splat(2.0) - Vec4::ONE,
-            y: c.y * Vec4::splat(2.0) - Vec4::ONE,
-            z: c.z * Vec4::splat(2.0) - Vec4::ONE,
+            x: c.x * two - one,
+            y: c.y * two - one,
+            z: c.z * two - one,
         };
         let t = f.tangent;
         let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
         let tt = if ok.all() {
             tt
         } else {
-            let mut fallback = [Vec3::ZERO; 4];
-            for (k, o) in fallback.iter_mut().enumerate() {
-                *o = n.lane(k).any_orthonormal_vector();
-            }
-            V3::select(ok, tt, V3::from_lanes(fallback))
+            let fallback = V3::from_fn(|k| n.lane(k).any_orthonormal_vector());
+            V3::select(ok, tt, fallback)
         };
-        let sign = Vec4::select(f.sign.cmplt(Vec4::ZERO), -Vec4::ONE, Vec4::ONE);
+        let sign = L::select(f.sign.cmplt(L::splat(0.0)), -one, one);
         let b = n.cross(tt).scale(sign);
-        let scale = Vec4::splat(scale);
+        let scale = L::splat(scale);
         let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
         mapped.normalize_or(n)
     }
 
-    /// The unit view vectors of four points (`view_vector`).
+    /// The unit view vectors of the points `p` (`view_vector`).
     #[inline(always)]
-    pub(super) fn view_lanes(&self, p: V3) -> V3 {
+    pub(super) fn view_lanes<L: Lane>(&self, p: V3<L>) -> V3<L> {
         if self.orthographic {
             V3::splat(-self.forward)
         } else {
@@ -338,21 +368,40 @@ impl<'a> ShadeContext<'a> {
         }
     }
 
-    /// Light `i`'s light on four points with unit normals `n`, as
+    /// Light `i`'s light on the lanes' points with unit normals `n`, as
     /// `for_each_lit` hands it on: the unit directions towards it, the
     /// irradiance times n.l times the shadow, and the lanes it lights.
     #[inline(always)]
-    pub(super) fn lit_lanes(&self, i: usize, light: &Light, f: &Lanes, n: V3) -> Lit {
+    pub(super) fn lit_lanes<L: Lane>(
+        &self,
+        i: usize,
+        light: &Light,
+        f: &Lanes<'_, L>,
+        n: V3<L>,
+    ) -> Lit<L> {
         let p = f.position;
-        let (l, e, reaches) = incidence4(light, p);
+        let (l, e, reaches) = incidence(light, p);
         let ndl = n.dot(l);
-        let mut lit = reaches & ndl.cmpgt(Vec4::ZERO);
-        let mut s = Vec4::ONE;
+        let mut lit = reaches & ndl.cmpgt(L::splat(0.0));
+        let mut s = L::splat(1.0);
         if light.shadows {
-            s = self
-                .shadows
-                .visibility4(i, p, &f.geo_normal, l, lit.bitmask());
-            lit &= s.cmpgt(Vec4::ZERO);
+            // Four lanes at a time.
+            let bits = lit.bitmask();
+            s = L::from_quads(|q| {
+                let quad = |v: V3<L>| V3 {
+                    x: v.x.quad(q),
+                    y: v.y.quad(q),
+                    z: v.z.quad(q),
+                };
+                let mask = if L::WIDTH == 1 {
+                    bits
+                } else {
+                    bits >> (4 * q) & 0xf
+                };
+                self.shadows
+                    .visibility4(i, quad(p), &f.geo_normal4(q), quad(l), mask)
+            });
+            lit = lit & s.cmpgt(L::splat(0.0));
         }
         Lit {
             l,
@@ -363,19 +412,21 @@ impl<'a> ShadeContext<'a> {
     }
 }
 
-/// A light's contribution at four points (`ShadeContext::lit_lanes`).
-pub(super) struct Lit {
-    pub l: V3,
-    pub ndl: Vec4,
+/// A light's contribution at the lanes' points
+/// (`ShadeContext::lit_lanes`).
+pub(super) struct Lit<L: Lane> {
+    pub l: V3<L>,
+    pub ndl: L,
     /// Irradiance times n.l times the shadow.
-    pub e: V3,
-    pub lit: glam::BVec4A,
+    pub e: V3<L>,
+    pub lit: L::Mask,
 }
 
-/// `incidence(light, p)` at four points: direction, irradiance (before
-/// n.l) and the lanes it reaches.
+/// `light::incidence(light, p)` at each lane's point: direction,
+/// irradiance (before n.l) and the lanes it reaches.
 #[inline(always)]
-fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
+fn incidence<L: Lane>(light: &Light, p: V3<L>) -> (V3<L>, V3<L>, L::Mask) {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
     let position = match light.kind {
         LightKind::Directional {
             direction,
@@ -384,7 +435,7 @@ fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
             return (
                 V3::splat(-direction),
                 V3::splat(light.color * irradiance),
-                Vec4::ONE.cmpgt(Vec4::ZERO),
+                one.cmpgt(zero),
             );
         }
         LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
@@ -393,16 +444,16 @@ fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
     let d = V3::splat(position) - p;
     let r2 = d.dot(d);
     let l = d / r2.sqrt();
-    let mut reaches = !r2.cmple(Vec4::ZERO);
+    let mut reaches = !r2.cmple(zero);
     // `window`: 1 without a range.
     let w = match light.range {
         Some(range) if range > 0.0 => {
-            let q = r2 / Vec4::splat(range * range);
-            let w = clamp01(Vec4::ONE - q * q);
-            reaches &= !w.cmple(Vec4::ZERO);
+            let q = r2 / L::splat(range * range);
+            let w = clamp01(one - q * q);
+            reaches = reaches & !w.cmple(zero);
             w * w
         }
-        _ => Vec4::ONE,
+        _ => one,
     };
     let k = match light.kind {
         LightKind::Spot {
@@ -416,70 +467,90 @@ fn incidence4(light: &Light, p: V3) -> (V3, V3, glam::BVec4A) {
             let cos_a = -l.dot(V3::splat(direction));
             let span = cos_inner - cos_outer;
             let f = if span <= 1e-7 {
-                Vec4::select(cos_a.cmpge(Vec4::splat(cos_outer)), Vec4::ONE, Vec4::ZERO)
+                L::select(cos_a.cmpge(L::splat(cos_outer)), one, zero)
             } else {
-                let t = clamp01((cos_a - Vec4::splat(cos_outer)) / Vec4::splat(span));
+                let t = clamp01((cos_a - L::splat(cos_outer)) / L::splat(span));
                 t * t
             };
-            reaches &= !f.cmple(Vec4::ZERO);
-            Vec4::splat(intensity) * f * w / r2
+            reaches = reaches & !f.cmple(zero);
+            L::splat(intensity) * f * w / r2
         }
-        LightKind::Point { intensity, .. } => Vec4::splat(intensity) * w / r2,
-        LightKind::Directional { .. } => Vec4::ZERO,
+        LightKind::Point { intensity, .. } => L::splat(intensity) * w / r2,
+        LightKind::Directional { .. } => zero,
     };
     (l, V3::splat(light.color).scale(k), reaches)
 }
 
 /// The texture lookups of one lane call: where each footprint slot's
-/// lookups fall, found once for all its maps (`Texture::taps4`).
-pub(super) struct Lookups<'f> {
-    f: &'f Lanes,
-    /// Per slot, once found (bit k of `found` for slot k): where its
-    /// lookups fall, or None where some lane takes anisotropic probes.
-    taps: [Option<Taps4>; MAX_SIZES],
+/// lookups fall, found once for all its maps (`Texture::taps4`), four
+/// lanes at a time.
+pub(super) struct Lookups<'f, 'p, L: Lane> {
+    f: &'f Lanes<'p, L>,
+    /// Per quad and slot, once found (bit k of `found` for slot k): where
+    /// its lookups fall, or None where some lane takes anisotropic probes.
+    taps: [[Option<Taps4>; MAX_SIZES]; 2],
     found: u32,
 }
 
-impl<'f> Lookups<'f> {
-    fn new(f: &'f Lanes) -> Lookups<'f> {
+impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
+    fn new(f: &'f Lanes<'p, L>) -> Lookups<'f, 'p, L> {
         Lookups {
             f,
-            taps: [None, None, None],
+            taps: [[None, None, None], [None, None, None]],
             found: 0,
         }
     }
 
-    /// Where the lanes' lookups of `map` fall (found once per slot).
+    /// Finds where the lanes' lookups of `map` fall (once per slot).
     #[inline(always)]
-    fn taps(&mut self, map: &Map) -> &Option<Taps4> {
+    fn find(&mut self, map: &Map) {
         let (f, s) = (self.f, map.slot);
         if self.found & (1 << s) == 0 {
             self.found |= 1 << s;
-            map.chain
-                .taps4_into(f.u, f.v, &f.footprints[s], &mut self.taps[s]);
+            for q in 0..L::QUADS {
+                map.chain.taps4_into(
+                    f.u.quad(q),
+                    f.v.quad(q),
+                    &f.footprints4(s, q),
+                    &mut self.taps[q][s],
+                );
+            }
         }
-        &self.taps[s]
     }
 
     /// Starts loading the texels `read(map)` will read.
     #[inline]
     pub fn prefetch(&mut self, map: &Map) {
-        if let Some(t) = self.taps(map) {
-            map.chain.prefetch(t);
+        self.find(map);
+        for q in 0..L::QUADS {
+            if let Some(t) = &self.taps[q][map.slot] {
+                map.chain.prefetch(t);
+            }
         }
     }
 
-    /// `map`'s red, green and blue at the four lanes.
+    /// `map`'s red, green and blue at the lanes.
     #[inline]
-    pub fn read(&mut self, map: &Map) -> V3 {
+    pub fn read(&mut self, map: &Map) -> V3<L> {
+        self.find(map);
         let f = self.f;
-        let [r, g, b] = match self.taps(map) {
-            Some(t) => map.chain.read4(t, map.mode),
-            None => map
-                .chain
-                .sample4(f.u, f.v, &f.footprints[map.slot], map.mode),
-        };
-        V3 { x: r, y: g, z: b }
+        let mut rgb = [[Vec4::ZERO; 3]; 2];
+        for (q, out) in rgb.iter_mut().enumerate().take(L::QUADS) {
+            *out = match &self.taps[q][map.slot] {
+                Some(t) => map.chain.read4(t, map.mode),
+                None => map.chain.sample4(
+                    f.u.quad(q),
+                    f.v.quad(q),
+                    &f.footprints4(map.slot, q),
+                    map.mode,
+                ),
+            };
+        }
+        V3 {
+            x: L::from_quads(|q| rgb[q][0]),
+            y: L::from_quads(|q| rgb[q][1]),
+            z: L::from_quads(|q| rgb[q][2]),
+        }
     }
 }
 

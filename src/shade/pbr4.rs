@@ -7,19 +7,16 @@
 //! Exponentials, the environment's BRDF table and its prefiltered levels
 //! (whose roughness differs from lane to lane) are looked up per lane.
 
-// Loops over the four lanes index several per-lane arrays at once.
-#![allow(clippy::needless_range_loop)]
-
 use std::f32::consts::PI;
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 
 use super::ShadeContext;
-use super::env::{EnvLight, dominant_direction4};
-use super::lanes::{Kind, Lanes, Lit, Lookups, MapSet, PbrMaps, same_lookup};
+use super::env::{EnvLight, dominant_direction_lanes};
+use super::lanes::{Kind, Lanes, Lit, Lookups, MAX_LANES, MapSet, PbrMaps, same_lookup};
 use super::pbr::{MIN_ALPHA, specular_occlusion};
 use crate::scene::Material;
-use crate::simd::{V3, clamp01};
+use crate::simd::{Lane, Mask, V3, clamp01};
 
 impl<'a> Kind<'a> {
     /// A metallic-roughness material's maps, or None where the lanes do
@@ -62,33 +59,35 @@ impl<'a> Kind<'a> {
 
 /// `x.powi(5)` per lane: x (x^2 x^2), the products LLVM makes of it.
 #[inline(always)]
-fn pow5(x: Vec4) -> Vec4 {
+fn pow5<L: Lane>(x: L) -> L {
     let x2 = x * x;
     x * (x2 * x2)
 }
 
-/// Four metallic-roughness points, as `PbrColor` holds one (without the
-/// layers the lanes do not take).
-struct Color4 {
-    roughness: Vec4,
-    occlusion: Vec4,
+/// Metallic-roughness points, one per lane, as `PbrColor` holds one
+/// (without the layers the lanes do not take).
+struct Color<L: Lane> {
+    roughness: L,
+    occlusion: L,
     /// `PbrColor::f0` and `c_diff`.
-    f0: V3,
-    c_diff: V3,
+    f0: V3<L>,
+    c_diff: V3<L>,
     /// alpha^2 of the GGX lobe.
-    a2: Vec4,
+    a2: L,
 }
 
 impl<'a> ShadeContext<'a> {
-    /// `shade` of four fragments of pbr material `m` with maps `maps`.
-    pub(super) fn pbr_lanes(
+    /// `shade` of the lanes' fragments of pbr material `m` with maps
+    /// `maps`.
+    pub(super) fn pbr_lanes<L: Lane>(
         &self,
         m: &Material,
         maps: &PbrMaps<'a>,
-        lookups: &mut Lookups,
-        f: &Lanes,
-    ) -> V3 {
+        lookups: &mut Lookups<'_, '_, L>,
+        f: &Lanes<'_, L>,
+    ) -> V3<L> {
         let p = &m.pbr;
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
         // `pbr_color`.
         let mut base = V3::splat(p.base_color.truncate());
         if let Some(map) = &maps.base {
@@ -102,11 +101,8 @@ impl<'a> ShadeContext<'a> {
             .as_ref()
             .map(|map| lookups.read(map));
         let (roughness, metallic) = match mr {
-            Some(mr) => (
-                Vec4::splat(p.roughness) * mr.y,
-                Vec4::splat(p.metallic) * mr.z,
-            ),
-            None => (Vec4::splat(p.roughness), Vec4::splat(p.metallic)),
+            Some(mr) => (L::splat(p.roughness) * mr.y, L::splat(p.metallic) * mr.z),
+            None => (L::splat(p.roughness), L::splat(p.metallic)),
         };
         let occlusion = match &maps.occlusion {
             Some(map) => {
@@ -114,12 +110,12 @@ impl<'a> ShadeContext<'a> {
                     (Some(other), Some(mr)) if same_lookup(map, other) => mr,
                     _ => lookups.read(map),
                 };
-                Vec4::ONE + Vec4::splat(p.occlusion_strength) * (o.x - Vec4::ONE)
+                one + L::splat(p.occlusion_strength) * (o.x - one)
             }
-            None => Vec4::ONE,
+            None => one,
         };
         let emissive = if p.emissive == Vec3::ZERO {
-            V3::ZERO
+            V3::zero()
         } else {
             let e = V3::splat(p.emissive);
             match &maps.emissive {
@@ -128,9 +124,9 @@ impl<'a> ShadeContext<'a> {
             }
         };
         let (metallic, roughness) = (clamp01(metallic), clamp01(roughness));
-        let alpha = (roughness * roughness).max(Vec4::splat(MIN_ALPHA));
-        let keep = Vec4::ONE - metallic;
-        let c = Color4 {
+        let alpha = (roughness * roughness).max(L::splat(MIN_ALPHA));
+        let keep = one - metallic;
+        let c = Color {
             roughness,
             occlusion,
             // `Vec3::lerp`: 0.04 (1 - metallic) + base metallic.
@@ -149,57 +145,51 @@ impl<'a> ShadeContext<'a> {
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
-                let added = out + e * brdf4(n, v, l, ndl, &c);
+                let added = out + e * brdf(n, v, l, ndl, &c);
                 out = V3::select(lit, added, out);
             }
         });
         let ambient = V3::splat(self.ambient).scale(f.ao);
-        let some_ambient = !(ambient.x.cmpeq(Vec4::ZERO)
-            & ambient.y.cmpeq(Vec4::ZERO)
-            & ambient.z.cmpeq(Vec4::ZERO));
+        let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
         if some_ambient.any() {
-            let (a, b) = env_brdf4(c.roughness, n.dot(v).abs());
+            let (a, b) = env_brdf(c.roughness, n.dot(v).abs());
             let spec = split_sum(&c, a, b);
             let spec = V3 {
                 x: clamp01(spec.x),
                 y: clamp01(spec.y),
                 z: clamp01(spec.z),
             };
-            let one = V3::splat(Vec3::ONE);
-            let added = out + ambient.scale(c.occlusion) * (c.c_diff * (one - spec) + spec);
+            let ones = V3::splat(Vec3::ONE);
+            let added = out + ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
             out = V3::select(some_ambient, added, out);
         }
         match self.env {
-            Some(env) => out + environment4(env, n, v, &c, f.ao),
+            Some(env) => out + environment(env, n, v, &c, f.ao),
             None => out,
         }
     }
 }
 
-/// `pbr::brdf` at four points, for unit light directions `l` with
+/// `pbr::brdf` at the lanes' points, for unit light directions `l` with
 /// n.l = `ndl` > 0.
 #[inline(always)]
-fn brdf4(n: V3, v: V3, l: V3, ndl: Vec4, c: &Color4) -> V3 {
-    let h = (l + v).normalize_or(V3::ZERO);
+fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &Color<L>) -> V3<L> {
+    let h = (l + v).normalize_or(V3::zero());
     let vdh = v.dot(h).abs();
     let one = V3::splat(Vec3::ONE);
     // F90 = 1 without a dielectric specular.
-    let fresnel = c.f0 + (one - c.f0).scale(pow5(Vec4::ONE - vdh));
-    (one - fresnel) * c.c_diff / Vec4::splat(PI) + fresnel.scale(d_vis4(n, v, h, ndl, c.a2))
+    let fresnel = c.f0 + (one - c.f0).scale(pow5(L::splat(1.0) - vdh));
+    (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(d_vis(n, v, h, ndl, c.a2))
 }
 
 /// `pbr::d_vis`, with the half vector `h` it computes.
 #[inline(always)]
-fn d_vis4(n: V3, v: V3, h: V3, ndl: Vec4, a2: Vec4) -> Vec4 {
-    let one = Vec4::ONE;
-    let ndv = n.dot(v).abs().max(Vec4::splat(1e-4));
+fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let ndv = n.dot(v).abs().max(L::splat(1e-4));
     let ndh = n.dot(h);
     let t = ndh * ndh * (a2 - one) + one;
-    let d = Vec4::select(
-        ndh.cmpgt(Vec4::ZERO),
-        a2 / (Vec4::splat(PI) * t * t),
-        Vec4::ZERO,
-    );
+    let d = L::select(ndh.cmpgt(zero), a2 / (L::splat(PI) * t * t), zero);
     let vis = one
         / ((ndl + (a2 + (one - a2) * ndl * ndl).sqrt())
             * (ndv + (a2 + (one - a2) * ndv * ndv).sqrt()));
@@ -208,59 +198,55 @@ fn d_vis4(n: V3, v: V3, h: V3, ndl: Vec4, a2: Vec4) -> Vec4 {
 
 /// `PbrColor::split_sum` without a film: f0 a + b (F90 1).
 #[inline(always)]
-fn split_sum(c: &Color4, a: Vec4, b: Vec4) -> V3 {
-    let b = b * Vec4::ONE;
+fn split_sum<L: Lane>(c: &Color<L>, a: L, b: L) -> V3<L> {
+    let b = b * L::splat(1.0);
     c.f0.scale(a) + V3 { x: b, y: b, z: b }
 }
 
-/// `pbr::env_brdf` (the analytic fit) at four points.
+/// `pbr::env_brdf` (the analytic fit) at the lanes' points.
 #[inline(always)]
-fn env_brdf4(roughness: Vec4, ndv: Vec4) -> (Vec4, Vec4) {
+fn env_brdf<L: Lane>(roughness: L, ndv: L) -> (L, L) {
     let r = clamp01(roughness);
-    let k = Vec4::splat;
+    let k = L::splat;
     let (x, y, z, w) = (
         -r + k(1.0),
         k(-0.0275) * r + k(0.0425),
         k(-0.572) * r + k(1.04),
         k(0.022) * r - k(0.04),
     );
-    let mut e = [0.0f32; 4];
-    for j in 0..4 {
-        e[j] = (-9.28 * ndv[j].max(0.0)).exp2();
-    }
-    let a004 = (x * x).min(Vec4::from(e)) * x + y;
+    let e = ndv.map(|n| (-9.28 * n.max(0.0)).exp2());
+    let a004 = (x * x).min(e) * x + y;
     (k(-1.04) * a004 + z, k(1.04) * a004 + w)
 }
 
-/// `pbr::environment` at four points (no sheen, clearcoat or
-/// transmission: the lanes never see them).
-fn environment4(env: &EnvLight, n: V3, v: V3, c: &Color4, ao: Vec4) -> V3 {
-    let ndv = n.dot(v).abs().max(Vec4::splat(1e-4));
-    let (mut a, mut b) = ([0.0f32; 4], [0.0f32; 4]);
-    for k in 0..4 {
-        let ab = env.brdf(ndv[k], c.roughness[k]);
+/// `pbr::environment` at the lanes' points (no sheen, clearcoat or
+/// iridescence).
+#[inline(always)]
+fn environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &Color<L>, ao: L) -> V3<L> {
+    let ndv = n.dot(v).abs().max(L::splat(1e-4));
+    let (mut a, mut b) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
+    for k in 0..L::WIDTH {
+        let ab = env.brdf(ndv.lane(k), c.roughness.lane(k));
         (a[k], b[k]) = (ab.x, ab.y);
     }
-    let spec = split_sum(c, Vec4::from(a), Vec4::from(b));
+    let spec = split_sum(c, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
     let one = V3::splat(Vec3::ONE);
-    let diffuse = (c.c_diff * (one - spec) * env.irradiance4(n)).scale(ao / Vec4::splat(PI));
-    let r = n.scale(Vec4::splat(2.0) * n.dot(v)) - v;
-    let r = dominant_direction4(n, r, c.roughness);
-    let mut light = [Vec3::ZERO; 4];
-    let mut so = [0.0f32; 4];
-    for k in 0..4 {
-        light[k] = env.prefiltered(r.lane(k), c.roughness[k]);
-        so[k] = specular_occlusion(ndv[k], ao[k], c.roughness[k]);
-    }
-    let specular = (V3::from_lanes(light) * spec).scale(Vec4::from(so));
+    let diffuse = (c.c_diff * (one - spec) * env.irradiance_lanes(n)).scale(ao / L::splat(PI));
+    let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
+    let r = dominant_direction_lanes(n, r, c.roughness);
+    let light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
+    let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
+    let specular = (light * spec).scale(so);
     (diffuse + specular).scale(c.occlusion)
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::shade::pbr::{self, PbrColor};
     use crate::testing::xorshift;
+    use glam::Vec4;
 
     #[test]
     fn pow5_is_powi_bit_for_bit() {
@@ -318,7 +304,7 @@ mod tests {
             let base = at(|x| x.3.base);
             let alpha = (roughness * roughness).max(Vec4::splat(MIN_ALPHA));
             let keep = Vec4::ONE - metallic;
-            let c = Color4 {
+            let c = Color {
                 roughness,
                 occlusion: Vec4::ONE,
                 f0: V3::splat(Vec3::splat(0.04)).scale(keep) + base.scale(metallic),
@@ -326,8 +312,8 @@ mod tests {
                 a2: alpha * alpha,
             };
             let ndl = n.dot(l);
-            let got = brdf4(n, v, l, ndl, &c);
-            let (a, b) = env_brdf4(roughness, n.dot(v).abs());
+            let got = brdf(n, v, l, ndl, &c);
+            let (a, b) = env_brdf(roughness, n.dot(v).abs());
             let albedo = split_sum(&c, a, b);
             for k in 0..4 {
                 let (n, v, l, color) = &lanes[k];

@@ -22,12 +22,11 @@ use rayon::prelude::*;
 
 use crate::assets::environment::EnvImage;
 
-mod lanes;
 mod octahedral;
 
 use octahedral::Octahedral;
 
-pub use lanes::dominant_direction4;
+use crate::simd::{Lane, V3};
 
 /// Prefiltered roughness levels: 0, 0.1, ..., 1 (0.2 apart blurred the
 /// highlights of roughness 0.1 against Mitsuba: mean FLIP of that sphere
@@ -62,24 +61,47 @@ struct Equirect {
 }
 
 impl Equirect {
-    /// Bilinear lookup, wrapping in u and clamping in v.
-    fn sample(&self, d: Vec3) -> Vec3 {
-        Vec3::from(self.sample_uv(direction_to_uv(d)))
-    }
-
-    /// Bilinear lookup at image coordinates `uv` (u in [0, 1] as
+    /// Bilinear lookup at image coordinates (u, v) (u in [0, 1] as
     /// `direction_to_uv` gives it; any finite u wraps).
     #[inline]
-    fn sample_uv(&self, uv: Vec2) -> Vec3A {
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
-        // floor without a library call: truncate, then step down where
-        // truncation went up (negative non-integers).
-        let xt = x as i64;
-        let x0 = if (xt as f32) > x { xt - 1 } else { xt };
-        let y0 = y as usize; // y >= 0: truncation is floor
-        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        self.blend(x0, y0, fx, fy)
+    fn sample_uv(&self, u: f32, v: f32) -> Vec3A {
+        let (x0, y0, fx, fy) = self.place(u, v);
+        self.blend(x0.lane(0) as i64, y0.lane(0) as usize, fx, fy)
+    }
+
+    /// Where bilinear lookups at (u, v) read, per lane: the top-left
+    /// texel's column (any: it wraps) and row, and the weights toward
+    /// the next ones.
+    #[inline(always)]
+    fn place<L: Lane>(&self, u: L, v: L) -> (L, L, L, L) {
+        let x = u * L::splat(self.width as f32) - L::splat(0.5);
+        let y = (v * L::splat(self.height as f32) - L::splat(0.5))
+            .max(L::splat(0.0))
+            .min(L::splat((self.height - 1) as f32));
+        let (x0, y0) = (x.floor(), y.floor());
+        (x0, y0, x - x0, y - y0)
+    }
+
+    /// `sample_uv` per lane of (u, v), times `scale`, lerped toward
+    /// `next`'s lookups by `f` where `f` > 0.
+    #[inline(always)]
+    fn sample_lanes<L: Lane>(&self, next: &Equirect, u: L, v: L, f: f32, scale: f32) -> V3<L> {
+        let (x0, y0, fx, fy) = self.place(u, v);
+        // Finite: u and v come from `direction_to_uv` (in [0, 1]) and y
+        // is clamped; `as` saturates in any case.
+        let at = |e: &Equirect, (x0, y0, fx, fy): (L, L, L, L), k: usize| {
+            e.blend(
+                x0.lane(k) as i64,
+                y0.lane(k) as usize,
+                fx.lane(k),
+                fy.lane(k),
+            )
+        };
+        if f <= 0.0 {
+            return V3::from_fn(|k| Vec3::from(at(self, (x0, y0, fx, fy), k) * scale));
+        }
+        let p = next.place(u, v);
+        V3::from_fn(|k| Vec3::from(at(self, (x0, y0, fx, fy), k).lerp(at(next, p, k), f) * scale))
     }
 
     /// The bilinear blend of the texels at column `x0` (any: it wraps) and
@@ -142,15 +164,22 @@ impl Equirect {
 /// `d` need not be unit length (zero or non-finite reads as +Y).
 #[inline]
 pub fn direction_to_uv(d: Vec3) -> Vec2 {
-    if !d.is_finite() {
-        return Vec2::new(0.5, 0.0);
-    }
+    let (u, v) = direction_to_uv_lanes(V3::<f32>::from(d));
+    Vec2::new(u, v)
+}
+
+/// `direction_to_uv` per lane: (u, v).
+#[inline(always)]
+fn direction_to_uv_lanes<L: Lane>(d: V3<L>) -> (L, L) {
     // acos(y / |d|) = atan2(|(x, z)|, y): both angles are ratios, so no
     // normalization is needed, and the second is exact near the poles.
     let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-    Vec2::new(
-        0.5 + atan2(d.x, -d.z) * (0.5 / PI),
-        atan2(horizontal, d.y) * (1.0 / PI),
+    let u = L::splat(0.5) + atan2(d.x, -d.z) * L::splat(0.5 / PI);
+    let v = atan2(horizontal, d.y) * L::splat(1.0 / PI);
+    let finite = d.is_finite_mask();
+    (
+        L::select(finite, u, L::splat(0.5)),
+        L::select(finite, v, L::splat(0.0)),
     )
 }
 
@@ -165,34 +194,28 @@ const ATAN_C: [f32; 7] = [
     0.006_811_782,
 ];
 
-/// atan2(y, x) to within 6e-7 radians (f32 rounding included) (libm's is a call and several times
-/// slower; a thousandth of a texel of a 2048-wide image is 3e-6 rad).
-/// Odd polynomial of degree 13 for atan on [0, 1], fitted to minimize the
-/// largest error, then folded into the four quadrants.
-#[inline]
-fn atan2(y: f32, x: f32) -> f32 {
-    if x.is_nan() || y.is_nan() {
-        return f32::NAN;
-    }
+/// atan2(y, x) per lane, to within 6e-7 radians (f32 rounding included)
+/// (libm's is a call and several times slower; a thousandth of a texel
+/// of a 2048-wide image is 3e-6 rad). Odd polynomial of degree 13 for
+/// atan on [0, 1], fitted to minimize the largest error, then folded
+/// into the four quadrants.
+#[inline(always)]
+fn atan2<L: Lane>(y: L, x: L) -> L {
+    let zero = L::splat(0.0);
     let (ax, ay) = (x.abs(), y.abs());
     let (lo, hi) = (ax.min(ay), ax.max(ay));
-    if hi == 0.0 {
-        return 0.0;
-    }
     let a = lo / hi;
     let s = a * a;
-    let mut p = ATAN_C[6];
+    let mut p = L::splat(ATAN_C[6]);
     for &c in ATAN_C[..6].iter().rev() {
-        p = p * s + c;
+        p = p * s + L::splat(c);
     }
     let mut r = p * a;
-    if ay > ax {
-        r = std::f32::consts::FRAC_PI_2 - r;
-    }
-    if x < 0.0 {
-        r = PI - r;
-    }
-    if y < 0.0 { -r } else { r }
+    r = L::select(ay.cmpgt(ax), L::splat(std::f32::consts::FRAC_PI_2) - r, r);
+    r = L::select(x.cmplt(zero), L::splat(PI) - r, r);
+    r = L::select(y.cmplt(zero), -r, r);
+    r = L::select(hi.cmpeq(zero), zero, r);
+    L::select(x.is_nan() | y.is_nan(), L::splat(f32::NAN), r)
 }
 
 /// The direction at image coordinates `uv` (the inverse of
@@ -310,22 +333,32 @@ impl EnvLight {
     /// `prefiltered` for a Blinn-Phong material of perceptual `roughness`:
     /// from its blended level where `with_phong_roughness` made one.
     pub fn prefiltered_phong(&self, r: Vec3, roughness: f32) -> Vec3 {
+        self.prefiltered_phong_lanes(V3::<f32>::from(r), roughness)
+            .into()
+    }
+
+    /// `prefiltered_phong` per lane, for one roughness.
+    #[inline]
+    pub fn prefiltered_phong_lanes<L: Lane>(&self, r: V3<L>, roughness: f32) -> V3<L> {
         match self.phong_level(roughness) {
-            Some(level) => Vec3::from(level.sample(self.to_env(r)) * self.intensity),
-            None => self.prefiltered(r, roughness),
+            Some(level) => {
+                let (u, v) = octahedral::encode(self.to_env(r));
+                V3::from_fn(|k| Vec3::from(level.at(u.lane(k), v.lane(k)) * self.intensity))
+            }
+            None => self.prefiltered_lanes(r, roughness),
         }
     }
 
     /// The two prefiltered levels around `roughness`, blended, along
     /// environment direction `d` (without the intensity).
     fn level_blend(&self, d: Vec3, roughness: f32) -> Vec3A {
-        let uv = direction_to_uv(d);
+        let (u, v) = direction_to_uv_lanes(V3::<f32>::from(d));
         let (k, f) = level_of(roughness);
-        let a = self.levels[k].sample_uv(uv);
+        let a = self.levels[k].sample_uv(u, v);
         if f <= 0.0 {
             return a;
         }
-        a.lerp(self.levels[k + 1].sample_uv(uv), f)
+        a.lerp(self.levels[k + 1].sample_uv(u, v), f)
     }
 
     fn phong_level(&self, roughness: f32) -> Option<&Octahedral> {
@@ -333,41 +366,53 @@ impl EnvLight {
         self.phong.iter().find(|(b, _)| *b == bits).map(|(_, l)| l)
     }
 
-    /// World direction `d` in the environment's frame.
-    #[inline]
-    fn to_env(&self, d: Vec3) -> Vec3 {
+    /// World directions `d` in the environment's frame (`Mat3 * Vec3`'s
+    /// sum, lane by lane).
+    #[inline(always)]
+    fn to_env<L: Lane>(&self, d: V3<L>) -> V3<L> {
         match &self.env_from_world {
-            Some(m) => *m * d,
+            Some(m) => {
+                let col = |c: Vec3, s: L| V3::splat(c).scale(s);
+                col(m.x_axis, d.x) + col(m.y_axis, d.y) + col(m.z_axis, d.z)
+            }
             None => d,
         }
     }
 
     /// Irradiance on a surface with unit normal `n` (world space).
     pub fn irradiance(&self, n: Vec3) -> Vec3 {
-        let y = sh_basis(self.to_env(n));
-        let mut e = Vec3::ZERO;
-        for (c, b) in self.sh.iter().zip(y) {
-            e += *c * b;
+        self.irradiance_lanes(V3::<f32>::from(n)).into()
+    }
+
+    /// `irradiance` at each lane's unit normal.
+    #[inline]
+    pub fn irradiance_lanes<L: Lane>(&self, n: V3<L>) -> V3<L> {
+        let d = self.to_env(n);
+        let mut e = V3::zero();
+        for (sh, b) in self.sh.iter().zip(sh_basis(d)) {
+            e = e + V3::splat(*sh).scale(b);
         }
-        e.max(Vec3::ZERO) * self.intensity
+        e.max(V3::zero()).scale(L::splat(self.intensity))
     }
 
     /// Radiance arriving from direction `d` (world space), unfiltered.
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        self.levels[0].sample(self.to_env(d)) * self.intensity
+        let (u, v) = direction_to_uv_lanes(self.to_env(V3::<f32>::from(d)));
+        Vec3::from(self.levels[0].sample_uv(u, v)) * self.intensity
     }
 
     /// Radiance along reflection direction `r` (world space), prefiltered
     /// for perceptual `roughness`.
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {
-        let uv = direction_to_uv(self.to_env(r));
+        self.prefiltered_lanes(V3::<f32>::from(r), roughness).into()
+    }
+
+    /// `prefiltered` along each lane's direction, for one roughness.
+    #[inline]
+    pub fn prefiltered_lanes<L: Lane>(&self, r: V3<L>, roughness: f32) -> V3<L> {
+        let (u, v) = direction_to_uv_lanes(self.to_env(r));
         let (k, f) = level_of(roughness);
-        let a = self.levels[k].sample_uv(uv);
-        if f <= 0.0 {
-            return Vec3::from(a * self.intensity);
-        }
-        let b = self.levels[k + 1].sample_uv(uv);
-        Vec3::from(a.lerp(b, f) * self.intensity)
+        self.levels[k].sample_lanes(&self.levels[k + 1], u, v, f, self.intensity)
     }
 
     /// The split sum's (scale, bias) of f0 for `n.v` and `roughness`.
@@ -399,24 +444,35 @@ fn level_of(roughness: f32) -> (usize, f32) {
 /// sum's n = v = r prefilter does not see (Lagarde and de Rousiers 2014,
 /// "Moving Frostbite to PBR", the dominant direction).
 pub fn dominant_direction(n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
-    let a = roughness * roughness;
-    let f = (1.0 - a) * ((1.0 - a).sqrt() + a);
-    n.lerp(r, f).normalize_or(r)
+    dominant_direction_lanes(V3::<f32>::from(n), V3::from(r), roughness).into()
 }
 
-/// The real SH basis, bands 0-2, at unit direction `d`.
-fn sh_basis(d: Vec3) -> [f32; 9] {
+/// `dominant_direction` per lane, each with its roughness.
+#[inline(always)]
+pub fn dominant_direction_lanes<L: Lane>(n: V3<L>, r: V3<L>, roughness: L) -> V3<L> {
+    let one = L::splat(1.0);
+    let a = roughness * roughness;
+    let f = (one - a) * ((one - a).sqrt() + a);
+    // `Vec3::lerp`: n (1 - f) + r f.
+    let l = n.scale(one - f) + r.scale(f);
+    l.normalize_or(r)
+}
+
+/// The real SH basis, bands 0-2, at unit directions `d`.
+#[inline(always)]
+fn sh_basis<L: Lane>(d: V3<L>) -> [L; 9] {
     let (x, y, z) = (d.x, d.y, d.z);
+    let c = |k: f32| L::splat(k);
     [
-        0.282_095,
-        0.488_603 * y,
-        0.488_603 * z,
-        0.488_603 * x,
-        1.092_548 * x * y,
-        1.092_548 * y * z,
-        0.315_392 * (3.0 * z * z - 1.0),
-        1.092_548 * x * z,
-        0.546_274 * (x * x - y * y),
+        c(0.282_095),
+        c(0.488_603) * y,
+        c(0.488_603) * z,
+        c(0.488_603) * x,
+        c(1.092_548) * x * y,
+        c(1.092_548) * y * z,
+        c(0.315_392) * (c(3.0) * z * z - c(1.0)),
+        c(1.092_548) * x * z,
+        c(0.546_274) * (x * x - y * y),
     ]
 }
 
@@ -433,7 +489,7 @@ fn irradiance_sh(img: &Equirect) -> [Vec3; 9] {
                     (x as f32 + 0.5) / img.width as f32,
                     (y as f32 + 0.5) / img.height as f32,
                 );
-                let b = sh_basis(uv_to_direction(uv));
+                let b = sh_basis(V3::<f32>::from(uv_to_direction(uv)));
                 let l = Vec3::from(img.texels[y * img.width + x]) * dw;
                 for (a, bi) in acc.iter_mut().zip(b) {
                     *a += l * bi;
@@ -528,7 +584,9 @@ fn prefilter(chain: &[Equirect], roughness: f32, width: usize) -> Equirect {
                     let k1 = (k + 1).min(chain.len() - 1);
                     let f = (lod - k as f32).clamp(0.0, 1.0);
                     let uv = direction_to_uv(m * l);
-                    let c = chain[k].sample_uv(uv).lerp(chain[k1].sample_uv(uv), f);
+                    let c = chain[k]
+                        .sample_uv(uv.x, uv.y)
+                        .lerp(chain[k1].sample_uv(uv.x, uv.y), f);
                     acc += c * l.z;
                     weight += l.z;
                 }
@@ -585,6 +643,8 @@ fn brdf_lut() -> Vec<Vec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::F8;
+    use glam::Vec4;
 
     #[test]
     fn the_polynomial_atan2_is_within_0_6_microradians_of_f64() {
@@ -619,15 +679,15 @@ mod tests {
                 .collect(),
         };
         // u = 0: halfway between the last column and the first.
-        let v = img.sample_uv(Vec2::new(0.0, 0.25));
+        let v = img.sample_uv(0.0, 0.25);
         assert!((v.x - 1.5).abs() < 1e-6, "{v}");
         // u = 1 wraps to the same place.
-        assert!((img.sample_uv(Vec2::new(1.0, 0.25)).x - 1.5).abs() < 1e-6);
+        assert!((img.sample_uv(1.0, 0.25).x - 1.5).abs() < 1e-6);
         // Texel centres read their own texel; v clamps at the edges.
-        assert!((img.sample_uv(Vec2::new(0.375, 0.0)).x - 1.0).abs() < 1e-6);
-        assert!((img.sample_uv(Vec2::new(0.375, 1.0)).x - 11.0).abs() < 1e-6);
+        assert!((img.sample_uv(0.375, 0.0).x - 1.0).abs() < 1e-6);
+        assert!((img.sample_uv(0.375, 1.0).x - 11.0).abs() < 1e-6);
         // Far outside [0, 1] in u still wraps.
-        assert!((img.sample_uv(Vec2::new(3.0, 0.25)).x - 1.5).abs() < 1e-5);
+        assert!((img.sample_uv(3.0, 0.25).x - 1.5).abs() < 1e-5);
     }
 
     #[test]
@@ -713,5 +773,154 @@ mod tests {
         let r = EnvLight::new(&img, 1.0, 90.0);
         assert!(r.radiance(-Vec3::X).x > 0.9, "{}", r.radiance(-Vec3::X));
         assert!(r.radiance(-Vec3::Z).x < 0.1);
+    }
+
+    /// Directions of every kind: random, on the axes and the poles, signed
+    /// zeros, tiny, huge, infinite and NaN components.
+    fn directions() -> Vec<Vec3> {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut out: Vec<Vec3> = (0..20_000)
+            .map(|_| Vec3::new(next(), next(), next()))
+            .collect();
+        let odd = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            1e-30,
+            -3e-39,
+            3e38,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        for &x in &odd {
+            for &y in &odd {
+                for &z in &odd {
+                    out.push(Vec3::new(x, y, z));
+                }
+            }
+        }
+        out
+    }
+
+    fn same(a: Vec3, b: Vec3) -> bool {
+        a.to_array()
+            .iter()
+            .zip(b.to_array())
+            .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
+    }
+
+    fn studio() -> EnvImage {
+        // Varied radiance: a bright patch, a gradient, a dark floor.
+        let (w, h) = (64u32, 32u32);
+        let texels = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+                let patch = if (0.3..0.4).contains(&x) && y < 0.3 {
+                    20.0
+                } else {
+                    0.0
+                };
+                Vec3::new(0.2 + x + patch, 1.0 - y, 0.5 * x * y + patch * 0.5)
+            })
+            .collect();
+        EnvImage {
+            width: w,
+            height: h,
+            texels,
+        }
+    }
+
+    /// Every width gives each lane the one-lane answer, bit for bit:
+    /// image coordinates, irradiance, prefiltered (lat-long and Blinn-Phong
+    /// octahedral) radiance and the dominant direction.
+    #[test]
+    fn every_width_is_the_one_lane_answer_bit_for_bit() {
+        // Turned, and not (the unturned one skips the rotation).
+        for turn in [33.0, 0.0] {
+            compare_widths(turn);
+        }
+    }
+
+    fn compare_widths(turn: f32) {
+        let phong = [0.15, 0.55, 0.75];
+        let env = EnvLight::with_size(&studio(), 1.7, turn, 16).with_phong_roughness(phong);
+        let dirs = directions();
+        for (i, q) in dirs.chunks_exact(8).enumerate() {
+            let roughness = (i % 13) as f32 / 12.0;
+            let ph = phong[i % 3];
+            let one = |k: usize| {
+                let d = V3::<f32>::from(q[k]);
+                let unit = d.normalize_or(V3::splat(Vec3::Y));
+                let n = V3::<f32>::from(q[(k + 1) % 8]).normalize_or(V3::splat(Vec3::Z));
+                let (u, v) = direction_to_uv_lanes(d);
+                [
+                    Vec3::new(u, v, 0.0),
+                    env.irradiance_lanes(unit).into(),
+                    env.prefiltered_lanes(unit, roughness).into(),
+                    env.prefiltered_phong_lanes(unit, ph).into(),
+                    dominant_direction_lanes(n, unit, roughness).into(),
+                ]
+            };
+            fn wide<L: Lane>(env: &EnvLight, q: &[Vec3], r: f32, ph: f32, k: usize) -> [Vec3; 5] {
+                let d = V3::<L>::from_fn(|j| q[j]);
+                let unit = d.normalize_or(V3::splat(Vec3::Y));
+                let n = V3::<L>::from_fn(|j| q[(j + 1) % 8]).normalize_or(V3::splat(Vec3::Z));
+                let (u, v) = direction_to_uv_lanes(d);
+                [
+                    Vec3::new(u.lane(k), v.lane(k), 0.0),
+                    env.irradiance_lanes(unit).lane(k),
+                    env.prefiltered_lanes(unit, r).lane(k),
+                    env.prefiltered_phong_lanes(unit, ph).lane(k),
+                    dominant_direction_lanes(n, unit, L::splat(r)).lane(k),
+                ]
+            }
+            for k in 0..8 {
+                let want = one(k);
+                let got8 = wide::<F8>(&env, q, roughness, ph, k);
+                for (a, b) in want.iter().zip(got8) {
+                    assert!(same(*a, b), "{:?}: {a} against {b} (8 lanes)", q[k]);
+                }
+                if k < 4 {
+                    let got4 = wide::<Vec4>(&env, q, roughness, ph, k);
+                    for (a, b) in want.iter().zip(got4) {
+                        assert!(same(*a, b), "{:?}: {a} against {b} (4 lanes)", q[k]);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_phong_level_reads_as_the_two_levels_it_blends() {
+        let env = EnvLight::with_size(&studio(), 1.0, 0.0, 128).with_phong_roughness([0.55, 0.15]);
+        assert!(env.phong_level(0.55).is_some() && env.phong_level(0.3).is_none());
+        // The octahedral map resamples the blended levels: the same light
+        // to within a small part of its range (the test sky has a patch 20
+        // times brighter than the rest, blurred by the lobe).
+        for rough in [0.55, 0.15] {
+            let (mut sum, mut worst, mut n) = (0.0f32, 0.0f32, 0);
+            let mut top = 0.0f32;
+            for d in directions().into_iter().take(5000) {
+                let Some(d) = d.try_normalize() else { continue };
+                let (a, b) = (env.prefiltered_phong(d, rough), env.prefiltered(d, rough));
+                let e = (a - b).abs().max_element();
+                sum += e;
+                worst = worst.max(e);
+                top = top.max(b.max_element());
+                n += 1;
+            }
+            let mean = sum / n as f32;
+            assert!(
+                mean < 0.01 * top && worst < 0.1 * top,
+                "roughness {rough}: mean {mean}, worst {worst}, top {top}"
+            );
+        }
     }
 }

@@ -6,9 +6,9 @@
 //! costs no visible detail. One direction and four (`simd::V3`) by the same
 //! operations, lane by lane.
 
-use glam::{Vec2, Vec3, Vec3A, Vec4};
+use glam::{Vec2, Vec3, Vec3A};
 
-use crate::simd::V3;
+use crate::simd::{Lane, V3};
 
 /// A `size` x `size` octahedral map, stored with a border of one texel
 /// that repeats the texels across each edge (the map's edges fold onto
@@ -22,41 +22,26 @@ pub(super) struct Octahedral {
 
 /// The fold of the lower hemisphere: (1 - |b|) sign(a), per coordinate.
 #[inline(always)]
-fn fold(a: f32, b: f32) -> f32 {
-    (1.0 - b.abs()) * a.signum()
+fn fold<L: Lane>(a: L, b: L) -> L {
+    (L::splat(1.0) - b.abs()) * a.signum()
 }
 
-/// Map coordinates in [0, 1]^2 of direction `d` (any length); zero or
-/// non-finite directions read the centre (+Y).
-#[inline]
-pub(super) fn encode(d: Vec3) -> Vec2 {
-    let s = d.x.abs() + d.y.abs() + d.z.abs();
-    if !(s > 0.0 && s.is_finite()) {
-        return Vec2::splat(0.5);
-    }
-    let (mut px, mut pz) = (d.x / s, d.z / s);
-    if d.y < 0.0 {
-        (px, pz) = (fold(px, pz), fold(pz, px));
-    }
-    Vec2::new(px * 0.5 + 0.5, pz * 0.5 + 0.5)
-}
-
-/// `encode` on four lanes: (u, v).
+/// Map coordinates in [0, 1]^2 of each lane's direction `d` (any
+/// length): (u, v); zero or non-finite directions read the centre (+Y).
 #[inline(always)]
-pub(super) fn encode4(d: V3) -> (Vec4, Vec4) {
+pub(super) fn encode<L: Lane>(d: V3<L>) -> (L, L) {
     let s = d.x.abs() + d.y.abs() + d.z.abs();
-    let ok = s.cmpgt(Vec4::ZERO) & s.is_finite_mask();
+    let ok = s.cmpgt(L::splat(0.0)) & s.is_finite();
     let (px, pz) = (d.x / s, d.z / s);
-    let fold4 = |a: Vec4, b: Vec4| (Vec4::ONE - b.abs()) * a.signum();
-    let below = d.y.cmplt(Vec4::ZERO);
+    let below = d.y.cmplt(L::splat(0.0));
     let (px, pz) = (
-        Vec4::select(below, fold4(px, pz), px),
-        Vec4::select(below, fold4(pz, px), pz),
+        L::select(below, fold(px, pz), px),
+        L::select(below, fold(pz, px), pz),
     );
-    let half = Vec4::splat(0.5);
+    let half = L::splat(0.5);
     (
-        Vec4::select(ok, px * half + half, half),
-        Vec4::select(ok, pz * half + half, half),
+        L::select(ok, px * half + half, half),
+        L::select(ok, pz * half + half, half),
     )
 }
 
@@ -106,7 +91,7 @@ impl Octahedral {
 
     /// Bilinear lookup at map coordinates (u, v), clamped to the edges.
     #[inline(always)]
-    fn at(&self, u: f32, v: f32) -> Vec3A {
+    pub(super) fn at(&self, u: f32, v: f32) -> Vec3A {
         let n = self.size;
         // In the bordered grid: texel k of the map is at k + 1, and u in
         // [0, 1] gives x in [0.5, n + 0.5].
@@ -126,26 +111,21 @@ impl Octahedral {
     }
 
     /// The map along direction `d`.
-    #[inline]
+    #[cfg(test)]
     pub fn sample(&self, d: Vec3) -> Vec3A {
-        let uv = encode(d);
-        self.at(uv.x, uv.y)
-    }
-
-    /// The map along four directions.
-    #[inline(always)]
-    pub fn sample4(&self, d: V3) -> [Vec3A; 4] {
-        let (u, v) = encode4(d);
-        std::array::from_fn(|k| self.at(u[k], v[k]))
+        let (u, v) = encode(V3::<f32>::from(d));
+        self.at(u, v)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::F8;
+    use glam::Vec4;
 
     #[test]
-    fn directions_round_trip_and_four_lanes_encode_as_one() {
+    fn directions_round_trip_and_every_width_encodes_as_one() {
         let mut s = 0x2545_f491_4f6c_dd1du64;
         let mut next = || {
             s ^= s << 13;
@@ -164,20 +144,20 @@ mod tests {
                 }
             }
         }
-        for q in dirs.chunks_exact(4) {
-            let (u, v) = encode4(V3::from_lanes([q[0], q[1], q[2], q[3]]));
-            for k in 0..4 {
-                let uv = encode(q[k]);
-                assert_eq!(
-                    (uv.x.to_bits(), uv.y.to_bits()),
-                    (u[k].to_bits(), v[k].to_bits()),
-                    "{:?}",
-                    q[k]
-                );
-                assert!((0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y));
+        for q in dirs.chunks_exact(8) {
+            let (u8, v8) = encode(V3::<F8>::from_fn(|k| q[k]));
+            let (u4, v4) = encode(V3::<Vec4>::from_fn(|k| q[k + 4]));
+            for k in 0..8 {
+                let (u, v) = encode(V3::<f32>::from(q[k]));
+                let bits = (u.to_bits(), v.to_bits());
+                assert_eq!(bits, (u8.lane(k).to_bits(), v8.lane(k).to_bits()));
+                if k >= 4 {
+                    assert_eq!(bits, (u4[k - 4].to_bits(), v4[k - 4].to_bits()));
+                }
+                assert!((0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v));
                 if let Some(d) = q[k].try_normalize() {
-                    let back = decode(uv);
-                    assert!(back.dot(d) > 1.0 - 1e-5, "{d} -> {uv} -> {back}");
+                    let back = decode(Vec2::new(u, v));
+                    assert!(back.dot(d) > 1.0 - 1e-5, "{d} -> {u} {v} -> {back}");
                 }
             }
         }

@@ -14,7 +14,49 @@
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use glam::{BVec4A, Vec3, Vec4};
+use glam::{Vec3, Vec4};
+
+mod lane;
+
+pub use lane::{F8, Lane, M8, Mask};
+
+/// The lane widths this build shades with: 8 where it targets AVX
+/// (x86-64-v3, the default x86-64 build), else 1 and 4.
+pub fn widths() -> &'static [usize] {
+    if cfg!(all(target_arch = "x86_64", target_feature = "avx")) {
+        &[1, 4, 8]
+    } else {
+        &[1, 4]
+    }
+}
+
+/// The widest lane width of this build.
+pub fn widest() -> usize {
+    widths().iter().copied().max().unwrap_or(4)
+}
+
+/// The lane width `SOFTRASTER_LANES` asks for (1, 4 or 8, for tests and
+/// bug reports), or None without it; an error names the variable and
+/// the widths this build has where it asks for another.
+pub fn lane_width() -> Result<Option<usize>, String> {
+    let Some(v) = std::env::var_os("SOFTRASTER_LANES") else {
+        return Ok(None);
+    };
+    let v = v.to_string_lossy();
+    match v.trim().parse::<usize>() {
+        Ok(w) if widths().contains(&w) => Ok(Some(w)),
+        _ => {
+            let w: Vec<String> = widths().iter().map(|w| w.to_string()).collect();
+            let (last, rest) = w
+                .split_last()
+                .map_or(("4", &[][..]), |(l, r)| (l.as_str(), r));
+            Err(format!(
+                "SOFTRASTER_LANES={v}: expected a lane width this build and CPU support: {} or {last}",
+                rest.join(", ")
+            ))
+        }
+    }
+}
 
 /// Lanes (a, b, c, d). glam's `Vec4::new` goes through memory on SSE
 /// (four scalar stores, then one wide load that waits for them); this
@@ -175,12 +217,122 @@ pub fn ramp4(s: i64, step: i64) -> Vec4 {
     Vec4::new(at(0), at(1), at(2), at(3))
 }
 
-/// Four 3-vectors, one per lane.
+/// 3-vectors, one per lane of `L` (four by default), as a structure of
+/// arrays: each operation is `Vec3`'s, lane by lane, in its order.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct V3 {
-    pub x: Vec4,
-    pub y: Vec4,
-    pub z: Vec4,
+pub struct V3<L = Vec4> {
+    pub x: L,
+    pub y: L,
+    pub z: L,
+}
+
+impl<L: Lane> V3<L> {
+    #[inline(always)]
+    pub fn zero() -> V3<L> {
+        V3::splat(Vec3::ZERO)
+    }
+
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V3<L> {
+        V3 {
+            x: L::splat(v.x),
+            y: L::splat(v.y),
+            z: L::splat(v.z),
+        }
+    }
+
+    /// Lane k is `f(k)`.
+    #[inline(always)]
+    pub fn from_fn(mut f: impl FnMut(usize) -> Vec3) -> V3<L> {
+        let mut v = [Vec3::ZERO; 8];
+        for (k, o) in v.iter_mut().take(L::WIDTH).enumerate() {
+            *o = f(k);
+        }
+        V3 {
+            x: L::from_fn(|k| v[k].x),
+            y: L::from_fn(|k| v[k].y),
+            z: L::from_fn(|k| v[k].z),
+        }
+    }
+
+    #[inline(always)]
+    pub fn lane(&self, k: usize) -> Vec3 {
+        Vec3::new(self.x.lane(k), self.y.lane(k), self.z.lane(k))
+    }
+
+    /// `Vec3::dot`: (x x') + (y y') + (z z').
+    #[inline(always)]
+    pub fn dot(self, o: V3<L>) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// `Vec3::cross`.
+    #[inline(always)]
+    pub fn cross(self, o: V3<L>) -> V3<L> {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// Each lane's vector times that lane's scalar (`Vec3 * f32`).
+    #[inline(always)]
+    pub fn scale(self, s: L) -> V3<L> {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+
+    /// Lane by lane: `a` where `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: L::Mask, a: V3<L>, b: V3<L>) -> V3<L> {
+        V3 {
+            x: L::select(m, a.x, b.x),
+            y: L::select(m, a.y, b.y),
+            z: L::select(m, a.z, b.z),
+        }
+    }
+
+    /// `Vec3::max` with a scalar per lane's components.
+    #[inline(always)]
+    pub fn max(self, o: V3<L>) -> V3<L> {
+        V3 {
+            x: self.x.max(o.x),
+            y: self.y.max(o.y),
+            z: self.z.max(o.z),
+        }
+    }
+
+    /// `Vec3::length_recip`: 1 / sqrt(dot).
+    #[inline(always)]
+    pub fn length_recip(self) -> L {
+        L::splat(1.0) / self.dot(self).sqrt()
+    }
+
+    /// `Vec3::try_normalize` per lane: the unit vector and the lanes where
+    /// it exists (the reciprocal length is finite and positive).
+    #[inline(always)]
+    pub fn try_normalize(self) -> (V3<L>, L::Mask) {
+        let rcp = self.length_recip();
+        let ok = rcp.is_finite() & rcp.cmpgt(L::splat(0.0));
+        (self.scale(rcp), ok)
+    }
+
+    /// `Vec3::normalize_or`.
+    #[inline(always)]
+    pub fn normalize_or(self, fallback: V3<L>) -> V3<L> {
+        let (n, ok) = self.try_normalize();
+        V3::select(ok, n, fallback)
+    }
+
+    /// The lanes where all three components are finite.
+    #[inline(always)]
+    pub fn is_finite_mask(self) -> L::Mask {
+        self.x.is_finite() & self.y.is_finite() & self.z.is_finite()
+    }
 }
 
 impl V3 {
@@ -191,15 +343,6 @@ impl V3 {
     };
 
     #[inline(always)]
-    pub fn splat(v: Vec3) -> V3 {
-        V3 {
-            x: Vec4::splat(v.x),
-            y: Vec4::splat(v.y),
-            z: Vec4::splat(v.z),
-        }
-    }
-
-    #[inline(always)]
     pub fn from_lanes(v: [Vec3; 4]) -> V3 {
         V3 {
             x: lanes4(v[0].x, v[1].x, v[2].x, v[3].x),
@@ -207,82 +350,31 @@ impl V3 {
             z: lanes4(v[0].z, v[1].z, v[2].z, v[3].z),
         }
     }
+}
 
+impl From<Vec3> for V3<f32> {
     #[inline(always)]
-    pub fn lane(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
-
-    /// `Vec3::dot`: (x x') + (y y') + (z z').
-    #[inline(always)]
-    pub fn dot(self, o: V3) -> Vec4 {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    /// `Vec3::cross`.
-    #[inline(always)]
-    pub fn cross(self, o: V3) -> V3 {
+    fn from(v: Vec3) -> V3<f32> {
         V3 {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
+            x: v.x,
+            y: v.y,
+            z: v.z,
         }
     }
+}
 
-    /// Each lane's vector times that lane's scalar (`Vec3 * f32`).
+impl From<V3<f32>> for Vec3 {
     #[inline(always)]
-    pub fn scale(self, s: Vec4) -> V3 {
-        V3 {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    /// Lane by lane: `a` where `m`, else `b`.
-    #[inline(always)]
-    pub fn select(m: BVec4A, a: V3, b: V3) -> V3 {
-        V3 {
-            x: Vec4::select(m, a.x, b.x),
-            y: Vec4::select(m, a.y, b.y),
-            z: Vec4::select(m, a.z, b.z),
-        }
-    }
-
-    /// `Vec3::length_recip`: 1 / sqrt(dot).
-    #[inline(always)]
-    pub fn length_recip(self) -> Vec4 {
-        Vec4::ONE / self.dot(self).sqrt()
-    }
-
-    /// `Vec3::try_normalize` per lane: the unit vector and the lanes where
-    /// it exists (the reciprocal length is finite and positive).
-    #[inline(always)]
-    pub fn try_normalize(self) -> (V3, BVec4A) {
-        let rcp = self.length_recip();
-        let ok = rcp.is_finite_mask() & rcp.cmpgt(Vec4::ZERO);
-        (self.scale(rcp), ok)
-    }
-
-    /// `Vec3::normalize_or`.
-    #[inline(always)]
-    pub fn normalize_or(self, fallback: V3) -> V3 {
-        let (n, ok) = self.try_normalize();
-        V3::select(ok, n, fallback)
-    }
-
-    /// The lanes where all three components are finite.
-    #[inline(always)]
-    pub fn is_finite_mask(self) -> BVec4A {
-        self.x.is_finite_mask() & self.y.is_finite_mask() & self.z.is_finite_mask()
+    fn from(v: V3<f32>) -> Vec3 {
+        Vec3::new(v.x, v.y, v.z)
     }
 }
 
 /// Component-wise sum.
-impl Add for V3 {
-    type Output = V3;
+impl<L: Lane> Add for V3<L> {
+    type Output = V3<L>;
     #[inline(always)]
-    fn add(self, o: V3) -> V3 {
+    fn add(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -292,10 +384,10 @@ impl Add for V3 {
 }
 
 /// Component-wise difference.
-impl Sub for V3 {
-    type Output = V3;
+impl<L: Lane> Sub for V3<L> {
+    type Output = V3<L>;
     #[inline(always)]
-    fn sub(self, o: V3) -> V3 {
+    fn sub(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x - o.x,
             y: self.y - o.y,
@@ -305,10 +397,10 @@ impl Sub for V3 {
 }
 
 /// Component-wise product (`Vec3 * Vec3`).
-impl Mul for V3 {
-    type Output = V3;
+impl<L: Lane> Mul for V3<L> {
+    type Output = V3<L>;
     #[inline(always)]
-    fn mul(self, o: V3) -> V3 {
+    fn mul(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x * o.x,
             y: self.y * o.y,
@@ -318,10 +410,10 @@ impl Mul for V3 {
 }
 
 /// Each lane's vector over that lane's scalar (`Vec3 / f32`).
-impl Div<Vec4> for V3 {
-    type Output = V3;
+impl<L: Lane> Div<L> for V3<L> {
+    type Output = V3<L>;
     #[inline(always)]
-    fn div(self, s: Vec4) -> V3 {
+    fn div(self, s: L) -> V3<L> {
         V3 {
             x: self.x / s,
             y: self.y / s,
@@ -330,10 +422,10 @@ impl Div<Vec4> for V3 {
     }
 }
 
-impl Neg for V3 {
-    type Output = V3;
+impl<L: Lane> Neg for V3<L> {
+    type Output = V3<L>;
     #[inline(always)]
-    fn neg(self) -> V3 {
+    fn neg(self) -> V3<L> {
         V3 {
             x: -self.x,
             y: -self.y,
@@ -344,15 +436,16 @@ impl Neg for V3 {
 
 /// `f32::clamp(x, 0.0, 1.0)` per lane (signed zeros and NaN included).
 #[inline(always)]
-pub fn clamp01(x: Vec4) -> Vec4 {
-    let x = Vec4::select(x.cmplt(Vec4::ZERO), Vec4::ZERO, x);
-    Vec4::select(x.cmpgt(Vec4::ONE), Vec4::ONE, x)
+pub fn clamp01<L: Lane>(x: L) -> L {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let x = L::select(x.cmplt(zero), zero, x);
+    L::select(x.cmpgt(one), one, x)
 }
 
 /// `a x + b y + c z` lane by lane, in that order (barycentric weights
 /// (x, y, z) of a triangle's corners, as `Vec3 * f32` sums).
 #[inline(always)]
-pub fn lerp3(a: V3, b: V3, c: V3, l: V3) -> V3 {
+pub fn lerp3<L: Lane>(a: V3<L>, b: V3<L>, c: V3<L>, l: V3<L>) -> V3<L> {
     a.scale(l.x) + b.scale(l.y) + c.scale(l.z)
 }
 
