@@ -1029,19 +1029,9 @@ fn tex_info(
     })
 }
 
-fn read_attributes(
-    prim: &gltf::Primitive,
-    buffers: &[Vec<u8>],
-    views: &[(usize, usize, usize)],
-) -> Result<Attributes, String> {
-    if let Some(ext) = prim
-        .extensions()
-        .and_then(|e| e.get("KHR_draco_mesh_compression"))
-    {
-        return super::draco::read(prim, ext, buffers, views);
-    }
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
+/// The types of a primitive's accessors, as its readers assume them: an
+/// error names the first that is not.
+fn check_accessor_types(prim: &gltf::Primitive) -> Result<(), String> {
     // KHR_mesh_quantization: integer positions, normals, tangents and
     // texture coordinates, which the gltf crate reads as f32 only.
     // Each attribute's accessor must have its type (the gltf crate's
@@ -1083,6 +1073,23 @@ fn read_attributes(
             a.dimensions()
         ));
     }
+    Ok(())
+}
+
+fn read_attributes(
+    prim: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    views: &[(usize, usize, usize)],
+) -> Result<Attributes, String> {
+    if let Some(ext) = prim
+        .extensions()
+        .and_then(|e| e.get("KHR_draco_mesh_compression"))
+    {
+        return super::draco::read(prim, ext, buffers, views);
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");
+    check_accessor_types(prim)?;
     let quantized = |s: gltf::Semantic| prim.get(&s).filter(|a| a.data_type() != DataType::F32);
     let positions: Vec<Vec3> = match quantized(gltf::Semantic::Positions) {
         Some(a) => read_floats::<3>(&a, buffers)?
@@ -1705,7 +1712,7 @@ impl Builder {
         self.note_sets(&uv, &colors);
         let base = self.mesh.positions.len() as u32;
         if let Some((positions, normals)) = source {
-            let segment = self.segment(prim, buffers, pose, base, positions, normals, &order);
+            let segment = self.segment(prim, buffers, pose, base, (positions, normals), &order);
             match (segment, &mut self.segments) {
                 (Ok(seg), Some(list)) => list.push(seg),
                 (Err(e), _) => {
@@ -1775,15 +1782,13 @@ impl Builder {
 
     /// The segment of a triangle primitive placed at `base` in the mesh,
     /// its vertices taken from the source in `order`.
-    #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
         prim: &gltf::Primitive,
         buffers: &[Vec<u8>],
         pose: &Pose,
         base: u32,
-        positions: Vec<Vec3>,
-        normals: Option<Vec<Vec3>>,
+        (positions, normals): (Vec<Vec3>, Option<Vec<Vec3>>),
         order: &[u32],
     ) -> Result<Segment, String> {
         let n = positions.len();

@@ -72,13 +72,10 @@ impl Skinned {
 
     /// A tube along -Y from `top` to `bottom` (elliptic section rx, rz),
     /// capped, weighted per ring by `weights(y)`.
-    #[allow(clippy::too_many_arguments)]
     fn tube(
         &mut self,
-        top: Vec3,
-        bottom: Vec3,
-        rx: f32,
-        rz: f32,
+        (top, bottom): (Vec3, Vec3),
+        (rx, rz): (f32, f32),
         rings: usize,
         color: [f32; 4],
         weights: impl Fn(f32) -> Vec<(u8, f32)>,
@@ -191,20 +188,22 @@ fn mesh() -> Skinned {
     // Torso: hips joint below the waist, spine above.
     let waist = j[1].y;
     m.tube(
-        Vec3::new(0.0, j[7].y + 0.06, 0.0),
-        Vec3::new(0.0, j[3].y - 0.03, 0.0),
-        0.17,
-        0.11,
+        (
+            Vec3::new(0.0, j[7].y + 0.06, 0.0),
+            Vec3::new(0.0, j[3].y - 0.03, 0.0),
+        ),
+        (0.17, 0.11),
         10,
         SHIRT,
         |y| blend(y, waist - 0.08, waist + 0.08, 0, 1),
     );
     // Neck and head.
     m.tube(
-        Vec3::new(0.0, j[2].y + 0.02, 0.0),
-        Vec3::new(0.0, j[7].y + 0.02, 0.0),
-        0.05,
-        0.05,
+        (
+            Vec3::new(0.0, j[2].y + 0.02, 0.0),
+            Vec3::new(0.0, j[7].y + 0.02, 0.0),
+        ),
+        (0.05, 0.05),
         3,
         SKIN,
         |y| blend(y, j[2].y - 0.04, j[2].y + 0.01, 1, 2),
@@ -214,10 +213,8 @@ fn mesh() -> Skinned {
         let (hip, knee) = (j[thigh as usize], j[shin as usize]);
         let ankle = knee - Vec3::new(0.0, 0.44, 0.0);
         m.tube(
-            hip + Vec3::Y * 0.04,
-            ankle,
-            0.075,
-            0.075,
+            (hip + Vec3::Y * 0.04, ankle),
+            (0.075, 0.075),
             12,
             TROUSERS,
             |y| {
@@ -239,10 +236,8 @@ fn mesh() -> Skinned {
         let (shoulder, elbow) = (j[arm as usize], j[fore as usize]);
         let wrist = elbow - Vec3::new(0.0, 0.26, 0.0);
         m.tube(
-            shoulder + Vec3::Y * 0.03,
-            wrist,
-            0.05,
-            0.05,
+            (shoulder + Vec3::Y * 0.03, wrist),
+            (0.05, 0.05),
             8,
             SHIRT,
             |y| blend(y, elbow.y - 0.05, elbow.y + 0.05, fore, arm),
@@ -373,23 +368,7 @@ pub fn walker_glb() -> Vec<u8> {
     channels
         .push(json!({"sampler": samplers.len() - 1, "target": {"node": 0, "path": "translation"}}));
 
-    let mut nodes: Vec<Value> = JOINTS
-        .iter()
-        .enumerate()
-        .map(|(i, (name, _, t))| {
-            let children: Vec<usize> = JOINTS
-                .iter()
-                .enumerate()
-                .filter(|(_, (_, p, _))| *p == Some(i))
-                .map(|(k, _)| k)
-                .collect();
-            let mut node = json!({"name": name, "translation": t});
-            if !children.is_empty() {
-                node["children"] = json!(children);
-            }
-            node
-        })
-        .collect();
+    let mut nodes = joint_nodes();
     nodes.push(json!({"name": "walker", "mesh": 0, "skin": 0}));
     let doc = json!({
         "asset": {"version": "2.0", "generator": "softraster generate-assets"},
@@ -406,7 +385,34 @@ pub fn walker_glb() -> Vec<u8> {
         "bufferViews": views,
         "accessors": accessors,
     });
-    let mut json_bytes = serde_json::to_vec(&doc).unwrap_or_default();
+    glb(&doc, blob)
+}
+
+/// The skeleton's nodes: each joint with its rest translation and its
+/// children.
+fn joint_nodes() -> Vec<Value> {
+    JOINTS
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _, t))| {
+            let children: Vec<usize> = JOINTS
+                .iter()
+                .enumerate()
+                .filter(|(_, (_, p, _))| *p == Some(i))
+                .map(|(k, _)| k)
+                .collect();
+            let mut node = json!({"name": name, "translation": t});
+            if !children.is_empty() {
+                node["children"] = json!(children);
+            }
+            node
+        })
+        .collect()
+}
+
+/// A binary glTF of `doc` and its buffer `blob`.
+fn glb(doc: &Value, mut blob: Vec<u8>) -> Vec<u8> {
+    let mut json_bytes = serde_json::to_vec(doc).unwrap_or_default();
     while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }

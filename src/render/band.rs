@@ -198,7 +198,7 @@ impl<'a> FrameData<'a> {
             } else {
                 [Gradients::default(); 2]
             };
-            let s = self.surface(t, it, frag, (px, py), grads, [None; 2], Reach::FULL);
+            let s = self.surface((t, it), frag, (px, py), (grads, [None; 2]), Reach::FULL);
             let (normal, albedo) = self.ctx.aov(&s);
             let d = self.draws[t.draw as usize];
             *a = AovPixel {
@@ -313,7 +313,7 @@ impl<'a> FrameData<'a> {
     ) -> Option<(Vec3, Vec3, f32)> {
         // Blended fragments may lie in front of the tile's visible depths:
         // every light.
-        let surface = self.surface(t, it, frag, px, grads, [None; 2], Reach::FULL);
+        let surface = self.surface((t, it), frag, px, (grads, [None; 2]), Reach::FULL);
         let (add, through, a) = self.ctx.layer(&surface);
         (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
@@ -347,15 +347,226 @@ impl<'a> FrameData<'a> {
         // Over a flat background: the empty pixels first, in one pass, and
         // quads without a triangle skipped below.
         let filled = flat_bg.is_some();
-        let empty_at = |i: usize| {
-            if n == 1 {
-                vis.id()[i] == NO_TRIANGLE
-            } else {
-                vis.id()[i * n..(i + 1) * n]
-                    .iter()
-                    .all(|&id| id == NO_TRIANGLE)
-            }
+        let empty_at = |i: usize| empty(vis, i);
+        let (spans, drawn) = self.fill_background(vis, filled, known, color, depth);
+        let mut lanes = self
+            .lanes
+            .iter()
+            .any(|l| l.is_some())
+            .then(|| LaneBatches::new(self.draws.len(), self.lane_width));
+        let mut shaded = Vec::new();
+        let sink = &mut Sink {
+            color: &mut *color,
+            depth: &mut *depth,
+            shaded: &mut shaded,
+            inv_n,
         };
+        let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
+        for qy in (0..th).step_by(2) {
+            let below = spans.get(qy + 1).copied().unwrap_or((usize::MAX, 0));
+            let (x0, x1) = (spans[qy].0.min(below.0), spans[qy].1.max(below.1));
+            if x0 >= x1 {
+                continue;
+            }
+            for qx in (x0 & !1..x1).step_by(2) {
+                if filled {
+                    let at = |x: usize, y: usize| x >= tw || y >= th || empty_at(y * tw + x);
+                    if at(qx, qy) && at(qx + 1, qy) && at(qx, qy + 1) && at(qx + 1, qy + 1) {
+                        continue;
+                    }
+                }
+                // A quad of one lane-shaded triangle: its four pixels are
+                // lanes.
+                if let Some(b) = lanes.as_mut()
+                    && qx + 1 < tw
+                    && qy + 1 < th
+                {
+                    let lights = lights_at(qx);
+                    let out = (&mut *sink.color, &mut *sink.depth);
+                    if self.lane_quad(vis, (qx, qy), b, &mut cache, (ao, lights), out) {
+                        continue;
+                    }
+                }
+                // Per triangle present in the quad: its texture-coordinate
+                // derivatives and the filter footprints computed from them.
+                let mut quad: smallvec::SmallVec<[QuadEntry; 4]> = smallvec::SmallVec::new();
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (x, y) = (qx + dx, qy + dy);
+                    if x >= tw || y >= th {
+                        continue;
+                    }
+                    let i = y * tw + x;
+                    let ids = &vis.id()[i * n..(i + 1) * n];
+                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
+                    let empty = ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE);
+                    let bg = match flat_bg {
+                        Some(bg) => bg,
+                        // Only where the background shows (some sample is
+                        // uncovered) is its per-pixel color needed.
+                        None if empty || ids.contains(&NO_TRIANGLE) => self.background_at(px, py),
+                        None => Vec4::ZERO,
+                    };
+                    if empty {
+                        if filled {
+                            continue;
+                        }
+                        sink.color[i] = bg;
+                        sink.depth[i] = f32::INFINITY;
+                        continue;
+                    }
+                    let occlusion = ao.map_or(1.0, |a| a[i]);
+                    let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
+                    let mut at = FragmentAt {
+                        px: (px, py),
+                        q0,
+                        reach: Reach {
+                            ao: occlusion,
+                            lights: lights_at(x),
+                        },
+                        lanes: lanes.is_some(),
+                        cache: &mut cache,
+                        quad: &mut quad,
+                    };
+                    if ids[1..].iter().all(|&s| s == ids[0]) {
+                        // One fragment over every sample, shaded now or
+                        // by the lanes (which write it).
+                        let all = (1u32 << n) - 1;
+                        match self.fragment(&mut at, ids[0], all) {
+                            Shaded::Now(part) => {
+                                (sink.color[i], sink.depth[i]) = resolve(&[part], &[], inv_n);
+                            }
+                            Shaded::Later(draw, mut p) => {
+                                p.pixel = i as u32;
+                                if let Some(b) = lanes.as_mut() {
+                                    b.push(self, draw, p, sink);
+                                }
+                            }
+                        }
+                        continue;
+                    }
+                    let (parts, queued) = self.pixel_parts(&mut at, ids, bg, lanes.as_mut(), sink);
+                    if queued {
+                        deferred.push((i, parts));
+                    } else {
+                        (sink.color[i], sink.depth[i]) = resolve(&parts, &[], inv_n);
+                    }
+                }
+            }
+        }
+        // The lanes' last groups, then the pixels that wait for them.
+        if let Some(b) = lanes.as_mut() {
+            b.finish(self, sink);
+        }
+        for (i, parts) in deferred {
+            (sink.color[i], sink.depth[i]) = resolve(&parts, sink.shaded, inv_n);
+        }
+        // Over a flat background, the pixels outside the drawn columns
+        // were filled with it above, and no quad reaches them.
+        filled.then_some(PlainBackground {
+            color: self.bg,
+            columns: drawn,
+        })
+    }
+
+    /// Shades the quad whose top-left band pixel is (qx, qy) with the
+    /// lanes where one lane-material triangle covers all its samples (and
+    /// says so), into `color` and `depth`.
+    fn lane_quad(
+        &self,
+        vis: &Visibility,
+        (qx, qy): (usize, usize),
+        b: &mut LaneBatches,
+        cache: &mut InterpolatorCache,
+        (ao, lights): (Option<&[f32]>, LightMask),
+        (color, depth): (&mut [Vec4], &mut [f32]),
+    ) -> bool {
+        let (rect, n) = (vis.rect, vis.samples());
+        let tw = rect.width();
+        let i0 = qy * tw + qx;
+        let quad = [i0, i0 + 1, i0 + tw, i0 + tw + 1];
+        let id = vis.id()[i0 * n];
+        let one = |i: usize| vis.id()[i * n..(i + 1) * n].iter().all(|&s| s == id);
+        if id == NO_TRIANGLE || !quad.iter().all(|&i| one(i)) {
+            return false;
+        }
+        let t = &self.tris[id as usize];
+        let Some(lm) = self.lane_material(t.draw as usize) else {
+            return false;
+        };
+        let q = QuadAt {
+            t,
+            id,
+            it: cache.get(id, t),
+            lm,
+            q0: (rect.x0 + qx as i32, rect.y0 + qy as i32),
+            ao: ao.map_or([1.0; 4], |a| quad.map(|i| a[i])),
+            lights,
+        };
+        b.quad(self, q, quad, (color, depth), n);
+        true
+    }
+
+    /// The parts of a pixel whose samples hold several fragments `ids`
+    /// (the background `bg` where none): each shaded now, or queued for
+    /// the lanes (then also `true`: the pixel waits for them).
+    fn pixel_parts(
+        &self,
+        at: &mut FragmentAt,
+        ids: &[u32],
+        bg: Vec4,
+        mut lanes: Option<&mut LaneBatches>,
+        sink: &mut Sink,
+    ) -> (smallvec::SmallVec<[Part; 4]>, bool) {
+        let mut parts: smallvec::SmallVec<[Part; 4]> = smallvec::SmallVec::new();
+        let mut queued = false;
+        for (id, mask) in fragments(ids) {
+            let count = mask.count_ones() as f32;
+            if id == NO_TRIANGLE {
+                parts.push(Part::Shaded(bg, f32::INFINITY, count));
+                continue;
+            }
+            match self.fragment(at, id, mask) {
+                Shaded::Now(part) => parts.push(part),
+                Shaded::Later(draw, mut p) => {
+                    if let Some(b) = lanes.as_deref_mut() {
+                        queued = true;
+                        p.pixel = LANE_SLOT;
+                        let slot = b.push(self, draw, p, sink);
+                        parts.push(Part::Queued(slot, count));
+                    }
+                }
+            }
+        }
+        (parts, queued)
+    }
+
+    /// The background at band pixel (px, py): the environment or the
+    /// colour, with the ground catcher over it.
+    fn background_at(&self, px: i32, py: i32) -> Vec4 {
+        let bg = match &self.env_bg {
+            Some(e) => e.at(px, py),
+            None => self.bg,
+        };
+        match &self.ground {
+            Some(g) => g.over(bg, px, py),
+            None => bg,
+        }
+    }
+
+    /// Over a flat background (`filled`), the band's empty pixels filled
+    /// with it (only where `known` says they may hold something else) and
+    /// per row the span of pixels some triangle covers; otherwise every
+    /// row's whole width. Also the columns drawn into.
+    fn fill_background(
+        &self,
+        vis: &Visibility,
+        filled: bool,
+        known: Option<PlainBackground>,
+        color: &mut [Vec4],
+        depth: &mut [f32],
+    ) -> (Vec<(usize, usize)>, (usize, usize)) {
+        let tw = vis.rect.width();
+        let th = vis.rect.height();
         // Per row: the span of pixels some triangle covers (over a flat
         // background only those are visited; the others are filled here).
         let mut spans = vec![(usize::MAX, 0usize); th];
@@ -387,7 +598,7 @@ impl<'a> FrameData<'a> {
                 }
             }
             for x in lo..hi {
-                if empty_at(y * tw + x) {
+                if empty(vis, y * tw + x) {
                     c[x] = self.bg;
                     d[x] = f32::INFINITY;
                 } else {
@@ -396,177 +607,7 @@ impl<'a> FrameData<'a> {
                 }
             }
         }
-        let mut lanes = self
-            .lanes
-            .iter()
-            .any(|l| l.is_some())
-            .then(|| LaneBatches::new(self.draws.len(), self.lane_width));
-        let mut shaded = Vec::new();
-        let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
-        for qy in (0..th).step_by(2) {
-            let below = spans.get(qy + 1).copied().unwrap_or((usize::MAX, 0));
-            let (x0, x1) = (spans[qy].0.min(below.0), spans[qy].1.max(below.1));
-            if x0 >= x1 {
-                continue;
-            }
-            for qx in (x0 & !1..x1).step_by(2) {
-                if filled {
-                    let at = |x: usize, y: usize| x >= tw || y >= th || empty_at(y * tw + x);
-                    if at(qx, qy) && at(qx + 1, qy) && at(qx, qy + 1) && at(qx + 1, qy + 1) {
-                        continue;
-                    }
-                }
-                // A quad of one lane-shaded triangle: its four pixels are
-                // the four lanes.
-                if lanes.is_some() && qx + 1 < tw && qy + 1 < th {
-                    let i0 = qy * tw + qx;
-                    let quad = [i0, i0 + 1, i0 + tw, i0 + tw + 1];
-                    let id = vis.id()[i0 * n];
-                    let one = |i: usize| vis.id()[i * n..(i + 1) * n].iter().all(|&s| s == id);
-                    if id != NO_TRIANGLE && quad.iter().all(|&i| one(i)) {
-                        let t = &self.tris[id as usize];
-                        if let (Some(lm), Some(b)) =
-                            (self.lane_material(t.draw as usize), lanes.as_mut())
-                        {
-                            let q = QuadAt {
-                                t,
-                                id,
-                                it: cache.get(id, t),
-                                lm,
-                                q0: (rect.x0 + qx as i32, rect.y0 + qy as i32),
-                                ao: ao.map_or([1.0; 4], |a| quad.map(|i| a[i])),
-                                lights: lights_at(qx),
-                            };
-                            b.quad(self, q, quad, (&mut *color, &mut *depth), n);
-                            continue;
-                        }
-                    }
-                }
-                // Per triangle present in the quad: its texture-coordinate
-                // derivatives and the filter footprints computed from them.
-                let mut quad: smallvec::SmallVec<[QuadEntry; 4]> = smallvec::SmallVec::new();
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let (x, y) = (qx + dx, qy + dy);
-                    if x >= tw || y >= th {
-                        continue;
-                    }
-                    let i = y * tw + x;
-                    let ids = &vis.id()[i * n..(i + 1) * n];
-                    let (px, py) = (rect.x0 + x as i32, rect.y0 + y as i32);
-                    let empty = ids[0] == NO_TRIANGLE && ids.iter().all(|&id| id == NO_TRIANGLE);
-                    let bg = match flat_bg {
-                        Some(bg) => bg,
-                        // Only where the background shows (some sample is
-                        // uncovered) is its per-pixel color needed.
-                        None if empty || ids.contains(&NO_TRIANGLE) => {
-                            let bg = match &self.env_bg {
-                                Some(e) => e.at(px, py),
-                                None => self.bg,
-                            };
-                            match &self.ground {
-                                Some(g) => g.over(bg, px, py),
-                                None => bg,
-                            }
-                        }
-                        None => Vec4::ZERO,
-                    };
-                    if empty {
-                        if filled {
-                            continue;
-                        }
-                        color[i] = bg;
-                        depth[i] = f32::INFINITY;
-                        continue;
-                    }
-                    let occlusion = ao.map_or(1.0, |a| a[i]);
-                    let q0 = (rect.x0 + qx as i32, rect.y0 + qy as i32);
-                    let mut at = FragmentAt {
-                        px: (px, py),
-                        q0,
-                        reach: Reach {
-                            ao: occlusion,
-                            lights: lights_at(x),
-                        },
-                        lanes: lanes.is_some(),
-                        cache: &mut cache,
-                        quad: &mut quad,
-                    };
-                    if ids[1..].iter().all(|&s| s == ids[0]) {
-                        // One fragment over every sample, shaded now or
-                        // by the lanes (which write it).
-                        let all = (1u32 << n) - 1;
-                        match self.fragment(&mut at, ids[0], all) {
-                            Shaded::Now(part) => {
-                                (color[i], depth[i]) = resolve(&[part], &[], inv_n);
-                            }
-                            Shaded::Later(draw, mut p) => {
-                                p.pixel = i as u32;
-                                if let Some(b) = lanes.as_mut() {
-                                    let sink = &mut Sink {
-                                        color: &mut *color,
-                                        depth: &mut *depth,
-                                        shaded: &mut shaded,
-                                        inv_n,
-                                    };
-                                    b.push(self, draw, p, sink);
-                                }
-                            }
-                        }
-                        continue;
-                    }
-                    let mut parts: smallvec::SmallVec<[Part; 4]> = smallvec::SmallVec::new();
-                    let mut queued = false;
-                    for (id, mask) in fragments(ids) {
-                        let count = mask.count_ones() as f32;
-                        if id == NO_TRIANGLE {
-                            parts.push(Part::Shaded(bg, f32::INFINITY, count));
-                            continue;
-                        }
-                        match self.fragment(&mut at, id, mask) {
-                            Shaded::Now(part) => parts.push(part),
-                            Shaded::Later(draw, mut p) => {
-                                if let Some(b) = lanes.as_mut() {
-                                    queued = true;
-                                    p.pixel = LANE_SLOT;
-                                    let sink = &mut Sink {
-                                        color: &mut *color,
-                                        depth: &mut *depth,
-                                        shaded: &mut shaded,
-                                        inv_n,
-                                    };
-                                    let slot = b.push(self, draw, p, sink);
-                                    parts.push(Part::Queued(slot, count));
-                                }
-                            }
-                        }
-                    }
-                    if queued {
-                        deferred.push((i, parts));
-                    } else {
-                        (color[i], depth[i]) = resolve(&parts, &[], inv_n);
-                    }
-                }
-            }
-        }
-        // The lanes' last groups, then the pixels that wait for them.
-        if let Some(b) = lanes.as_mut() {
-            let sink = &mut Sink {
-                color: &mut *color,
-                depth: &mut *depth,
-                shaded: &mut shaded,
-                inv_n,
-            };
-            b.finish(self, sink);
-        }
-        for (i, parts) in deferred {
-            (color[i], depth[i]) = resolve(&parts, &shaded, inv_n);
-        }
-        // Over a flat background, the pixels outside the drawn columns
-        // were filled with it above, and no quad reaches them.
-        filled.then_some(PlainBackground {
-            color: self.bg,
-            columns: drawn,
-        })
+        (spans, drawn)
     }
 
     /// Shades the fragment of triangle `id` covering samples `mask` of
@@ -621,7 +662,7 @@ impl<'a> FrameData<'a> {
         }
         let q = &quad[k];
         let (grads, fps) = (q.grads, q.footprints);
-        let (c, d, fps) = self.shade_with(t, it, frag, (px, py), grads, fps, at.reach);
+        let (c, d, fps) = self.shade_with((t, it), frag, (px, py), (grads, fps), at.reach);
         quad[k].footprints = fps;
         // A NaN from degenerate input must not poison the frame: such a
         // fragment is black.
@@ -716,18 +757,15 @@ impl<'a> FrameData<'a> {
     /// Color (linear, or the data view's value) and view depth of triangle
     /// `t` at pixel (px, py), given the filter footprints already known for
     /// `grads`; also returns the footprints known afterwards.
-    #[allow(clippy::too_many_arguments)]
     fn shade_with(
         &self,
-        t: &Tri,
-        it: &Interpolator,
+        tri: (&Tri, &Interpolator),
         frag: Fragment,
-        (px, py): (i32, i32),
-        grads: [Gradients; 2],
-        footprints: [Option<SizedFootprint>; 2],
+        px: (i32, i32),
+        texture: ([Gradients; 2], [Option<SizedFootprint>; 2]),
         reach: Reach,
     ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
-        let surface = self.surface(t, it, frag, (px, py), grads, footprints, reach);
+        let surface = self.surface(tri, frag, px, texture, reach);
         (
             self.ctx.shade(&surface),
             surface.view_depth,
@@ -735,16 +773,15 @@ impl<'a> FrameData<'a> {
         )
     }
 
-    /// The surface of triangle `t` at a fragment, as shading sees it.
-    #[allow(clippy::too_many_arguments)]
+    /// The surface of triangle `t` (interpolated by `it`) at a fragment,
+    /// as shading sees it, with the texture derivatives `grads` and the
+    /// filter footprints already known for them.
     fn surface(
         &self,
-        t: &Tri,
-        it: &Interpolator,
+        (t, it): (&Tri, &Interpolator),
         frag: Fragment,
         (px, py): (i32, i32),
-        grads: [Gradients; 2],
-        footprints: [Option<SizedFootprint>; 2],
+        (grads, footprints): ([Gradients; 2], [Option<SizedFootprint>; 2]),
         reach: Reach,
     ) -> Surface<'_> {
         let ctx = &self.ctx;
@@ -949,4 +986,17 @@ fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
         }
     }
     best
+}
+
+/// Whether no triangle covers any sample of band pixel `i`.
+#[inline]
+fn empty(vis: &Visibility, i: usize) -> bool {
+    let n = vis.samples();
+    if n == 1 {
+        vis.id()[i] == NO_TRIANGLE
+    } else {
+        vis.id()[i * n..(i + 1) * n]
+            .iter()
+            .all(|&id| id == NO_TRIANGLE)
+    }
 }

@@ -67,18 +67,16 @@ pub(super) struct Paths {
 }
 
 impl<'a> FrameData<'a> {
-    /// `grads`: the texture filter reads derivatives (trilinear,
-    /// anisotropic). `paths`: shade the materials that allow it four
+    /// `verts` and `geo`: the frame's vertex and geometry passes.
+    /// `pattern`: the sample offsets; `grads`: the texture filter reads
+    /// derivatives (trilinear, anisotropic). `paths`: shade the materials that allow it four
     /// fragments at a time (`shade::lanes`), skip lights per tile
     /// (`light_tiles`); the same pixels either way.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         fs: &'a FrameSetup<'a>,
         ctx: ShadeContext<'a>,
-        verts: &'a [ModelVertices],
-        geo: &'a Geometry,
-        pattern: &'static [(i8, i8)],
-        grads: bool,
+        (verts, geo): (&'a [ModelVertices], &'a Geometry),
+        (pattern, grads): (&'static [(i8, i8)], bool),
         tracer: Option<&'a Tracer<'a>>,
         paths: Paths,
     ) -> FrameData<'a> {

@@ -122,8 +122,7 @@ pub(super) fn setup_and_bin(
             let (tris, density) = setup_range(
                 fs,
                 (mv, &corners[d.model]),
-                d,
-                di,
+                (d, di),
                 start..end,
                 vp,
                 cull,
@@ -263,12 +262,10 @@ fn corners_all_of(clip: &[Vec4], vp: Viewport) -> Vec<Corner> {
 /// Triangles inside every plane (most of them) are set up from their
 /// corners' projections, which is what `clip_triangle` and `setup` would
 /// give them; only the others are clipped.
-#[allow(clippy::too_many_arguments)]
 fn setup_range(
     fs: &FrameSetup,
     (mv, corners): (&ModelVertices, &[Corner]),
-    d: Draw,
-    di: usize,
+    (d, di): (Draw, usize),
     prims: std::ops::Range<u32>,
     vp: Viewport,
     cull: CullMode,

@@ -450,10 +450,8 @@ impl Renderer {
         let mut data = fragment::FrameData::new(
             fs,
             ctx,
-            &verts,
-            &geo,
-            pattern,
-            filtered,
+            (&verts, &geo),
+            (pattern, filtered),
             tracer.as_ref(),
             fragment::Paths {
                 lanes: self.lanes,

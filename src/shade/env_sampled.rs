@@ -182,13 +182,10 @@ fn ggx_d(ndh: f32, a: f32) -> f32 {
 /// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
 /// `ng` for the rays' offset) from the environment, `samples` pairs of
 /// directions, with visibility through `tracer`.
-#[allow(clippy::too_many_arguments)]
 pub fn radiance(
     env: &EnvSampler,
     tracer: &Tracer,
-    p: Vec3,
-    n: Vec3,
-    ng: Vec3,
+    (p, n, ng): (Vec3, Vec3, Vec3),
     v: Vec3,
     lobes: &Lobes,
     samples: u32,

@@ -255,7 +255,7 @@ impl ShadeContext<'_> {
         if let Some((e, tracer, samples)) = self.env_sampled {
             let lobes = env_sampled::Lobes::Pbr(&c);
             let l =
-                env_sampled::radiance(e, tracer, s.position, n, s.geo_normal, v, &lobes, samples);
+                env_sampled::radiance(e, tracer, (s.position, n, s.geo_normal), v, &lobes, samples);
             return direct + l * c.occlusion;
         }
         match self.env {
@@ -289,7 +289,7 @@ impl ShadeContext<'_> {
                 ks: c.ks,
                 roughness,
             };
-            return env_sampled::radiance(e, tracer, position, n, geo_normal, v, &lobes, samples);
+            return env_sampled::radiance(e, tracer, (position, n, geo_normal), v, &lobes, samples);
         }
         let diffuse = c.kd * env.irradiance(n) * (ao / std::f32::consts::PI);
         if c.ks == Vec3::ZERO {

@@ -321,22 +321,19 @@ impl Shadows<'_> {
                 (fx, fy, z, gx, gy, near * t / (d * d))
             }
         };
-        self.filtered(m, fx, fy, z, gx, gy, z_per_texel)
+        self.filtered(m, (fx, fy), z, (gx, gy), z_per_texel)
     }
 
     /// The lookup at texel coordinates (`fx`, `fy`) of the receiver's
     /// plane (depth `z` there, `gx`, `gy` per texel, capped at
     /// `z_per_texel` times the slope cap), by the filter.
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     fn filtered(
         &self,
         m: &ShadowMap,
-        fx: f32,
-        fy: f32,
+        (fx, fy): (f32, f32),
         z: f32,
-        gx: f32,
-        gy: f32,
+        (gx, gy): (f32, f32),
         z_per_texel: f32,
     ) -> f32 {
         let size = m.size as f32;
@@ -383,7 +380,7 @@ impl Shadows<'_> {
                 } else if d[k] < near {
                     1.0
                 } else {
-                    self.filtered(m, fx[k], fy[k], z[k], gx[k], gy[k], z_per_texel)
+                    self.filtered(m, (fx[k], fy[k]), z[k], (gx[k], gy[k]), z_per_texel)
                 };
             }
             return out;

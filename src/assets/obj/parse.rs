@@ -85,18 +85,7 @@ pub fn parse(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<ObjF
         let err = |msg: String| Error::asset(path, Some(line_no), format!("{msg}: `{line}`"));
         match tag {
             "v" => {
-                let n = numbers(rest).map_err(|w| err(format!("`{w}` is not a number")))?;
-                let (p, c) = match n.len() {
-                    3 | 4 => (Vec3::new(n[0], n[1], n[2]), None),
-                    6 | 7 => (
-                        Vec3::new(n[0], n[1], n[2]),
-                        Some(Vec3::new(n[3], n[4], n[5])),
-                    ),
-                    _ => return Err(err("expected three numbers after v (or x y z r g b)".into())),
-                };
-                if !p.is_finite() {
-                    return Err(err("a vertex position is not finite".into()));
-                }
+                let (p, c) = vertex(rest).map_err(err)?;
                 f.positions.push(p);
                 f.colors.push(c.filter(|c| c.is_finite()));
             }
@@ -117,12 +106,7 @@ pub fn parse(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<ObjF
                 f.normals.push(Vec3::new(n[0], n[1], n[2]));
             }
             "f" | "fo" => {
-                let start = f.corners.len() as u32;
-                for word in rest.split_whitespace() {
-                    let c = corner(word, &f).map_err(err)?;
-                    f.corners.push(c);
-                }
-                let len = f.corners.len() as u32 - start;
+                let (start, len) = corners(rest, &mut f).map_err(err)?;
                 if len < 3 {
                     f.corners.truncate(start as usize);
                     warnings.push(format!(
@@ -138,12 +122,7 @@ pub fn parse(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<ObjF
                 });
             }
             "p" | "l" => {
-                let start = f.corners.len() as u32;
-                for word in rest.split_whitespace() {
-                    let c = corner(word, &f).map_err(err)?;
-                    f.corners.push(c);
-                }
-                let len = f.corners.len() as u32 - start;
+                let (start, len) = corners(rest, &mut f).map_err(err)?;
                 let (list, min) = if tag == "p" {
                     (&mut f.points, 1)
                 } else {
@@ -195,6 +174,34 @@ pub fn parse(path: &Path, text: &str, warnings: &mut Vec<String>) -> Result<ObjF
         warnings.push(format!("{}:{line}: {what}", path.display()));
     }
     Ok(f)
+}
+
+/// A `v` statement's position and, where it has one, vertex colour.
+fn vertex(rest: &str) -> Result<(Vec3, Option<Vec3>), String> {
+    let n = numbers(rest).map_err(|w| format!("`{w}` is not a number"))?;
+    let (p, c) = match n.len() {
+        3 | 4 => (Vec3::new(n[0], n[1], n[2]), None),
+        6 | 7 => (
+            Vec3::new(n[0], n[1], n[2]),
+            Some(Vec3::new(n[3], n[4], n[5])),
+        ),
+        _ => return Err("expected three numbers after v (or x y z r g b)".into()),
+    };
+    if !p.is_finite() {
+        return Err("a vertex position is not finite".into());
+    }
+    Ok((p, c))
+}
+
+/// The corners of a face, point or line statement appended to
+/// `f.corners`: where they start, and how many.
+fn corners(rest: &str, f: &mut ObjFile) -> Result<(u32, u32), String> {
+    let start = f.corners.len() as u32;
+    for word in rest.split_whitespace() {
+        let c = corner(word, f)?;
+        f.corners.push(c);
+    }
+    Ok((start, f.corners.len() as u32 - start))
 }
 
 /// Lines with `\` continuations joined, each with its 1-based number (the

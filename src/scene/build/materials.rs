@@ -295,6 +295,36 @@ pub fn to_material(src: &SourceMaterial, tex: &TextureLookup) -> Material {
     }
 }
 
+/// An MTL material's alpha mode: the scene's where it gives one; else a
+/// constant opacity below 1 blends, and an alpha channel (of map_d, else
+/// map_Kd) that is (almost) all-or-nothing is a cutout, a gradual one
+/// blends.
+fn mtl_alpha(
+    x: &MtlSource,
+    opacity: f32,
+    map_d: &Option<TextureRef>,
+    map_kd: &Option<TextureRef>,
+) -> AlphaMode {
+    let alpha_texture = map_d
+        .iter()
+        .chain(map_kd.iter())
+        .find(|t| t.texture.has_alpha);
+    let cutoff = x.alpha_cutoff.unwrap_or(0.5);
+    match x.alpha_mode {
+        Some(AlphaModeDesc::Opaque) => AlphaMode::Opaque,
+        Some(AlphaModeDesc::Mask) => AlphaMode::Mask(cutoff),
+        Some(AlphaModeDesc::Blend) => AlphaMode::Blend,
+        None if opacity < 1.0 => AlphaMode::Blend,
+        None => match alpha_texture {
+            Some(t) if t.texture.binary_alpha >= 0.9 => AlphaMode::Mask(cutoff),
+            Some(_) => AlphaMode::Blend,
+            // A grey map_d without alpha channel: its red channel.
+            None if map_d.is_some() => AlphaMode::Blend,
+            None => AlphaMode::Opaque,
+        },
+    }
+}
+
 fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
     let m = &x.mtl;
     let tex = |map: &Option<MapSpec>, srgb: bool| -> Option<TextureRef> {
@@ -338,26 +368,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
     } else {
         None
     };
-    // Opacity: a constant below 1 blends; an alpha channel that is (almost)
-    // all-or-nothing is a cutout, a gradual one blends.
-    let alpha_texture = map_d
-        .iter()
-        .chain(map_kd.iter())
-        .find(|t| t.texture.has_alpha);
-    let cutoff = x.alpha_cutoff.unwrap_or(0.5);
-    let alpha = match x.alpha_mode {
-        Some(AlphaModeDesc::Opaque) => AlphaMode::Opaque,
-        Some(AlphaModeDesc::Mask) => AlphaMode::Mask(cutoff),
-        Some(AlphaModeDesc::Blend) => AlphaMode::Blend,
-        None if opacity < 1.0 => AlphaMode::Blend,
-        None => match alpha_texture {
-            Some(t) if t.texture.binary_alpha >= 0.9 => AlphaMode::Mask(cutoff),
-            Some(_) => AlphaMode::Blend,
-            // A grey map_d without alpha channel: its red channel.
-            None if map_d.is_some() => AlphaMode::Blend,
-            None => AlphaMode::Opaque,
-        },
-    };
+    let alpha = mtl_alpha(x, opacity, &map_d, &map_kd);
     let kd = constant(m.kd, &m.map_kd, d.kd);
     let ke = constant(m.ke, &m.map_ke, Vec3::ZERO);
     let ns = m.ns.unwrap_or(d.ns);

@@ -270,7 +270,6 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
     Ok(rows)
 }
 
-#[allow(clippy::too_many_arguments)]
 fn row(
     knob: Knob,
     setting: impl Into<String>,
