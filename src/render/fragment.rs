@@ -2,7 +2,7 @@
 //! pixel: the frame's data (`FrameData`, built once per frame: set-up,
 //! shading context, vertices, draws, per-draw lane materials, the
 //! backgrounds) and the sink that takes shaded fragments
-//! (`Sink`, `Part`, `resolve`). The band loop (`band`) and the four-lane
+//! (`Sink`, `Part`, `resolve`). The band loop (`band`) and the lane
 //! shading (`lanes`) both build on it; it depends on neither.
 
 use glam::{Vec3, Vec4};
@@ -45,7 +45,7 @@ pub(super) struct FrameData<'a> {
     /// Shading reads the triangle's plane normal (flat shading, shadows,
     /// AO); otherwise it is not computed.
     pub geo_normal: bool,
-    /// Per draw: its material prepared for shading four fragments at a
+    /// Per draw: its material prepared for shading a lane group at a
     /// time, or None (the one-fragment path).
     pub lanes: Vec<Option<LaneMaterial<'a>>>,
     /// Per-tile light culling, where some light can be culled.
@@ -58,7 +58,7 @@ pub(super) struct FrameData<'a> {
 /// off only to compare).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Paths {
-    /// Shade the materials that allow it four fragments at a time.
+    /// Shade the materials that allow it a lane group at a time.
     pub lanes: bool,
     /// Skip per tile the lights that cannot reach it.
     pub light_culling: bool,

@@ -98,7 +98,7 @@ pub struct Renderer {
     /// The last camera's environment backdrop (reused while the view
     /// stays).
     backdrops: backdrop::BackdropCache,
-    /// Shade the materials that allow it four fragments at a time
+    /// Shade the materials that allow it a lane group at a time
     /// (`shade::lanes`); off only to compare the two paths.
     lanes: bool,
     /// Skip, per tile, the lights that cannot reach it (`light_tiles`);

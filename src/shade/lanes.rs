@@ -1,18 +1,21 @@
-//! Shading four fragments at once: what `ShadeContext::shade` gives a
-//! material, computed on four lanes with the operations of the
-//! one-fragment code in the same order, so each lane is bit for bit that
-//! code's answer.
+//! Shading a lane group of fragments at once: what `ShadeContext::shade`
+//! gives a material, written once over the lane type `L` (`simd::Lane`:
+//! one, four or eight lanes) with the operations of the one-fragment code
+//! in the same order, so each lane is bit for bit that code's answer at
+//! every width.
 //!
 //! The renderer shades the visible fragments of a band this way wherever
 //! `ShadeContext::lane_material` accepts the material: Blinn-Phong
 //! (`blinn_phong4`, textured OBJ models) and metallic-roughness without
-//! the KHR layers (`pbr4`, most glTF models). Everything else (the data
-//! views, flat and Gouraud shading, unlit, clearcoat, sheen,
+//! the KHR layers but a constant clearcoat (`pbr4`, most glTF models).
+//! Everything else (the data views, flat and Gouraud shading, unlit, a
+//! clearcoat with maps, sheen, specular,
 //! transmission, iridescence, bump and object-space normal maps, texture
 //! transforms, the sampled environment) takes the one-fragment path. The
-//! lanes of one call share a material but not a triangle: texture
-//! lookups, interpolation and lighting run four-wide; texel loads,
-//! shadow lookups, powers and some environment lookups per lane.
+//! lanes of one call share a material but not a triangle: interpolation
+//! and lighting run `L`-wide; texture lookups, shadow-map lookups and
+//! powers four lanes at a time (`Lane::quad`); texel loads and some
+//! environment lookups per lane.
 //!
 //! This module holds what both kinds share: the material's maps prepared
 //! for four lookups, the interpolated fragments (`Lanes`), the lights'
@@ -636,7 +639,13 @@ mod tests {
             roughness_map: None,
             normal_map: None,
         });
-        assert_eq!(kind(&auto, &coat), None);
+        // A constant clearcoat is shaded in lanes; one with a map is not.
+        assert_eq!(kind(&auto, &coat), Some(("pbr", true)));
+        let mut coat_map = coat.clone();
+        if let Some(k) = &mut coat_map.pbr.clearcoat {
+            k.roughness_map = Some(map(16));
+        }
+        assert_eq!(kind(&auto, &coat_map), None);
         let mut unlit = gltf.clone();
         unlit.unlit = true;
         assert_eq!(kind(&auto, &unlit), None);

@@ -86,7 +86,7 @@ pub struct Coat {
 }
 
 /// The coat's reflectance at normal incidence (ior 1.5).
-const COAT_F0: f32 = 0.04;
+pub(super) const COAT_F0: f32 = 0.04;
 
 impl Coat {
     /// The share of the light below that the layer reflects away, towards

@@ -1,8 +1,9 @@
-//! Metallic-roughness shading of four fragments at once (see
+//! Metallic-roughness shading of a lane group of fragments at once (see
 //! `shade::lanes`): what `ShadeContext::shade` gives a pbr material
-//! without the KHR layers (base colour, metallic-roughness, occlusion,
-//! emissive and tangent-space normal maps, every light kind and shadow,
-//! ambient, the prefiltered environment), each lane bit for bit the
+//! without the KHR layers but a clearcoat of constant factor and
+//! roughness (base colour, metallic-roughness, occlusion, emissive and
+//! tangent-space normal maps, every light kind and shadow, ambient, the
+//! prefiltered environment), each lane bit for bit the
 //! one-fragment code's answer (`pbr::radiance`, `pbr::environment`).
 //! Exponentials, the environment's BRDF table and its prefiltered levels
 //! (whose roughness differs from lane to lane) are looked up per lane.
@@ -14,14 +15,15 @@ use glam::Vec3;
 use super::ShadeContext;
 use super::env::{EnvLight, dominant_direction_lanes};
 use super::lanes::{Kind, Lanes, Lit, Lookups, MAX_LANES, MapSet, PbrMaps, same_lookup};
-use super::pbr::{MIN_ALPHA, specular_occlusion};
+use super::pbr::{COAT_F0, MIN_ALPHA, specular_occlusion};
 use crate::scene::Material;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 impl<'a> Kind<'a> {
     /// A metallic-roughness material's maps, or None where the lanes do
     /// not take it (separate roughness or metallic maps, a specular,
-    /// clearcoat, transmission, sheen or iridescence layer).
+    /// transmission, sheen or iridescence layer, a clearcoat with maps of
+    /// its own).
     pub(super) fn pbr(
         m: &'a Material,
         maps: &mut MapSet<'_, 'a>,
@@ -31,7 +33,9 @@ impl<'a> Kind<'a> {
         if p.roughness_map.is_some()
             || p.metallic_map.is_some()
             || p.specular.is_some()
-            || p.clearcoat.is_some()
+            || p.clearcoat.as_ref().is_some_and(|k| {
+                k.map.is_some() || k.roughness_map.is_some() || k.normal_map.is_some()
+            })
             || p.transmission.is_some()
             || p.sheen.is_some()
             || p.iridescence.is_some()
@@ -62,6 +66,39 @@ impl<'a> Kind<'a> {
 fn pow5<L: Lane>(x: L) -> L {
     let x2 = x * x;
     x * (x2 * x2)
+}
+
+/// A clearcoat of constant factor and roughness over the lanes' points,
+/// about the interpolated normals (`pbr::Coat`).
+struct Coat<L: Lane> {
+    /// In (0, 1].
+    factor: f32,
+    roughness: f32,
+    normal: V3<L>,
+}
+
+impl<L: Lane> Coat<L> {
+    /// `pbr::Coat::weight`: factor times the layer's Fresnel at n.v.
+    #[inline(always)]
+    fn weight(&self, v: V3<L>) -> L {
+        let one = L::splat(1.0);
+        let ndv = self.normal.dot(v).abs().min(one);
+        L::splat(self.factor) * (L::splat(COAT_F0) + L::splat(1.0 - COAT_F0) * pow5(one - ndv))
+    }
+
+    /// `pbr::Coat::f_cos`: the layer's BRDF times its cosine, times
+    /// factor, for light from `l` (zero where the layer faces away).
+    #[inline(always)]
+    fn f_cos(&self, v: V3<L>, l: V3<L>) -> L {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let nc = self.normal;
+        let ndl = nc.dot(l);
+        let h = (l + v).normalize_or(V3::zero());
+        let fresnel = L::splat(COAT_F0) + L::splat(1.0 - COAT_F0) * pow5(one - v.dot(h).abs());
+        let a = (self.roughness * self.roughness).max(MIN_ALPHA);
+        let f = L::splat(self.factor) * fresnel * d_vis(nc, v, h, ndl, L::splat(a * a)) * ndl;
+        L::select(ndl.cmple(zero), zero, f)
+    }
 }
 
 /// Metallic-roughness points, one per lane, as `PbrColor` holds one
@@ -140,6 +177,22 @@ impl<'a> ShadeContext<'a> {
             Some((map, scale)) => self.normal_map_lanes(f, lookups.read(map), *scale),
             None => f.normal,
         };
+        // `pbr_color`'s clearcoat (no maps: factor and roughness times 1).
+        let coat = p.clearcoat.as_ref().and_then(|k| {
+            let factor = (k.factor * 1.0).clamp(0.0, 1.0);
+            (factor > 0.0).then(|| Coat {
+                factor,
+                roughness: (k.roughness * 1.0).clamp(0.0, 1.0),
+                normal: f.normal,
+            })
+        });
+        if let Some(coat) = &coat {
+            let out = self.coated_radiance(f, [n, v], &c, coat, emissive);
+            return match self.env {
+                Some(env) => out + coated_environment(env, [n, v], &c, coat, f.ao),
+                None => out,
+            };
+        }
         // `pbr::radiance`.
         let mut out = emissive;
         f.light_set(self.lights).for_each(|i, light| {
@@ -168,6 +221,101 @@ impl<'a> ShadeContext<'a> {
             None => out,
         }
     }
+}
+
+impl ShadeContext<'_> {
+    /// `pbr::layered_radiance` with a clearcoat (and no sheen) at the
+    /// lanes' points, normals and view vectors `[n, v]`: each light through
+    /// `f_cos`, the base's ambient term and the emission under the coat,
+    /// plus the coat's ambient term.
+    #[inline(always)]
+    fn coated_radiance<L: Lane>(
+        &self,
+        f: &Lanes<'_, L>,
+        [n, v]: [V3<L>; 2],
+        c: &Color<L>,
+        coat: &Coat<L>,
+        emissive: V3<L>,
+    ) -> V3<L> {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let w = coat.weight(v);
+        let mut direct = V3::zero();
+        f.light_set(self.lights).for_each(|i, light| {
+            let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
+            if lit.any() {
+                // `f_cos`: the base under the coat, plus the coat, over
+                // n.l (e carries n.l).
+                let base = brdf(n, v, l, ndl, c).scale(ndl.max(zero));
+                let layered = base.scale(one - w) + splat3(coat.f_cos(v, l));
+                let added = direct + e * (layered / ndl);
+                direct = V3::select(lit, added, direct);
+            }
+        });
+        let ndv = n.dot(v).abs();
+        let ambient = V3::splat(self.ambient).scale(f.ao);
+        let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
+        let mut under = V3::zero();
+        if some_ambient.any() {
+            let (a, b) = env_brdf(c.roughness, ndv);
+            let spec = split_sum(c, a, b);
+            let spec = V3 {
+                x: clamp01(spec.x),
+                y: clamp01(spec.y),
+                z: clamp01(spec.z),
+            };
+            let ones = V3::splat(Vec3::ONE);
+            // c_diff (1 - transmission), transmission 0.
+            let c_diff = c.c_diff.scale(one - zero);
+            let lit = ambient.scale(c.occlusion) * (c_diff * (ones - spec) + spec);
+            under = V3::select(some_ambient, lit, under);
+        }
+        under = under + emissive;
+        under = under.scale(one - w);
+        if some_ambient.any() {
+            // `specular_albedo` of F0 0.04 (F90 1) at the coat's n.v.
+            let (a, b) = env_brdf(L::splat(coat.roughness), coat.normal.dot(v).abs());
+            let s = clamp01(L::splat(COAT_F0) * a + b * one);
+            let added =
+                under + (ambient.scale(c.occlusion) * splat3(s)).scale(L::splat(coat.factor));
+            under = V3::select(some_ambient, added, under);
+        }
+        under + direct
+    }
+}
+
+/// The same value in x, y and z.
+#[inline(always)]
+fn splat3<L: Lane>(x: L) -> V3<L> {
+    V3 { x, y: x, z: x }
+}
+
+/// `pbr::environment` with a clearcoat (and no sheen) at the lanes'
+/// points, normals and view vectors `[n, v]`: the base under the coat,
+/// plus the coat's prefiltered lobe about its normal.
+#[inline(always)]
+fn coated_environment<L: Lane>(
+    env: &EnvLight,
+    [n, v]: [V3<L>; 2],
+    c: &Color<L>,
+    coat: &Coat<L>,
+    ao: L,
+) -> V3<L> {
+    let base = environment(env, n, v, c, ao);
+    let nc = coat.normal;
+    let ndv = nc.dot(v).abs().max(L::splat(1e-4));
+    let (mut a, mut b) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
+    for k in 0..L::WIDTH {
+        let ab = env.brdf(ndv.lane(k), coat.roughness);
+        (a[k], b[k]) = (ab.x, ab.y);
+    }
+    let (a, b) = (L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
+    let r = nc.scale(L::splat(2.0) * nc.dot(v)) - v;
+    let r = dominant_direction_lanes(nc, r, L::splat(coat.roughness));
+    let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), coat.roughness));
+    let layer = env
+        .prefiltered_lanes(r, coat.roughness)
+        .scale((L::splat(COAT_F0) * a + b) * so);
+    base.scale(L::splat(1.0) - coat.weight(v)) + layer.scale(L::splat(coat.factor) * c.occlusion)
 }
 
 /// `pbr::brdf` at the lanes' points, for unit light directions `l` with

@@ -1,13 +1,14 @@
-//! The wide types of the renderer's four-lane code (shading four
-//! fragments at a time, `shade::lanes`, and its texture lookups):
-//! four f32 lanes are glam's `Vec4` (SSE on x86-64), `V3` is four
-//! 3-vectors as a structure of arrays, and the few operations glam does
-//! not offer (lanes from scalars without a trip through memory, whole
-//! numbers and bytes to and from lanes) are here, with a scalar fallback
-//! elsewhere. Every operation is the scalar one lane by lane, in the same
-//! order (IEEE operations on SSE lanes round as scalar ones do, and Rust
-//! never fuses a multiply and an add), so four-lane code can give the
-//! one-lane code's results bit for bit.
+//! The wide types of the renderer's lane code (shading a group of
+//! fragments at a time, `shade::lanes`, and its texture lookups): the
+//! lane type `Lane` (`lane`: one f32, four as glam's `Vec4`, eight as
+//! `F8`), `V3<L>` for 3-vectors as a structure of arrays, the lane widths
+//! this build has (`widths`, `SOFTRASTER_LANES`), and the few four-lane
+//! operations glam does not offer (lanes from scalars without a trip
+//! through memory, whole numbers and bytes to and from lanes), with a
+//! scalar fallback elsewhere. Every operation is the scalar one lane by
+//! lane, in the same order (IEEE operations on SIMD lanes round as scalar
+//! ones do, and Rust never fuses a multiply and an add), so lane code
+//! gives the one-lane code's results bit for bit at every width.
 
 // Loops over the four lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
