@@ -43,6 +43,8 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use crate::simd::V3;
+
 use super::env::EnvLight;
 pub use super::iridescence::Iridescence;
 use super::light::{LightSet, for_each_lit};
@@ -93,22 +95,23 @@ impl Coat {
     /// `v`: factor times Schlick's Fresnel at nc.v.
     #[inline]
     pub fn weight(&self, v: Vec3) -> f32 {
-        let ndv = self.normal.dot(v).abs().min(1.0);
-        self.factor * (COAT_F0 + (1.0 - COAT_F0) * (1.0 - ndv).powi(5))
+        self.lanes().weight(V3::from(v))
     }
 
     /// The layer's BRDF times its cosine, times factor, for light from `l`.
     #[inline]
     pub fn f_cos(&self, v: Vec3, l: Vec3) -> f32 {
-        let nc = self.normal;
-        let ndl = nc.dot(l);
-        if ndl <= 0.0 {
-            return 0.0;
+        self.lanes().f_cos(V3::from(v), V3::from(l))
+    }
+
+    /// The layer as the lanes hold it (one lane: this code is theirs).
+    #[inline(always)]
+    fn lanes(&self) -> super::pbr4::Coat<f32> {
+        super::pbr4::Coat {
+            factor: self.factor,
+            roughness: self.roughness,
+            normal: V3::from(self.normal),
         }
-        let h = (l + v).normalize_or_zero();
-        let fresnel = COAT_F0 + (1.0 - COAT_F0) * (1.0 - v.dot(h).abs()).powi(5);
-        let a = (self.roughness * self.roughness).max(MIN_ALPHA);
-        self.factor * fresnel * d_vis(nc, v, l, ndl, a * a) * ndl
     }
 }
 
@@ -196,23 +199,12 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     (Vec3::ONE - fresnel) * diffuse / PI + fresnel * d_vis(n, v, l, ndl, a2)
 }
 
-/// GGX's D times the separable Smith visibility, for n.l = `ndl` > 0.
+/// GGX's D times the separable Smith visibility, for n.l = `ndl` > 0
+/// (`pbr4::d_vis` at one lane).
 #[inline(always)]
 fn d_vis(n: Vec3, v: Vec3, l: Vec3, ndl: f32, a2: f32) -> f32 {
-    let ndv = n.dot(v).abs().max(1e-4);
     let h = (l + v).normalize_or_zero();
-    let ndh = n.dot(h);
-    let d = if ndh > 0.0 {
-        let t = ndh * ndh * (a2 - 1.0) + 1.0;
-        a2 / (PI * t * t)
-    } else {
-        0.0
-    };
-    // X(h.l) and X(h.v): h lies between l and v, both above the surface.
-    let vis = 1.0
-        / ((ndl + (a2 + (1.0 - a2) * ndl * ndl).sqrt())
-            * (ndv + (a2 + (1.0 - a2) * ndv * ndv).sqrt()));
-    d * vis
+    super::pbr4::d_vis(V3::from(n), V3::from(v), V3::from(h), ndl, a2)
 }
 
 /// The whole material's f(v, l) cos: the base layer's BRDF times n.l,
@@ -254,18 +246,10 @@ pub fn specular_albedo(f0: Vec3, f90: f32, roughness: f32, ndv: f32) -> Vec3 {
     (f0 * a + Vec3::splat(b * f90)).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
-/// Scale and bias of f0 in the fit.
+/// Scale and bias of f0 in the fit (`pbr4::env_brdf` at one lane).
 #[inline]
 fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
-    let r = roughness.clamp(0.0, 1.0);
-    let (x, y, z, w) = (
-        -r + 1.0,
-        -0.0275 * r + 0.0425,
-        -0.572 * r + 1.04,
-        0.022 * r - 0.04,
-    );
-    let a004 = (x * x).min((-9.28 * ndv.max(0.0)).exp2()) * x + y;
-    (-1.04 * a004 + z, 1.04 * a004 + w)
+    super::pbr4::env_brdf(roughness, ndv)
 }
 
 /// The environment's light reflected towards `v` (the split sum): the

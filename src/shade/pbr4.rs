@@ -70,17 +70,17 @@ fn pow5<L: Lane>(x: L) -> L {
 
 /// A clearcoat of constant factor and roughness over the lanes' points,
 /// about the interpolated normals (`pbr::Coat`).
-struct Coat<L: Lane> {
+pub(super) struct Coat<L: Lane> {
     /// In (0, 1].
-    factor: f32,
-    roughness: f32,
-    normal: V3<L>,
+    pub factor: f32,
+    pub roughness: f32,
+    pub normal: V3<L>,
 }
 
 impl<L: Lane> Coat<L> {
     /// `pbr::Coat::weight`: factor times the layer's Fresnel at n.v.
     #[inline(always)]
-    fn weight(&self, v: V3<L>) -> L {
+    pub fn weight(&self, v: V3<L>) -> L {
         let one = L::splat(1.0);
         let ndv = self.normal.dot(v).abs().min(one);
         L::splat(self.factor) * (L::splat(COAT_F0) + L::splat(1.0 - COAT_F0) * pow5(one - ndv))
@@ -89,7 +89,7 @@ impl<L: Lane> Coat<L> {
     /// `pbr::Coat::f_cos`: the layer's BRDF times its cosine, times
     /// factor, for light from `l` (zero where the layer faces away).
     #[inline(always)]
-    fn f_cos(&self, v: V3<L>, l: V3<L>) -> L {
+    pub fn f_cos(&self, v: V3<L>, l: V3<L>) -> L {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let nc = self.normal;
         let ndl = nc.dot(l);
@@ -330,9 +330,10 @@ fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &Color<L>) -> V3<L> {
     (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(d_vis(n, v, h, ndl, c.a2))
 }
 
-/// `pbr::d_vis`, with the half vector `h` it computes.
+/// GGX's D times the separable Smith visibility for n.l = `ndl` > 0 and
+/// half vector `h`, per lane (`pbr::d_vis` is its one-lane instance).
 #[inline(always)]
-fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
+pub(super) fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
     let ndv = n.dot(v).abs().max(L::splat(1e-4));
     let ndh = n.dot(h);
@@ -351,9 +352,10 @@ fn split_sum<L: Lane>(c: &Color<L>, a: L, b: L) -> V3<L> {
     c.f0.scale(a) + V3 { x: b, y: b, z: b }
 }
 
-/// `pbr::env_brdf` (the analytic fit) at the lanes' points.
+/// The analytic fit of the environment BRDF's scale and bias of f0, per
+/// lane (`pbr::env_brdf` is its one-lane instance).
 #[inline(always)]
-fn env_brdf<L: Lane>(roughness: L, ndv: L) -> (L, L) {
+pub(super) fn env_brdf<L: Lane>(roughness: L, ndv: L) -> (L, L) {
     let r = clamp01(roughness);
     let k = L::splat;
     let (x, y, z, w) = (
