@@ -368,3 +368,81 @@ shadows = true
         }
     }
 }
+
+#[test]
+fn khr_layers_are_the_same_with_and_without_lanes() {
+    // A turned glTF cube whose material has constant KHR layers (specular,
+    // clearcoat, sheen, iridescence: each alone and all together), under
+    // a point and a directional light, ambient, and the studio
+    // environment with SSAO and MSAA 4.
+    let dir = scratch("lanes_khr_layers");
+    let base = r#""pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.1, 0.1, 1.0], "metallicFactor": 0.3, "roughnessFactor": 0.45}"#;
+    let layers = [
+        (
+            "specular",
+            r#""KHR_materials_specular": {"specularFactor": 0.7, "specularColorFactor": [1.0, 0.8, 0.6]}"#,
+        ),
+        (
+            "clearcoat",
+            r#""KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.15}"#,
+        ),
+        (
+            "sheen",
+            r#""KHR_materials_sheen": {"sheenColorFactor": [0.6, 0.6, 0.9], "sheenRoughnessFactor": 0.4}"#,
+        ),
+        (
+            "iridescence",
+            r#""KHR_materials_iridescence": {"iridescenceFactor": 0.9, "iridescenceIor": 1.35, "iridescenceThicknessMaximum": 380}"#,
+        ),
+    ];
+    let all = layers.map(|(_, l)| l).join(", ");
+    let mut cases: Vec<(&str, String)> = layers.iter().map(|(n, l)| (*n, l.to_string())).collect();
+    cases.push(("all", all));
+    let used = r#""KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence""#;
+    for (name, ext) in cases {
+        let (text, _) = common::gltf_text(
+            &common::cube(),
+            r#", "material": 0"#,
+            &format!(
+                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+                "extensionsUsed": [{used}], "materials": [{{{base}, "extensions": {{{ext}}}}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join("c.gltf"), text).unwrap();
+        let scene = scene_in(
+            &dir,
+            r#"
+[output]
+width = 64
+height = 64
+[ambient]
+color = [0.1, 0.1, 0.12]
+[[model]]
+path = "c.gltf"
+[[light]]
+kind = "point"
+position = [1.0, 1.5, 2.0]
+intensity = 4.0
+[[light]]
+kind = "directional"
+direction = [-0.3, -0.5, -1.0]
+irradiance = 0.8
+"#,
+            &[],
+        );
+        same_both_ways(&scene, &[0], &format!("cube, {name}"));
+        let file = dir.join("studio.toml");
+        std::fs::write(
+            &file,
+            "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 4\nao = { method = \"ssao\" }\n\
+             [[model]]\npath = \"c.gltf\"\n[environment]\npreset = \"studio\"\n",
+        )
+        .unwrap();
+        same_both_ways(
+            &load_with(&file, &[]),
+            &[0],
+            &format!("cube, {name}, studio"),
+        );
+    }
+}

@@ -6,11 +6,11 @@
 //!
 //! The renderer shades the visible fragments of a band this way wherever
 //! `ShadeContext::lane_material` accepts the material: Blinn-Phong
-//! (`blinn_phong4`, textured OBJ models) and metallic-roughness without
-//! the KHR layers but a constant clearcoat (`pbr4`, most glTF models).
-//! Everything else (the data views, flat and Gouraud shading, unlit, a
-//! clearcoat with maps, sheen, specular,
-//! transmission, iridescence, bump and object-space normal maps, texture
+//! (`blinn_phong4`, textured OBJ models) and metallic-roughness with the
+//! KHR specular, clearcoat, sheen and iridescence layers of constant
+//! factors (`pbr4`, most glTF models). Everything else (the data views,
+//! flat and Gouraud shading, unlit, layers with maps of their own,
+//! transmission, bump and object-space normal maps, texture
 //! transforms, the sampled environment) takes the one-fragment path. The
 //! lanes of one call share a material but not a triangle: interpolation
 //! and lighting run `L`-wide; texture lookups, shadow-map lookups and

@@ -1,8 +1,8 @@
 //! Metallic-roughness shading of a lane group of fragments at once (see
-//! `shade::lanes`): what `ShadeContext::shade` gives a pbr material
-//! without the KHR layers but a clearcoat of constant factor and
-//! roughness (base colour, metallic-roughness, occlusion, emissive and
-//! tangent-space normal maps, every light kind and shadow, ambient, the
+//! `shade::lanes`): what `ShadeContext::shade` gives a pbr material (base
+//! colour, metallic-roughness, occlusion, emissive and tangent-space
+//! normal maps; the KHR specular, clearcoat, sheen and iridescence layers
+//! of constant factors; every light kind and shadow, ambient, the
 //! prefiltered environment), each lane bit for bit the
 //! one-fragment code's answer (`pbr::radiance`, `pbr::environment`).
 //! Exponentials, the environment's BRDF table and its prefiltered levels
@@ -15,15 +15,15 @@ use glam::Vec3;
 use super::ShadeContext;
 use super::env::{EnvLight, dominant_direction_lanes};
 use super::lanes::{Kind, Lanes, Lit, Lookups, MAX_LANES, MapSet, PbrMaps, same_lookup};
-use super::pbr::{COAT_F0, MIN_ALPHA, specular_occlusion};
+use super::pbr::{COAT_F0, Iridescence, MIN_ALPHA, Sheen, specular_occlusion};
 use crate::scene::Material;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 impl<'a> Kind<'a> {
     /// A metallic-roughness material's maps, or None where the lanes do
-    /// not take it (separate roughness or metallic maps, a specular,
-    /// transmission, sheen or iridescence layer, a clearcoat with maps of
-    /// its own).
+    /// not take it (separate roughness or metallic maps, transmission, a
+    /// specular, clearcoat, sheen or iridescence layer with maps of its
+    /// own).
     pub(super) fn pbr(
         m: &'a Material,
         maps: &mut MapSet<'_, 'a>,
@@ -32,13 +32,19 @@ impl<'a> Kind<'a> {
         let p = &m.pbr;
         if p.roughness_map.is_some()
             || p.metallic_map.is_some()
-            || p.specular.is_some()
+            || p.transmission.is_some()
+            || p.specular
+                .as_ref()
+                .is_some_and(|d| d.color_map.is_some() || d.weight_map.is_some())
             || p.clearcoat.as_ref().is_some_and(|k| {
                 k.map.is_some() || k.roughness_map.is_some() || k.normal_map.is_some()
             })
-            || p.transmission.is_some()
-            || p.sheen.is_some()
-            || p.iridescence.is_some()
+            || p.sheen
+                .as_ref()
+                .is_some_and(|k| k.color_map.is_some() || k.roughness_map.is_some())
+            || p.iridescence
+                .as_ref()
+                .is_some_and(|k| k.map.is_some() || k.thickness_map.is_some())
         {
             return None;
         }
@@ -106,11 +112,15 @@ impl<L: Lane> Coat<L> {
 struct Color<L: Lane> {
     roughness: L,
     occlusion: L,
-    /// `PbrColor::f0` and `c_diff`.
+    /// `PbrColor::f0`, `f90` and `c_diff`.
     f0: V3<L>,
+    f90: L,
     c_diff: V3<L>,
     /// alpha^2 of the GGX lobe.
     a2: L,
+    /// The constant layers (`PbrColor`'s).
+    sheen: Option<Sheen>,
+    iridescence: Option<Iridescence>,
 }
 
 impl<'a> ShadeContext<'a> {
@@ -163,13 +173,35 @@ impl<'a> ShadeContext<'a> {
         let (metallic, roughness) = (clamp01(metallic), clamp01(roughness));
         let alpha = (roughness * roughness).max(L::splat(MIN_ALPHA));
         let keep = one - metallic;
+        // `pbr_color`'s constant layers (their maps' lookups are 1).
+        let dielectric = p.specular.as_ref().map(|d| {
+            let weight = d.weight * 1.0;
+            ((d.f0 * Vec3::ONE).min(Vec3::ONE) * weight, weight)
+        });
+        let (f0, f90) = match dielectric {
+            None => (Vec3::splat(0.04), one),
+            Some((f0, w)) => (f0, L::splat(w) + L::splat(1.0 - w) * metallic),
+        };
         let c = Color {
             roughness,
             occlusion,
-            // `Vec3::lerp`: 0.04 (1 - metallic) + base metallic.
-            f0: V3::splat(Vec3::splat(0.04)).scale(keep) + base.scale(metallic),
+            // `Vec3::lerp`: f0 (1 - metallic) + base metallic.
+            f0: V3::splat(f0).scale(keep) + base.scale(metallic),
+            f90,
             c_diff: base.scale(keep),
             a2: alpha * alpha,
+            sheen: p.sheen.as_ref().map(|k| Sheen {
+                color: k.color * Vec3::ONE,
+                roughness: (k.roughness * 1.0).clamp(0.0, 1.0),
+            }),
+            iridescence: p.iridescence.as_ref().and_then(|k| {
+                let factor = (k.factor * 1.0).clamp(0.0, 1.0);
+                (factor > 0.0).then_some(Iridescence {
+                    factor,
+                    ior: k.ior,
+                    thickness: k.thickness_max,
+                })
+            }),
         };
 
         let v = self.view_lanes(f.position);
@@ -186,10 +218,10 @@ impl<'a> ShadeContext<'a> {
                 normal: f.normal,
             })
         });
-        if let Some(coat) = &coat {
-            let out = self.coated_radiance(f, [n, v], &c, coat, emissive);
+        if coat.is_some() || c.sheen.is_some() {
+            let out = self.layered_radiance(f, [n, v], &c, coat.as_ref(), emissive);
             return match self.env {
-                Some(env) => out + coated_environment(env, [n, v], &c, coat, f.ao),
+                Some(env) => out + layered_environment(env, [n, v], &c, coat.as_ref(), f.ao),
                 None => out,
             };
         }
@@ -205,13 +237,7 @@ impl<'a> ShadeContext<'a> {
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
         if some_ambient.any() {
-            let (a, b) = env_brdf(c.roughness, n.dot(v).abs());
-            let spec = split_sum(&c, a, b);
-            let spec = V3 {
-                x: clamp01(spec.x),
-                y: clamp01(spec.y),
-                z: clamp01(spec.z),
-            };
+            let spec = specular_albedo(&c, n.dot(v).abs());
             let ones = V3::splat(Vec3::ONE);
             let added = out + ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
             out = V3::select(some_ambient, added, out);
@@ -224,60 +250,70 @@ impl<'a> ShadeContext<'a> {
 }
 
 impl ShadeContext<'_> {
-    /// `pbr::layered_radiance` with a clearcoat (and no sheen) at the
-    /// lanes' points, normals and view vectors `[n, v]`: each light through
-    /// `f_cos`, the base's ambient term and the emission under the coat,
-    /// plus the coat's ambient term.
+    /// `pbr::layered_radiance` at the lanes' points, normals and view
+    /// vectors `[n, v]`, with a sheen (`c.sheen`) or a clearcoat `coat`:
+    /// each light through `f_cos`, the base's ambient term scaled by the
+    /// sheen plus the sheen's own, then (with the emission) under the
+    /// coat, plus the coat's ambient term.
     #[inline(always)]
-    fn coated_radiance<L: Lane>(
+    fn layered_radiance<L: Lane>(
         &self,
         f: &Lanes<'_, L>,
         [n, v]: [V3<L>; 2],
         c: &Color<L>,
-        coat: &Coat<L>,
+        coat: Option<&Coat<L>>,
         emissive: V3<L>,
     ) -> V3<L> {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let w = coat.weight(v);
+        let w = coat.map(|k| k.weight(v));
+        let ndv = n.dot(v).abs();
         let mut direct = V3::zero();
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
-                // `f_cos`: the base under the coat, plus the coat, over
-                // n.l (e carries n.l).
-                let base = brdf(n, v, l, ndl, c).scale(ndl.max(zero));
-                let layered = base.scale(one - w) + splat3(coat.f_cos(v, l));
+                // `f_cos` over n.l (e carries n.l).
+                let ndl_0 = ndl.max(zero);
+                let mut base = brdf(n, v, l, ndl, c).scale(ndl_0);
+                if let Some(s) = &c.sheen {
+                    let k = L::from_fn(|k| s.scaling(ndv.lane(k), Some(ndl_0.lane(k))));
+                    let lobe = L::from_fn(|k| s.lobe_cos(n.lane(k), v.lane(k), l.lane(k)));
+                    base = base.scale(k) + V3::splat(s.color).scale(lobe);
+                }
+                let layered = match (coat, w) {
+                    (Some(coat), Some(w)) => base.scale(one - w) + splat3(coat.f_cos(v, l)),
+                    _ => base,
+                };
                 let added = direct + e * (layered / ndl);
                 direct = V3::select(lit, added, direct);
             }
         });
-        let ndv = n.dot(v).abs();
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
         let mut under = V3::zero();
         if some_ambient.any() {
-            let (a, b) = env_brdf(c.roughness, ndv);
-            let spec = split_sum(c, a, b);
-            let spec = V3 {
-                x: clamp01(spec.x),
-                y: clamp01(spec.y),
-                z: clamp01(spec.z),
-            };
+            let spec = specular_albedo(c, ndv);
             let ones = V3::splat(Vec3::ONE);
             // c_diff (1 - transmission), transmission 0.
             let c_diff = c.c_diff.scale(one - zero);
-            let lit = ambient.scale(c.occlusion) * (c_diff * (ones - spec) + spec);
+            let mut lit = ambient.scale(c.occlusion) * (c_diff * (ones - spec) + spec);
+            if let Some(s) = &c.sheen {
+                let k = L::from_fn(|k| s.scaling(ndv.lane(k), None));
+                let own = V3::from_fn(|k| s.reflectance(ndv.lane(k)));
+                lit = lit.scale(k) + ambient.scale(c.occlusion) * own;
+            }
             under = V3::select(some_ambient, lit, under);
         }
         under = under + emissive;
-        under = under.scale(one - w);
-        if some_ambient.any() {
-            // `specular_albedo` of F0 0.04 (F90 1) at the coat's n.v.
-            let (a, b) = env_brdf(L::splat(coat.roughness), coat.normal.dot(v).abs());
-            let s = clamp01(L::splat(COAT_F0) * a + b * one);
-            let added =
-                under + (ambient.scale(c.occlusion) * splat3(s)).scale(L::splat(coat.factor));
-            under = V3::select(some_ambient, added, under);
+        if let (Some(coat), Some(w)) = (coat, w) {
+            under = under.scale(one - w);
+            if some_ambient.any() {
+                // `specular_albedo` of F0 0.04 (F90 1) at the coat's n.v.
+                let (a, b) = env_brdf(L::splat(coat.roughness), coat.normal.dot(v).abs());
+                let s = clamp01(L::splat(COAT_F0) * a + b * one);
+                let added =
+                    under + (ambient.scale(c.occlusion) * splat3(s)).scale(L::splat(coat.factor));
+                under = V3::select(some_ambient, added, under);
+            }
         }
         under + direct
     }
@@ -289,18 +325,29 @@ fn splat3<L: Lane>(x: L) -> V3<L> {
     V3 { x, y: x, z: x }
 }
 
-/// `pbr::environment` with a clearcoat (and no sheen) at the lanes'
-/// points, normals and view vectors `[n, v]`: the base under the coat,
-/// plus the coat's prefiltered lobe about its normal.
+/// `pbr::environment` with a sheen (`c.sheen`) or a clearcoat `coat` at
+/// the lanes' points, normals and view vectors `[n, v]`: the base scaled
+/// by the sheen plus the sheen's lobe, under the coat, plus the coat's
+/// prefiltered lobe about its normal.
 #[inline(always)]
-fn coated_environment<L: Lane>(
+fn layered_environment<L: Lane>(
     env: &EnvLight,
     [n, v]: [V3<L>; 2],
     c: &Color<L>,
-    coat: &Coat<L>,
+    coat: Option<&Coat<L>>,
     ao: L,
 ) -> V3<L> {
-    let base = environment(env, n, v, c, ao);
+    let mut base = environment(env, n, v, c, ao);
+    if let Some(s) = &c.sheen {
+        let ndv = n.dot(v).abs().max(L::splat(1e-4));
+        let irradiance = env.irradiance_lanes(n);
+        let lobe = V3::from_fn(|k| irradiance.lane(k) * (s.reflectance(ndv.lane(k)) / PI));
+        let k = L::from_fn(|k| s.scaling(ndv.lane(k), None));
+        base = base.scale(k) + lobe.scale(ao.min(L::splat(1.0)) * c.occlusion);
+    }
+    let Some(coat) = coat else {
+        return base;
+    };
     let nc = coat.normal;
     let ndv = nc.dot(v).abs().max(L::splat(1e-4));
     let (mut a, mut b) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
@@ -325,8 +372,10 @@ fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &Color<L>) -> V3<L> {
     let h = (l + v).normalize_or(V3::zero());
     let vdh = v.dot(h).abs();
     let one = V3::splat(Vec3::ONE);
-    // F90 = 1 without a dielectric specular.
-    let fresnel = c.f0 + (one - c.f0).scale(pow5(L::splat(1.0) - vdh));
+    let mut fresnel = c.f0 + (splat3(c.f90) - c.f0).scale(pow5(L::splat(1.0) - vdh));
+    if let Some(film) = &c.iridescence {
+        fresnel = V3::from_fn(|k| film.blend(fresnel.lane(k), vdh.lane(k), c.f0.lane(k)));
+    }
     (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(d_vis(n, v, h, ndl, c.a2))
 }
 
@@ -345,11 +394,31 @@ pub(super) fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
     d * vis
 }
 
-/// `PbrColor::split_sum` without a film: f0 a + b (F90 1).
+/// `PbrColor::split_sum`: f0 a + f90 b, with a film blended towards its
+/// Fresnel at n.v = `ndv` times the lobe's albedo a + b.
 #[inline(always)]
-fn split_sum<L: Lane>(c: &Color<L>, a: L, b: L) -> V3<L> {
-    let b = b * L::splat(1.0);
-    c.f0.scale(a) + V3 { x: b, y: b, z: b }
+fn split_sum<L: Lane>(c: &Color<L>, ndv: L, a: L, b: L) -> V3<L> {
+    let s = c.f0.scale(a) + splat3(b * c.f90);
+    match &c.iridescence {
+        Some(film) => V3::from_fn(|k| {
+            let f = film.fresnel(ndv.lane(k), c.f0.lane(k)).min(Vec3::ONE);
+            s.lane(k).lerp(f * (a.lane(k) + b.lane(k)), film.factor)
+        }),
+        None => s,
+    }
+}
+
+/// `PbrColor::specular_albedo` at n.v = `ndv`: the split sum of the
+/// analytic fit, clamped to [0, 1].
+#[inline(always)]
+fn specular_albedo<L: Lane>(c: &Color<L>, ndv: L) -> V3<L> {
+    let (a, b) = env_brdf(c.roughness, ndv);
+    let spec = split_sum(c, ndv, a, b);
+    V3 {
+        x: clamp01(spec.x),
+        y: clamp01(spec.y),
+        z: clamp01(spec.z),
+    }
 }
 
 /// The analytic fit of the environment BRDF's scale and bias of f0, per
@@ -369,8 +438,8 @@ pub(super) fn env_brdf<L: Lane>(roughness: L, ndv: L) -> (L, L) {
     (k(-1.04) * a004 + z, k(1.04) * a004 + w)
 }
 
-/// `pbr::environment` at the lanes' points (no sheen, clearcoat or
-/// iridescence).
+/// `pbr::environment` at the lanes' points, without the sheen and the
+/// clearcoat (`layered_environment` adds them).
 #[inline(always)]
 fn environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &Color<L>, ao: L) -> V3<L> {
     let ndv = n.dot(v).abs().max(L::splat(1e-4));
@@ -379,7 +448,7 @@ fn environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &Color<L>, ao: L)
         let ab = env.brdf(ndv.lane(k), c.roughness.lane(k));
         (a[k], b[k]) = (ab.x, ab.y);
     }
-    let spec = split_sum(c, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
+    let spec = split_sum(c, ndv, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
     let one = V3::splat(Vec3::ONE);
     let diffuse = (c.c_diff * (one - spec) * env.irradiance_lanes(n)).scale(ao / L::splat(PI));
     let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
@@ -458,13 +527,16 @@ mod tests {
                 roughness,
                 occlusion: Vec4::ONE,
                 f0: V3::splat(Vec3::splat(0.04)).scale(keep) + base.scale(metallic),
+                f90: Vec4::ONE,
                 c_diff: base.scale(keep),
                 a2: alpha * alpha,
+                sheen: None,
+                iridescence: None,
             };
             let ndl = n.dot(l);
             let got = brdf(n, v, l, ndl, &c);
             let (a, b) = env_brdf(roughness, n.dot(v).abs());
-            let albedo = split_sum(&c, a, b);
+            let albedo = split_sum(&c, n.dot(v).abs(), a, b);
             for k in 0..4 {
                 let (n, v, l, color) = &lanes[k];
                 if n.dot(*l) <= 0.0 {
