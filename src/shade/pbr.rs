@@ -153,14 +153,27 @@ impl PbrColor {
     /// Fresnel at n.v = `ndv` times the lobe's albedo A + B.
     #[inline]
     pub fn split_sum(&self, ndv: f32, a: f32, b: f32) -> Vec3 {
-        let f0 = self.f0();
-        let s = f0 * a + Vec3::splat(b * self.f90());
-        match &self.iridescence {
-            Some(film) if film.factor > 0.0 => {
-                let f = film.fresnel(ndv, f0).min(Vec3::ONE);
-                s.lerp(f * (a + b), film.factor)
-            }
-            _ => s,
+        super::pbr4::split_sum(&self.lanes(), ndv, a, b).into()
+    }
+
+    /// The point as the lanes hold one (one lane: their code is this
+    /// code), the diffuse colour with the transmitted share taken out.
+    #[inline(always)]
+    fn lanes(&self) -> super::pbr4::Color<f32> {
+        let alpha = self.alpha();
+        super::pbr4::Color {
+            roughness: self.roughness,
+            occlusion: self.occlusion,
+            f0: V3::from(self.f0()),
+            f90: self.f90(),
+            c_diff: V3::from(if self.transmission > 0.0 {
+                self.c_diff() * (1.0 - self.transmission)
+            } else {
+                self.c_diff()
+            }),
+            a2: alpha * alpha,
+            sheen: self.sheen,
+            iridescence: self.iridescence.filter(|f| f.factor > 0.0),
         }
     }
 
@@ -183,28 +196,8 @@ pub fn brdf(n: Vec3, v: Vec3, l: Vec3, c: &PbrColor) -> Vec3 {
     if ndl <= 0.0 {
         return Vec3::ZERO;
     }
-    let h = (l + v).normalize_or_zero();
-    let vdh = v.dot(h).abs();
-    let a2 = c.alpha() * c.alpha();
-    let f0 = c.f0();
-    let mut fresnel = f0 + (Vec3::splat(c.f90()) - f0) * (1.0 - vdh).powi(5);
-    if let Some(film) = &c.iridescence {
-        fresnel = film.blend(fresnel, vdh, f0);
-    }
-    let diffuse = if c.transmission > 0.0 {
-        c.c_diff() * (1.0 - c.transmission)
-    } else {
-        c.c_diff()
-    };
-    (Vec3::ONE - fresnel) * diffuse / PI + fresnel * d_vis(n, v, l, ndl, a2)
-}
-
-/// GGX's D times the separable Smith visibility, for n.l = `ndl` > 0
-/// (`pbr4::d_vis` at one lane).
-#[inline(always)]
-fn d_vis(n: Vec3, v: Vec3, l: Vec3, ndl: f32, a2: f32) -> f32 {
-    let h = (l + v).normalize_or_zero();
-    super::pbr4::d_vis(V3::from(n), V3::from(v), V3::from(h), ndl, a2)
+    let [n, v, l] = [n, v, l].map(V3::from);
+    super::pbr4::brdf(n, v, l, ndl, &c.lanes()).into()
 }
 
 /// The whole material's f(v, l) cos: the base layer's BRDF times n.l,

@@ -109,18 +109,19 @@ impl<L: Lane> Coat<L> {
 
 /// Metallic-roughness points, one per lane, as `PbrColor` holds one
 /// (without the layers the lanes do not take).
-struct Color<L: Lane> {
-    roughness: L,
-    occlusion: L,
-    /// `PbrColor::f0`, `f90` and `c_diff`.
-    f0: V3<L>,
-    f90: L,
-    c_diff: V3<L>,
+pub(super) struct Color<L: Lane> {
+    pub roughness: L,
+    pub occlusion: L,
+    /// `PbrColor::f0`, `f90` and `c_diff` (less the transmitted share).
+    pub f0: V3<L>,
+    pub f90: L,
+    pub c_diff: V3<L>,
     /// alpha^2 of the GGX lobe.
-    a2: L,
-    /// The constant layers (`PbrColor`'s).
-    sheen: Option<Sheen>,
-    iridescence: Option<Iridescence>,
+    pub a2: L,
+    /// The constant layers (`PbrColor`'s; a film only where its factor
+    /// is above 0).
+    pub sheen: Option<Sheen>,
+    pub iridescence: Option<Iridescence>,
 }
 
 impl<'a> ShadeContext<'a> {
@@ -365,10 +366,10 @@ fn layered_environment<L: Lane>(
     base.scale(L::splat(1.0) - coat.weight(v)) + layer.scale(L::splat(coat.factor) * c.occlusion)
 }
 
-/// `pbr::brdf` at the lanes' points, for unit light directions `l` with
-/// n.l = `ndl` > 0.
+/// The base layer's BRDF at the lanes' points, for unit light directions
+/// `l` with n.l = `ndl` > 0 (`pbr::brdf` is its one-lane instance).
 #[inline(always)]
-fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &Color<L>) -> V3<L> {
+pub(super) fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &Color<L>) -> V3<L> {
     let h = (l + v).normalize_or(V3::zero());
     let vdh = v.dot(h).abs();
     let one = V3::splat(Vec3::ONE);
@@ -394,10 +395,11 @@ pub(super) fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
     d * vis
 }
 
-/// `PbrColor::split_sum`: f0 a + f90 b, with a film blended towards its
-/// Fresnel at n.v = `ndv` times the lobe's albedo a + b.
+/// The split sum's specular albedo f0 a + f90 b, with a film blended
+/// towards its Fresnel at n.v = `ndv` times the lobe's albedo a + b
+/// (`PbrColor::split_sum` is its one-lane instance).
 #[inline(always)]
-fn split_sum<L: Lane>(c: &Color<L>, ndv: L, a: L, b: L) -> V3<L> {
+pub(super) fn split_sum<L: Lane>(c: &Color<L>, ndv: L, a: L, b: L) -> V3<L> {
     let s = c.f0.scale(a) + splat3(b * c.f90);
     match &c.iridescence {
         Some(film) => V3::from_fn(|k| {
