@@ -39,8 +39,6 @@
 //! 1/pi as bright as Blinn-Phong Kd 1, whose formula (the scene format's)
 //! has none. Lights are in the same units for both.
 
-use std::f32::consts::PI;
-
 use glam::Vec3;
 
 use crate::simd::V3;
@@ -106,7 +104,7 @@ impl Coat {
 
     /// The layer as the lanes hold it (one lane: this code is theirs).
     #[inline(always)]
-    fn lanes(&self) -> super::pbr4::Coat<f32> {
+    pub(super) fn lanes(&self) -> super::pbr4::Coat<f32> {
         super::pbr4::Coat {
             factor: self.factor,
             roughness: self.roughness,
@@ -251,38 +249,13 @@ fn env_brdf(roughness: f32, ndv: f32) -> (f32, f32) {
 /// energy. `ao` multiplies the diffuse part, and the specular part through
 /// Lagarde's specular occlusion; the occlusion map multiplies both.
 pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> Vec3 {
-    let ndv = n.dot(v).abs().max(1e-4);
-    let ab = env.brdf(ndv, c.roughness);
-    let spec = c.split_sum(ndv, ab.x, ab.y);
-    let c_diff = if c.transmission > 0.0 {
-        c.c_diff() * (1.0 - c.transmission)
-    } else {
-        c.c_diff()
-    };
-    let diffuse = c_diff * (Vec3::ONE - spec) * env.irradiance(n) * (ao / PI);
-    let r = super::env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, c.roughness);
-    let so = specular_occlusion(ndv, ao, c.roughness);
-    let mut base = (diffuse + env.prefiltered(r, c.roughness) * spec * so) * c.occlusion;
-    if let Some(s) = &c.sheen {
-        // The sheen lobe's light: its albedo times the cosine-weighted
-        // mean radiance E(n) / pi. The Charlie lobe is broad and leans to
-        // grazing directions; against the sampled reference this is closer
-        // than the GGX level prefiltered at its roughness along r (mean
-        // difference 0.036 against 0.056 on a sphere in the studio).
-        let lobe = env.irradiance(n) * (s.reflectance(ndv) / PI);
-        base = base * s.scaling(ndv, None) + lobe * (ao.min(1.0) * c.occlusion);
-    }
-    let Some(coat) = &c.coat else {
-        return base;
-    };
-    // The clearcoat: a dielectric lobe (F0 0.04) about its own normal.
-    let nc = coat.normal;
-    let ndv = nc.dot(v).abs().max(1e-4);
-    let ab = env.brdf(ndv, coat.roughness);
-    let r = super::env::dominant_direction(nc, nc * (2.0 * nc.dot(v)) - v, coat.roughness);
-    let layer = env.prefiltered(r, coat.roughness)
-        * ((COAT_F0 * ab.x + ab.y) * specular_occlusion(ndv, ao, coat.roughness));
-    base * (1.0 - coat.weight(v)) + layer * (coat.factor * c.occlusion)
+    // The lanes' code at one lane (the sheen's lobe: its albedo times the
+    // cosine-weighted mean radiance E(n) / pi, closer to the sampled
+    // reference than the GGX level at its roughness; the clearcoat: a
+    // dielectric lobe, F0 0.04, about its own normal).
+    let coat = c.coat.as_ref().map(Coat::lanes);
+    super::pbr4::layered_environment(env, [n, v].map(V3::from), &c.lanes(), coat.as_ref(), ao)
+        .into()
 }
 
 /// Lagarde's specular occlusion from ambient occlusion `ao`.
@@ -366,6 +339,7 @@ fn layered_radiance(
 mod tests {
     use super::*;
     use crate::shade::light::unshadowed;
+    use std::f32::consts::PI;
 
     fn dielectric(base: f32, roughness: f32) -> PbrColor {
         PbrColor {

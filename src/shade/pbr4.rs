@@ -326,12 +326,13 @@ fn splat3<L: Lane>(x: L) -> V3<L> {
     V3 { x, y: x, z: x }
 }
 
-/// `pbr::environment` with a sheen (`c.sheen`) or a clearcoat `coat` at
-/// the lanes' points, normals and view vectors `[n, v]`: the base scaled
-/// by the sheen plus the sheen's lobe, under the coat, plus the coat's
-/// prefiltered lobe about its normal.
+/// The environment's light at the lanes' points, normals and view vectors
+/// `[n, v]` (`pbr::environment` is its one-lane instance), with a sheen
+/// (`c.sheen`) or a clearcoat `coat`: the base scaled by the sheen plus
+/// the sheen's lobe, under the coat, plus the coat's prefiltered lobe
+/// about its normal.
 #[inline(always)]
-fn layered_environment<L: Lane>(
+pub(super) fn layered_environment<L: Lane>(
     env: &EnvLight,
     [n, v]: [V3<L>; 2],
     c: &Color<L>,
