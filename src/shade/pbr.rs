@@ -41,6 +41,7 @@
 
 use glam::Vec3;
 
+use super::pbr4::{COAT_F0, MIN_ALPHA};
 use crate::simd::V3;
 
 use super::env::EnvLight;
@@ -85,9 +86,6 @@ pub struct Coat {
     pub normal: Vec3,
 }
 
-/// The coat's reflectance at normal incidence (ior 1.5).
-pub(super) const COAT_F0: f32 = 0.04;
-
 impl Coat {
     /// The share of the light below that the layer reflects away, towards
     /// `v`: factor times Schlick's Fresnel at nc.v.
@@ -112,10 +110,6 @@ impl Coat {
         }
     }
 }
-
-/// Smallest alpha: a perfect mirror would make D a delta that point lights
-/// never hit; this keeps a tiny, finite highlight.
-pub(super) const MIN_ALPHA: f32 = 2e-3;
 
 impl PbrColor {
     #[inline]
@@ -256,16 +250,6 @@ pub fn environment(env: &EnvLight, n: Vec3, v: Vec3, c: &PbrColor, ao: f32) -> V
     let coat = c.coat.as_ref().map(Coat::lanes);
     super::pbr4::layered_environment(env, [n, v].map(V3::from), &c.lanes(), coat.as_ref(), ao)
         .into()
-}
-
-/// Lagarde's specular occlusion from ambient occlusion `ao`.
-#[inline]
-pub(super) fn specular_occlusion(ndv: f32, ao: f32, roughness: f32) -> f32 {
-    if ao >= 1.0 {
-        1.0
-    } else {
-        ((ndv + ao).powf((-16.0 * roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0)
-    }
 }
 
 /// Outgoing radiance at `p` towards `v`.

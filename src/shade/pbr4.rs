@@ -14,8 +14,9 @@ use glam::Vec3;
 
 use super::ShadeContext;
 use super::env::{EnvLight, dominant_direction_lanes};
+use super::iridescence::Iridescence;
 use super::lanes::{Kind, Lanes, Lit, Lookups, MAX_LANES, MapSet, PbrMaps, same_lookup};
-use super::pbr::{COAT_F0, Iridescence, MIN_ALPHA, Sheen, specular_occlusion};
+use super::sheen::Sheen;
 use crate::scene::Material;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
@@ -64,6 +65,23 @@ impl<'a> Kind<'a> {
             emissive,
             normal,
         }))
+    }
+}
+
+/// The coat's reflectance at normal incidence (ior 1.5).
+pub(super) const COAT_F0: f32 = 0.04;
+
+/// Smallest alpha: a perfect mirror would make D a delta that point lights
+/// never hit; this keeps a tiny, finite highlight.
+pub(super) const MIN_ALPHA: f32 = 2e-3;
+
+/// Lagarde's specular occlusion from ambient occlusion `ao`.
+#[inline]
+pub(super) fn specular_occlusion(ndv: f32, ao: f32, roughness: f32) -> f32 {
+    if ao >= 1.0 {
+        1.0
+    } else {
+        ((ndv + ao).powf((-16.0 * roughness - 1.0).exp2()) - 1.0 + ao).clamp(0.0, 1.0)
     }
 }
 
