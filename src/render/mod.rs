@@ -38,6 +38,7 @@ pub mod memory;
 mod rays;
 mod setup;
 mod shadow_pass;
+mod surface;
 mod vertex;
 
 use std::sync::{Arc, OnceLock};

@@ -1,0 +1,264 @@
+//! The surface of a triangle at a fragment, as shading sees it: where a
+//! fragment is interpolated (the pixel center or the covered samples'
+//! centroid), its position and normals (`point`), texture coordinates in
+//! both sets with their quad derivatives (`material_uv`, `gradients`), and
+//! the `Surface` handed to `ShadeContext`. The band (`band`) shades what
+//! these give.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use super::fragment::{FrameData, Point};
+use crate::assets::texture::Gradients;
+use crate::raster::interp::{Fragment, Interpolator};
+use crate::raster::setup::Tri;
+use crate::scene::settings::ShadingMode;
+use crate::shade::light::LightMask;
+use crate::shade::{SizedFootprint, Surface, TexCoords};
+
+impl<'a> FrameData<'a> {
+    /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
+    /// is interpolated: the pixel center when it is inside the triangle,
+    /// otherwise the centroid of the covered samples.
+    #[inline]
+    pub(super) fn shading_point(&self, it: &Interpolator, px: i32, py: i32, mask: u32) -> Fragment {
+        if self.pattern.len() == 1 || it.covers_center(px, py) {
+            return it.at_pixel(px, py);
+        }
+        let (mut sx, mut sy, mut k) = (0i32, 0i32, 0i32);
+        for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
+            if mask & (1 << s) != 0 {
+                sx += ox as i32;
+                sy += oy as i32;
+                k += 1;
+            }
+        }
+        let k = (16 * k.max(1)) as f64;
+        it.at(
+            px as f64 + 0.5 + sx as f64 / k,
+            py as f64 + 0.5 + sy as f64 / k,
+        )
+    }
+
+    /// The material of `t`, its texture coordinates (both sets) and vertex
+    /// color at barycentrics `l`.
+    pub(super) fn material_uv(
+        &self,
+        t: &Tri,
+        l: Vec3,
+    ) -> (&crate::scene::Material, [Option<Vec2>; 2], Vec4) {
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let mesh = &model.mesh;
+        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let at = |uv: &[Vec2]| {
+            (!uv.is_empty()).then(|| uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z)
+        };
+        let color = if mesh.colors.is_empty() {
+            Vec4::ONE
+        } else {
+            let c = &mesh.colors;
+            c[idx[0]] * l.x + c[idx[1]] * l.y + c[idx[2]] * l.z
+        };
+        (
+            &model.materials[d.material],
+            [at(&mesh.uvs), at(&mesh.uvs1)],
+            color,
+        )
+    }
+
+    /// Texture-coordinate derivatives of `t` (both sets) over the quad
+    /// whose top-left pixel is `q0`.
+    pub(super) fn gradients(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> [Gradients; 2] {
+        let uv = |px: i32, py: i32| self.material_uv(t, it.at_pixel(px, py).lambda).1;
+        let (a, b, c) = (uv(q0.0, q0.1), uv(q0.0 + 1, q0.1), uv(q0.0, q0.1 + 1));
+        [0, 1].map(|k| match (a[k], b[k], c[k]) {
+            (Some(a), Some(b), Some(c)) => Gradients {
+                dx: b - a,
+                dy: c - a,
+            },
+            _ => Gradients::default(),
+        })
+    }
+
+    /// `gradients` of set 0 alone.
+    pub(super) fn gradients0(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
+        let d = self.draws[t.draw as usize];
+        let mesh = &self.fs.scene.models[d.model].mesh;
+        let uv = &mesh.uvs;
+        if uv.is_empty() {
+            return Gradients::default();
+        }
+        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let at = |px: i32, py: i32| {
+            let l = it.at_pixel(px, py).lambda;
+            uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
+        };
+        let (a, b, c) = (at(q0.0, q0.1), at(q0.0 + 1, q0.1), at(q0.0, q0.1 + 1));
+        Gradients {
+            dx: b - a,
+            dy: c - a,
+        }
+    }
+
+    /// Color (linear, or the data view's value) and view depth of triangle
+    /// `t` at pixel (px, py), given the filter footprints already known for
+    /// `grads`; also returns the footprints known afterwards.
+    pub(super) fn shade_with(
+        &self,
+        tri: (&Tri, &Interpolator),
+        frag: Fragment,
+        px: (i32, i32),
+        texture: ([Gradients; 2], [Option<SizedFootprint>; 2]),
+        reach: Reach,
+    ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
+        let surface = self.surface(tri, frag, px, texture, reach);
+        (
+            self.ctx.shade(&surface),
+            surface.view_depth,
+            surface.tc.footprints(),
+        )
+    }
+
+    /// The surface of triangle `t` (interpolated by `it`) at a fragment,
+    /// as shading sees it, with the texture derivatives `grads` and the
+    /// filter footprints already known for them.
+    pub(super) fn surface(
+        &self,
+        (t, it): (&Tri, &Interpolator),
+        frag: Fragment,
+        (px, py): (i32, i32),
+        (grads, footprints): ([Gradients; 2], [Option<SizedFootprint>; 2]),
+        reach: Reach,
+    ) -> Surface<'_> {
+        let ctx = &self.ctx;
+        let mode = ctx.mode;
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let mv = &self.verts[d.model];
+        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
+        let l = frag.lambda;
+        let Point {
+            position,
+            raw_normal,
+            normal,
+            geo_normal,
+            view_depth,
+        } = self.point(t, frag);
+        let normal = if mode == ShadingMode::Flat {
+            geo_normal
+        } else {
+            normal
+        };
+        let (_, uv, color) = self.material_uv(t, l);
+        let tt = &self.tangents[d.model];
+        let tangent = (!tt.is_empty()).then(|| {
+            let c = t.prim as usize * 3;
+            let v = tt[c] * l.x + tt[c + 1] * l.y + tt[c + 2] * l.z;
+            // The sign is per triangle (MikkTSpace keeps it constant).
+            v.truncate().extend(tt[c].w)
+        });
+        let vertex_light = (!mv.light.is_empty()).then(|| {
+            let g = |k: usize| mv.light[idx[k]];
+            let (a, b, c) = (g(0), g(1), g(2));
+            (
+                a.0 * l.x + b.0 * l.y + c.0 * l.z,
+                a.1 * l.x + b.1 * l.y + c.1 * l.z,
+            )
+        });
+        let edge_distance = if mode == ShadingMode::Wireframe {
+            edge_distance(it, px, py, l)
+        } else {
+            f32::INFINITY
+        };
+        Surface {
+            material: &model.materials[d.material],
+            position,
+            normal,
+            raw_normal,
+            tc: TexCoords::with_footprints(uv, grads, footprints),
+            color,
+            tangent,
+            normal_from_object: mv.normal_from_object,
+            view_depth,
+            vertex_light,
+            edge_distance,
+            geo_normal,
+            ao: reach.ao,
+            lights: reach.lights,
+        }
+    }
+
+    /// Position, normals and view depth of triangle `t` at a fragment.
+    #[inline]
+    pub(super) fn point(&self, t: &Tri, frag: Fragment) -> Point {
+        let ctx = &self.ctx;
+        let d = self.draws[t.draw as usize];
+        let model = &self.fs.scene.models[d.model];
+        let mv = &self.verts[d.model];
+        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
+        let l = frag.lambda;
+        let lerp3 = |a: &[Vec3]| a[idx[0]] * l.x + a[idx[1]] * l.y + a[idx[2]] * l.z;
+        let position = lerp3(&mv.world);
+        let raw_normal = lerp3(&mv.normal);
+        let view_depth = if ctx.orthographic {
+            (position - ctx.eye).dot(ctx.forward)
+        } else {
+            frag.w
+        };
+        // Light the side the camera sees.
+        let n = raw_normal.normalize_or(Vec3::Y);
+        let normal = if t.front { n } else { -n };
+        let geo_normal = if self.geo_normal {
+            let [a, b, c] = idx.map(|k| mv.world[k]);
+            let g = (b - a).cross(c - a).normalize_or(normal);
+            if g.dot(ctx.view_vector(position)) < 0.0 {
+                -g
+            } else {
+                g
+            }
+        } else {
+            normal
+        };
+        Point {
+            position,
+            raw_normal,
+            normal,
+            geo_normal,
+            view_depth,
+        }
+    }
+}
+
+/// What reaches a fragment besides its triangle: its ambient occlusion
+/// (1: none) and the lights that may reach its tile.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Reach {
+    pub ao: f32,
+    pub lights: LightMask,
+}
+
+impl Reach {
+    /// No occlusion, every light.
+    pub const FULL: Reach = Reach {
+        ao: 1.0,
+        lights: LightMask::ALL,
+    };
+}
+
+/// Screen-space distance (pixels) from the pixel center to the nearest edge
+/// of the original triangle: each barycentric over the length of its
+/// screen-space gradient.
+fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
+    // Gradients per pixel step; `l` may be off the center (MSAA centroid).
+    let c = it.at_pixel(px, py).lambda;
+    let dx = it.at_pixel(px + 1, py).lambda - c;
+    let dy = it.at_pixel(px, py + 1).lambda - c;
+    let mut best = f32::INFINITY;
+    for k in 0..3 {
+        let g = Vec2::new(dx[k], dy[k]).length();
+        if g > 0.0 {
+            best = best.min(l[k] / g);
+        }
+    }
+    best
+}
