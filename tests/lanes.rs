@@ -163,6 +163,40 @@ fov = 45.0
     );
 }
 
+/// A quad (`quad.obj`, turned) under a point and a directional light
+/// with ambient, 96x80, both faces drawn.
+const QUAD_SCENE: &str = r#"
+[output]
+width = 96
+height = 80
+[render]
+cull = "none"
+[ambient]
+color = [0.1, 0.1, 0.1]
+[[model]]
+path = "quad.obj"
+rotate = [-35.0, 20.0, 0.0]
+[[light]]
+kind = "point"
+position = [0.5, 1.0, 2.0]
+intensity = 3.0
+[[light]]
+kind = "directional"
+direction = [0.3, -0.2, -1.0]
+irradiance = 0.7
+"#;
+
+/// A spot light with a ray-traced shadow, to add to `QUAD_SCENE`.
+const SHADOWED_SPOT: &str = r#"[[light]]
+kind = "spot"
+position = [-0.5, 0.8, 1.6]
+direction = [0.3, -0.4, -1.0]
+intensity = 2.0
+inner_angle = 15
+outer_angle = 30
+shadows = true
+"#;
+
 #[test]
 fn vertex_colours_illum_and_repeat_are_the_same_with_and_without_lanes() {
     let dir = scratch("lanes_small");
@@ -188,30 +222,7 @@ fn vertex_colours_illum_and_repeat_are_the_same_with_and_without_lanes() {
             "newmtl tiled\nKd 1 1 1\nKa 0.2 0.2 0.2\nKs 0.4 0.4 0.4\nNs 20\nillum {illum}\nmap_Kd checker.png\nmap_Ks checker.png\n\
              newmtl plain\nKd 0.3 0.6 0.3\nKe 0.05 0 0\nillum {illum}\n"
         );
-        let scene = scene_in(
-            &dir,
-            r#"
-[output]
-width = 96
-height = 80
-[render]
-cull = "none"
-[ambient]
-color = [0.1, 0.1, 0.1]
-[[model]]
-path = "quad.obj"
-rotate = [-35.0, 20.0, 0.0]
-[[light]]
-kind = "point"
-position = [0.5, 1.0, 2.0]
-intensity = 3.0
-[[light]]
-kind = "directional"
-direction = [0.3, -0.2, -1.0]
-irradiance = 0.7
-"#,
-            &[("quad.obj", obj), ("m.mtl", &mtl)],
-        );
+        let scene = scene_in(&dir, QUAD_SCENE, &[("quad.obj", obj), ("m.mtl", &mtl)]);
         same_both_ways(&scene, &[0], &format!("quad, illum {illum}"));
     }
 }
@@ -317,39 +328,12 @@ fn clearcoats_are_the_same_with_and_without_lanes() {
             "newmtl coated\nKd 0.8 0.1 0.1\nPr 0.6\nPm 0.2\nPc {pc}\nPcr {pcr}\n\
              newmtl plain\nKd 0.3 0.6 0.3\nKe 0.05 0 0\nPr 0.3\nPc {pc}\nPcr {pcr}\n"
         );
-        let scene = scene_in(
+        scene_in(
             &dir,
-            r#"
-[output]
-width = 96
-height = 80
-[render]
-cull = "none"
-msaa = 4
-[ambient]
-color = [0.1, 0.1, 0.1]
-[[model]]
-path = "quad.obj"
-rotate = [-35.0, 20.0, 0.0]
-[[light]]
-kind = "point"
-position = [0.5, 1.0, 2.0]
-intensity = 3.0
-[[light]]
-kind = "directional"
-direction = [0.3, -0.2, -1.0]
-irradiance = 0.7
-[[light]]
-kind = "spot"
-position = [-0.5, 0.8, 1.6]
-direction = [0.3, -0.4, -1.0]
-intensity = 2.0
-inner_angle = 15
-outer_angle = 30
-shadows = true
-"#,
+            &format!("{QUAD_SCENE}{SHADOWED_SPOT}"),
             &[("quad.obj", obj), ("m.mtl", &mtl)],
         );
+        let scene = load_with(&dir.join("scene.toml"), &["render.msaa=4"]);
         same_both_ways(&scene, &[0], &format!("clearcoat {pc}, {pcr}"));
         let file = dir.join("lit.toml");
         std::fs::write(
