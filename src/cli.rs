@@ -90,6 +90,11 @@ struct RenderArgs {
     /// `render.max_memory`.
     #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
     max_memory: Option<u64>,
+    /// Confine every read to the scene's folder (as `render.sandbox =
+    /// true`): a path with `..`, an absolute path, a URI scheme or a link
+    /// leading out is an error (exit 2). For farms and services.
+    #[arg(long)]
+    sandbox: bool,
     /// Keep decoded textures and their mip chains in DIR between runs,
     /// keyed by a hash of each image's content (opt-in; created if
     /// missing; renders running at the same time may share it).
@@ -444,24 +449,31 @@ fn video(args: VideoArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// `--max-memory` (or `render.max_memory`): the estimate against the
-/// limit, before the first frame.
+/// `--max-memory` (or `render.max_memory`, or by default what the
+/// machine has: the smaller of the memory available and the address-space
+/// limit, less headroom): the estimate against the limit, before the
+/// first frame.
 fn check_memory(scene: &Scene, flag: Option<u64>, args: &RenderArgs) -> Result<(), Error> {
     let estimate = softraster::render::memory::estimate(scene, rayon::current_num_threads());
-    let Some(limit) = flag.or(scene.settings.max_memory) else {
-        return Ok(());
+    let (limit, what) = match (flag, scene.settings.max_memory) {
+        (Some(f), _) => (f, "--max-memory"),
+        (None, Some(s)) => (s, "render.max_memory"),
+        (None, None) => (
+            softraster::assets::input::default_budget(),
+            "the default budget (the memory available, or the address-space limit, less headroom; --max-memory sets it):",
+        ),
     };
-    let what = if flag.is_some() {
-        "--max-memory"
-    } else {
-        "render.max_memory"
-    };
+    let chosen = flag.is_some() || scene.settings.max_memory.is_some();
     if estimate.total() > limit {
         return Err(Error::Argument(format!(
             "{}: the render needs about {estimate}, more than {what} {}",
             args.scene.display(),
             softraster::render::memory::human(limit)
         )));
+    }
+    if !chosen {
+        // Within the default: nothing to say.
+        return Ok(());
     }
     if !args.quiet {
         eprintln!(
@@ -489,16 +501,20 @@ fn load_options(
         plain_look: false,
         strict,
         cache,
+        max_memory: None,
+        sandbox: false,
     })
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {
-    let opts = load_options(
+    let mut opts = load_options(
         &args.sets,
         args.out.clone(),
         args.strict,
         args.cache.clone(),
     )?;
+    opts.max_memory = args.max_memory;
+    opts.sandbox = args.sandbox;
     let pool = thread_pool(args.threads)?;
     pool.install(|| {
         let t0 = std::time::Instant::now();

@@ -58,6 +58,17 @@ pub enum Error {
         message: String,
     },
 
+    /// `--sandbox`: a file names a path outside the scene's folder (with
+    /// `..`, absolute, a URI scheme, or a link leading out). Never lenient.
+    #[error("{}: --sandbox: refused to read it{message}", path.display())]
+    Sandbox { path: PathBuf, message: String },
+
+    /// An asset would take more memory than the budget (`--max-memory`,
+    /// or the default: what the machine has), seen from its header
+    /// before anything is allocated.
+    #[error("{}: {message}", path.display())]
+    Memory { path: PathBuf, message: String },
+
     /// `--strict` and the load gave warnings.
     #[error("{}: --strict: {} warning(s) treated as errors:\n  {}", file.display(), warnings.len(), warnings.join("\n  "))]
     Strict {
@@ -97,6 +108,8 @@ impl Error {
             Error::Scene { .. }
             | Error::SceneGlobal { .. }
             | Error::Asset { .. }
+            | Error::Sandbox { .. }
+            | Error::Memory { .. }
             | Error::Strict { .. }
             | Error::Argument(_) => 2,
             Error::Io { .. } | Error::Encode { .. } | Error::Render(_) => 1,

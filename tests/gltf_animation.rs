@@ -351,7 +351,11 @@ fn a_skinned_bar_follows_its_joints_through_the_clip() {
 fn the_default_pose_of_the_rig_is_the_loaded_mesh() {
     let dir = common::scratch("anim_rest");
     std::fs::write(dir.join("bar.gltf"), bar()).unwrap();
-    let m = softraster::assets::gltf::load(&dir.join("bar.gltf")).unwrap();
+    let m = softraster::assets::gltf::load(
+        &dir.join("bar.gltf"),
+        &softraster::assets::input::Input::default(),
+    )
+    .unwrap();
     let rig = m.rig.unwrap().unwrap();
     let posed = rig.place(
         &rig.node_pose(None),

@@ -50,6 +50,7 @@ impl Goldens {
             plain_look: false,
             strict: false,
             cache: None,
+            ..LoadOptions::default()
         };
         let scene = Scene::load(scene, &opts).unwrap_or_else(|e| panic!("{e}"));
         let img = resolve(&render_frame(&scene, 0, frame), &scene.settings);

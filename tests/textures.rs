@@ -220,12 +220,25 @@ fn tangent_and_object_space_maps_of_diablo3_agree() {
     use softraster::assets::texture::Texture;
     use softraster::scene::settings::AddressMode;
     let d3 = assets.join("tinyrenderer/diablo3_pose");
-    let mut mesh = softraster::assets::obj::load(&d3.join("diablo3_pose.obj"))
-        .unwrap()
-        .mesh;
+    let mut mesh = softraster::assets::obj::load(
+        &d3.join("diablo3_pose.obj"),
+        &softraster::assets::input::Input::default(),
+    )
+    .unwrap()
+    .mesh;
     mesh.compute_tangents(0);
-    let tangent_map = Texture::load(&d3.join("diablo3_pose_nm_tangent.tga"), false).unwrap();
-    let object_map = Texture::load(&d3.join("diablo3_pose_nm.tga"), false).unwrap();
+    let tangent_map = Texture::load(
+        &d3.join("diablo3_pose_nm_tangent.tga"),
+        false,
+        &softraster::assets::input::Input::default(),
+    )
+    .unwrap();
+    let object_map = Texture::load(
+        &d3.join("diablo3_pose_nm.tga"),
+        false,
+        &softraster::assets::input::Input::default(),
+    )
+    .unwrap();
     let decode = |t: &Texture, uv: glam::Vec2| {
         (t.sample_bilinear(uv, AddressMode::Repeat).truncate() * 2.0 - Vec3::ONE).normalize()
     };

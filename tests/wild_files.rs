@@ -170,11 +170,26 @@ fn tga_dds_and_ktx2_textures_decode_to_their_source_image() {
         ("blocks_etc1s.ktx2", 8),
     ] {
         let png = if name.starts_with("blocks") {
-            Texture::load(&dir.join("blocks.png"), false).unwrap()
+            Texture::load(
+                &dir.join("blocks.png"),
+                false,
+                &softraster::assets::input::Input::default(),
+            )
+            .unwrap()
         } else {
-            Texture::load(&dir.join("checker.png"), false).unwrap()
+            Texture::load(
+                &dir.join("checker.png"),
+                false,
+                &softraster::assets::input::Input::default(),
+            )
+            .unwrap()
         };
-        let dds = Texture::load(&dir.join(name), false).unwrap();
+        let dds = Texture::load(
+            &dir.join(name),
+            false,
+            &softraster::assets::input::Input::default(),
+        )
+        .unwrap();
         assert_eq!((dds.width, dds.height), (png.width, png.height), "{name}");
         for y in 0..png.height {
             for x in 0..png.width {
@@ -202,7 +217,12 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
     // Universal KTX2 file whose Zstandard level claims 432 PB uncompressed;
     // the transcoder allocated it (the process aborted).
     let path = dir.join("fuzz_ktx2_zstd_huge_level.ktx2");
-    let err = match Texture::from_bytes(&std::fs::read(&path).unwrap(), &path, true) {
+    let err = match Texture::from_bytes(
+        &std::fs::read(&path).unwrap(),
+        &path,
+        true,
+        &softraster::assets::input::Input::default(),
+    ) {
         Ok(_) => panic!("{} was read", path.display()),
         Err(e) => e.to_string(),
     };

@@ -43,6 +43,12 @@ fn u32_at(b: &[u8], at: usize) -> Option<u32> {
         .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
 }
 
+/// The bytes decoding level 0 takes (its RGBA8 texels), from the header,
+/// or None when the header is cut short.
+pub fn decode_bytes(b: &[u8]) -> Option<u64> {
+    Some(u32_at(b, 12)? as u64 * u32_at(b, 16)? as u64 * 4)
+}
+
 /// Decodes level 0 of a DDS file, or says why it cannot.
 pub fn decode(b: &[u8]) -> Result<Decoded, String> {
     if !is_dds(b) {

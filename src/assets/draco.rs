@@ -1,6 +1,7 @@
 //! KHR_draco_mesh_compression: a primitive whose attributes and indices
 //! are one Draco bitstream in a buffer view, decoded by the pure-Rust
-//! `draco-core` crate (Apache-2.0; decoding bounded by its `DecodeLimits`).
+//! `draco-core` crate (Apache-2.0; decoding bounded by its `DecodeLimits`, set from the memory
+//! budget).
 //! The extension maps each glTF attribute to a Draco attribute id; the
 //! accessors still give count, type and normalization.
 
@@ -15,6 +16,7 @@ pub(super) fn read(
     ext: &Value,
     buffers: &[Vec<u8>],
     views: &[(usize, usize, usize)],
+    budget: u64,
 ) -> Result<Attributes, String> {
     let err = |m: String| format!("KHR_draco_mesh_compression: {m}");
     if prim.mode() != gltf::mesh::Mode::Triangles {
@@ -34,7 +36,12 @@ pub(super) fn read(
         .get(buffer)
         .and_then(|b| b.get(offset..offset.checked_add(length)?))
         .ok_or_else(|| err(format!("buffer view {view_index} lies outside its buffer")))?;
-    let mut buffer = draco_core::DecoderBuffer::new(bytes);
+    // The decoded attributes are copied once more into the mesh: half
+    // the budget each; a face is 12 bytes of indices, twice.
+    let limits = draco_core::DecodeLimits::default()
+        .with_max_decoded_bytes(budget / 2)
+        .with_max_faces(budget / 24);
+    let mut buffer = draco_core::DecoderBuffer::new(bytes).with_limits(limits);
     let mut mesh = draco_core::Mesh::new();
     draco_core::MeshDecoder::new()
         .decode(&mut buffer, &mut mesh)

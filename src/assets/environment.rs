@@ -6,6 +6,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
+use super::input::Input;
 use crate::error::Error;
 
 /// Linear RGB radiance, row-major from the top; `width == 2 * height`.
@@ -20,23 +21,25 @@ impl EnvImage {
     /// Reads an `.hdr` or `.exr` environment. A file that is not 2:1, has
     /// fewer than 8 rows, or holds negative or non-finite radiance is
     /// refused, naming the file.
-    pub fn load(path: &Path) -> Result<EnvImage, Error> {
+    pub fn load(path: &Path, input: &Input) -> Result<EnvImage, Error> {
         let bad = |message: String| Error::asset(path, None, message);
-        if !path.is_file() {
+        if std::fs::symlink_metadata(path).is_err() {
             return Err(bad("environment file not found".into()));
         }
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
-        let (width, height, texels) = match ext.as_str() {
-            "hdr" => read_hdr(path).map_err(bad)?,
-            "exr" => read_exr(path).map_err(bad)?,
-            _ => {
-                return Err(bad(format!(
-                    "an environment is a .hdr or .exr file, not .{ext}"
-                )));
-            }
+        if !matches!(ext.as_str(), "hdr" | "exr") {
+            return Err(bad(format!(
+                "an environment is a .hdr or .exr file, not .{ext}"
+            )));
+        }
+        let bytes = input.read(path, None, None)?;
+        let (width, height, texels) = if ext == "hdr" {
+            read_hdr(&bytes, path, input)?
+        } else {
+            read_exr(&bytes, path, input)?
         };
         EnvImage::new(width, height, texels).map_err(bad)
     }
@@ -193,29 +196,64 @@ impl EnvImage {
 
 type Texels = (u32, u32, Vec<Vec3>);
 
-fn read_hdr(path: &Path) -> Result<Texels, String> {
-    let img = image::ImageReader::open(path)
-        .map_err(|e| format!("cannot read the environment: {e}"))?
+/// What a texel takes while loading: the decoded RGB floats, the texels
+/// kept, and the prefiltered levels made from them (a third more).
+const ENV_TEXEL_BYTES: u64 = 12 + 12 + 4;
+
+fn read_hdr(bytes: &[u8], path: &Path, input: &Input) -> Result<Texels, Error> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
-        .map_err(|e| format!("cannot read the environment: {e}"))?
-        .decode()
-        .map_err(|e| format!("not a readable Radiance HDR image: {e}"))?
-        .into_rgb32f();
+        .map_err(|e| Error::asset(path, None, format!("cannot read the environment: {e}")))?;
+    let img = crate::assets::texture::decode_within(
+        reader,
+        input,
+        path,
+        "the environment",
+        ENV_TEXEL_BYTES,
+    )?
+    .into_rgb32f();
     let (w, h) = img.dimensions();
     let texels = img.pixels().map(|p| Vec3::from(p.0)).collect();
     Ok((w, h, texels))
 }
 
-fn read_exr(path: &Path) -> Result<Texels, String> {
-    use exr::prelude::read_first_rgba_layer_from_file;
-    let image = read_first_rgba_layer_from_file(
+fn read_exr(bytes: &[u8], path: &Path, input: &Input) -> Result<Texels, Error> {
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let bad = |e: exr::error::Error| {
+        Error::asset(path, None, format!("not a readable OpenEXR RGB image: {e}"))
+    };
+    // The size from the header, before the pixels are allocated.
+    let meta =
+        exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(bad)?;
+    let largest = meta
+        .headers
+        .iter()
+        .map(|h| h.layer_size.area() as u64)
+        .max()
+        .unwrap_or(0);
+    // The channels decoded as floats (at most four) and the texels kept.
+    input.check_file(
         path,
-        |size, _| (size.width(), vec![Vec3::ZERO; size.width() * size.height()]),
-        |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
-        },
-    )
-    .map_err(|e| format!("not a readable OpenEXR RGB image: {e}"))?;
+        "the environment",
+        largest.saturating_mul(16 + ENV_TEXEL_BYTES),
+    )?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size: exr::math::Vec2<usize>, _: &exr::prelude::RgbaChannels| {
+                (size.width(), vec![Vec3::ZERO; size.width() * size.height()])
+            },
+            |(w, px): &mut (usize, Vec<Vec3>),
+             pos: exr::math::Vec2<usize>,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(bad)?;
     let size = image.layer_data.size;
     let (_, texels) = image.layer_data.channel_data.pixels;
     Ok((size.width() as u32, size.height() as u32, texels))

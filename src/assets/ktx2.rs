@@ -38,6 +38,19 @@ fn u64_at(b: &[u8], at: usize) -> Option<u64> {
     Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
 }
 
+/// The bytes decoding level 0 takes, from the header (the texels, and
+/// the inflated level when supercompressed), or None when the header is
+/// cut short: for the memory budget, before anything is allocated.
+pub fn decode_bytes(b: &[u8]) -> Option<u64> {
+    let (vk_format, width, height) = (u32_at(b, 12)?, u32_at(b, 20)?, u32_at(b, 24)?);
+    let texels = width as u64 * height as u64 * 4;
+    let inflated = match (u32_at(b, 44)?, format(vk_format)) {
+        (2 | 3, Ok(f)) => level_size(f, width, height),
+        _ => 0,
+    };
+    Some(texels + inflated)
+}
+
 /// Decodes level 0 of a KTX 2.0 file, or says why it cannot.
 pub fn decode(b: &[u8]) -> Result<Decoded, String> {
     if !is_ktx2(b) {

@@ -8,6 +8,7 @@ pub mod draco;
 pub mod environment;
 pub mod gltf;
 pub mod gltf_pose;
+pub mod input;
 pub mod ktx2;
 pub mod mesh;
 pub mod meshopt;

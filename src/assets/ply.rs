@@ -15,12 +15,12 @@ use super::obj::triangulate;
 use crate::color::srgb_to_linear;
 use crate::error::Error;
 
-pub fn load(path: &Path) -> Result<Mesh, Error> {
+pub fn load(path: &Path, input: &super::input::Input) -> Result<Mesh, Error> {
     let err = |msg: String| Error::asset(path, None, msg);
-    let mut f = std::fs::File::open(path).map_err(|e| err(format!("cannot read model: {e}")))?;
+    let bytes = input.read(path, None, None)?;
     let parser = ply_rs_bw::parser::Parser::<DefaultElement>::new();
     let ply = parser
-        .read_ply(&mut std::io::BufReader::new(&mut f))
+        .read_ply(&mut std::io::Cursor::new(bytes))
         .map_err(|e| err(format!("malformed PLY: {e}")))?;
     let empty = Vec::new();
     let vertices = ply.payload.get("vertex").unwrap_or(&empty);

@@ -9,9 +9,8 @@ use glam::Vec3;
 use super::mesh::{Group, Mesh};
 use crate::error::Error;
 
-pub fn load(path: &Path) -> Result<Mesh, Error> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
+pub fn load(path: &Path, input: &super::input::Input) -> Result<Mesh, Error> {
+    let bytes = input.read(path, None, None)?;
     let mut cursor = std::io::Cursor::new(bytes);
     let stl = stl_io::read_stl(&mut cursor)
         .map_err(|e| Error::asset(path, None, format!("malformed STL: {e}")))?;

@@ -41,15 +41,7 @@ impl std::fmt::Display for MemoryEstimate {
     }
 }
 
-/// Bytes as MiB or GiB with one decimal.
-pub fn human(b: u64) -> String {
-    let mib = b as f64 / (1u64 << 20) as f64;
-    if mib >= 1024.0 {
-        format!("{:.1} GiB", mib / 1024.0)
-    } else {
-        format!("{mib:.1} MiB")
-    }
-}
+pub use crate::assets::input::human;
 
 /// The process itself (code, allocator, thread stacks touched), measured
 /// as the peak resident size of a 64x64 render of one triangle, and per

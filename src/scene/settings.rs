@@ -144,6 +144,8 @@ pub struct RenderSettings {
     /// `render.max_memory` (bytes): refuse to render when the estimate
     /// (`render::memory`) exceeds it. `--max-memory` wins.
     pub max_memory: Option<u64>,
+    /// `render.sandbox` (or `--sandbox`): reads stay in the scene's folder.
+    pub sandbox: bool,
     /// Output pixels across a point and a line.
     pub point_size: f32,
     pub line_width: f32,

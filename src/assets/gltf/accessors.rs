@@ -6,8 +6,14 @@ use super::*;
 
 /// Every accessor lies within its buffer view and buffer, has at least one
 /// element, and a stride no smaller than its element (the crate assumes
-/// all three).
-pub(super) fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Result<(), String> {
+/// all three); its elements, read out (a sparse or view-less accessor is
+/// filled from zeros), fit in the memory budget, and a sparse accessor's
+/// indices and values lie within their views.
+pub(super) fn check_accessors(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    input: &crate::assets::input::Input,
+) -> Result<(), String> {
     for v in doc.views() {
         let len = buffers[v.buffer().index()].len();
         if v.offset()
@@ -28,7 +34,13 @@ pub(super) fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Resu
         if a.count() == 0 {
             return Err(format!("accessor {i} has no elements"));
         }
-        if a.sparse().is_some() {
+        // Read out as f32 (or u32) components: at most 16 of 4 bytes.
+        let read = (a.count() as u64).saturating_mul(a.dimensions().multiplicity() as u64 * 4);
+        input
+            .check(&format!("accessor {i} ({} elements)", a.count()), read)
+            .map_err(|m| m.to_string())?;
+        if let Some(sparse) = a.sparse() {
+            check_sparse(i, a.count(), a.size(), &sparse)?;
             continue;
         }
         let Some(view) = a.view() else { continue };
@@ -48,6 +60,47 @@ pub(super) fn check_accessors(doc: &gltf::Document, buffers: &[Vec<u8>]) -> Resu
                 "accessor {i} ({} elements from byte {}) runs past the end of buffer view {} ({} bytes)",
                 a.count(),
                 a.offset(),
+                view.index(),
+                view.length()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A sparse accessor: no more substitutions than elements, and its
+/// indices and values within their views.
+fn check_sparse(
+    i: usize,
+    count: usize,
+    size: usize,
+    sparse: &gltf::accessor::sparse::Sparse,
+) -> Result<(), String> {
+    let n = sparse.count();
+    if n > count {
+        return Err(format!(
+            "accessor {i}: {n} sparse substitutions for {count} elements"
+        ));
+    }
+    let index_size = sparse.indices().index_type().size();
+    for (what, view, offset, each) in [
+        (
+            "indices",
+            sparse.indices().view(),
+            sparse.indices().offset(),
+            index_size,
+        ),
+        (
+            "values",
+            sparse.values().view(),
+            sparse.values().offset(),
+            size,
+        ),
+    ] {
+        let end = n.checked_mul(each).and_then(|x| x.checked_add(offset));
+        if end.is_none_or(|end| end > view.length()) {
+            return Err(format!(
+                "accessor {i}: its {n} sparse {what} from byte {offset} run past the end of buffer view {} ({} bytes)",
                 view.index(),
                 view.length()
             ));
@@ -107,12 +160,13 @@ pub(super) fn read_attributes(
     prim: &gltf::Primitive,
     buffers: &[Vec<u8>],
     views: &[(usize, usize, usize)],
+    budget: u64,
 ) -> Result<Attributes, String> {
     if let Some(ext) = prim
         .extensions()
         .and_then(|e| e.get("KHR_draco_mesh_compression"))
     {
-        return crate::assets::draco::read(prim, ext, buffers, views);
+        return crate::assets::draco::read(prim, ext, buffers, views, budget);
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let unreadable = |what: &str| format!("its {what} cannot be read from the buffers");

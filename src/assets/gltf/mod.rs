@@ -21,6 +21,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
 use super::accessor::{Attributes, read_floats};
+use super::input::Input;
 use super::mesh::{Group, Mesh, Primitive};
 use super::rig::{Rig, RigNode, RigSkin, Segment, SegmentNormals};
 use super::texture::Wrap;
@@ -110,9 +111,10 @@ fn version_1(bytes: &[u8]) -> Option<String> {
     }
 }
 
-pub fn load(path: &Path) -> Result<GltfModel, Error> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
+/// Reads a .gltf or .glb file, its buffers and the names of its images,
+/// through `input` (bounded reads, the sandbox, the memory budget).
+pub fn load(path: &Path, input: &Input) -> Result<GltfModel, Error> {
+    let bytes = input.read(path, None, None)?;
     let err = |msg: String| Error::asset(path, None, msg);
     if bytes.starts_with(b"glTF") && bytes.len() < 12 {
         return Err(err(format!(
@@ -146,9 +148,9 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
     let mut warnings = extensions(doc, path).map_err(err)?;
     validate(doc).map_err(err)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut buffers = load_buffers(doc, gltf.blob.as_deref(), dir, path)?;
+    let mut buffers = load_buffers(doc, gltf.blob.as_deref(), path, input)?;
     super::meshopt::decode_views(doc, &mut buffers).map_err(err)?;
-    check_accessors(doc, &buffers).map_err(err)?;
+    check_accessors(doc, &buffers, input).map_err(err)?;
     let images = image_sources(doc, &buffers, dir, path).map_err(err)?;
 
     let mut materials: Vec<GltfMaterial> = doc
@@ -168,6 +170,7 @@ pub fn load(path: &Path) -> Result<GltfModel, Error> {
         // Only files with animations keep their source vertices.
         segments: doc.animations().next().is_some().then(Vec::new),
         rig_error: None,
+        budget: input.budget(),
     };
     let mut placed = Placed::default();
     walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
@@ -433,9 +436,10 @@ fn validate(doc: &gltf::Document) -> Result<(), String> {
 fn load_buffers(
     doc: &gltf::Document,
     blob: Option<&[u8]>,
-    dir: &Path,
     path: &Path,
+    input: &Input,
 ) -> Result<Vec<Vec<u8>>, Error> {
+    let dir = path.parent().unwrap_or(Path::new("."));
     let mut out = Vec::new();
     // Room for meshopt-decoded views, bounded by what the real buffers
     // could decode to.
@@ -458,6 +462,12 @@ fn load_buffers(
                     ),
                 ));
             }
+            input
+                .check(
+                    &format!("buffer {i} (a meshopt fallback)"),
+                    b.length() as u64,
+                )
+                .map_err(|m| Error::asset(path, None, m))?;
             out.push(vec![0; b.length()]);
             continue;
         }
@@ -474,14 +484,23 @@ fn load_buffers(
             gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
                 Some(d) => d.map_err(|m| Error::asset(path, None, format!("buffer {i}: {m}")))?,
                 None => {
+                    // At most its byteLength (a longer file is read that
+                    // far; a FIFO or device is refused).
                     let file = dir.join(percent_decode(uri));
-                    std::fs::read(&file).map_err(|e| {
-                        Error::asset(
-                            &file,
-                            None,
-                            format!("cannot read buffer {i} of {}: {e}", path.display()),
-                        )
-                    })?
+                    input
+                        .read(&file, Some(path), Some(b.length() as u64))
+                        .map_err(|e| match e {
+                            Error::Asset {
+                                path,
+                                line,
+                                message,
+                            } => Error::Asset {
+                                path,
+                                line,
+                                message: format!("buffer {i}: {message}"),
+                            },
+                            other => other,
+                        })?
                 }
             },
         };
@@ -621,6 +640,8 @@ struct Builder {
     /// Why the segments cannot pose the mesh (then the file still loads
     /// in its default pose).
     rig_error: Option<String>,
+    /// The memory budget (a Draco stream's decode is bounded by it).
+    budget: u64,
 }
 
 /// Vertex `s`'s texture coordinates (both sets) and colour, defaults where
@@ -652,7 +673,7 @@ impl Builder {
         material: usize,
     ) -> Result<(), String> {
         let world = pose.world;
-        let a = read_attributes(prim, buffers, &self.views)?;
+        let a = read_attributes(prim, buffers, &self.views, self.budget)?;
         self.note_sets(&a.uv, &a.colors);
         let base = self.mesh.positions.len() as u32;
         if let Some(segments) = &mut self.segments {
@@ -713,7 +734,7 @@ impl Builder {
         ) {
             return self.add_points_or_lines(prim, buffers, pose, material);
         }
-        let mut attributes = read_attributes(prim, buffers, &self.views)?;
+        let mut attributes = read_attributes(prim, buffers, &self.views, self.budget)?;
         // Animated files: the source vertices, before morphing.
         let source = self
             .segments

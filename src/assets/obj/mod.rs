@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
+use super::input::Input;
 use super::mesh::{Group, Mesh, Primitive, smooth_normals};
-use super::text;
 use crate::color::srgb_to_linear;
 use crate::error::Error;
 
@@ -88,14 +88,13 @@ pub struct ObjModel {
     pub warnings: Vec<String>,
 }
 
-pub fn load(path: &Path) -> Result<ObjModel, Error> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::asset(path, None, format!("cannot read model: {e}")))?;
-    let text = text::decode(&bytes);
+/// Reads an OBJ file and its material libraries through `input` (bounded
+/// reads, the sandbox).
+pub fn load(path: &Path, input: &Input) -> Result<ObjModel, Error> {
+    let text = input.read_text(path, None)?;
     let mut warnings = Vec::new();
     let file = parse::parse(path, &text, &mut warnings)?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut mats = libraries(&file, path, dir, &mut warnings);
+    let mut mats = libraries(&file, path, input, &mut warnings)?;
     let mut mesh = build_mesh(&file, &mut mats, path, &mut warnings);
     if mesh.triangles.is_empty() && mesh.lines.is_empty() && mesh.points.is_empty() {
         return Err(Error::asset(
@@ -132,13 +131,15 @@ pub fn load(path: &Path) -> Result<ObjModel, Error> {
 }
 
 /// The materials of every `mtllib`, in order. A library that cannot be
-/// read is a warning: its materials fall back to the default.
+/// read is a warning: its materials fall back to the default (one the
+/// sandbox refuses is an error).
 fn libraries(
     file: &parse::ObjFile,
     path: &Path,
-    dir: &Path,
+    input: &Input,
     warnings: &mut Vec<String>,
-) -> Vec<MtlMaterial> {
+) -> Result<Vec<MtlMaterial>, Error> {
+    let dir = path.parent().unwrap_or(Path::new("."));
     let mut mats = Vec::new();
     for (arg, line) in &file.mtllibs {
         // A name with spaces, else a list of names.
@@ -151,17 +152,31 @@ fn libraries(
                 .collect()
         };
         for lib in names {
-            match std::fs::read(&lib) {
-                Ok(bytes) => mats.extend(mtl::parse(&lib, &text::decode(&bytes), warnings)),
+            match input.read_text(&lib, Some(path)) {
+                Ok(text) => mats.extend(mtl::parse(&lib, &text, warnings)),
+                Err(e @ Error::Sandbox { .. }) => return Err(e),
                 Err(e) => warnings.push(format!(
-                    "{}:{line}: material library {} cannot be read ({e}); its materials render with the default material",
+                    "{}:{line}: material library {} cannot be read ({}); its materials render with the default material",
                     path.display(),
-                    lib.display()
+                    lib.display(),
+                    reason(&e)
                 )),
             }
         }
     }
-    mats
+    Ok(mats)
+}
+
+/// Why a file could not be read, without the paths (the warning names
+/// them).
+fn reason(e: &Error) -> String {
+    match e {
+        Error::Asset { message, .. } => {
+            let m = message.strip_prefix("cannot read: ").unwrap_or(message);
+            m.split(" (named by ").next().unwrap_or(m).to_string()
+        }
+        other => other.to_string(),
+    }
 }
 
 /// One mesh: a vertex per distinct (position, uv, normal) corner, each

@@ -19,6 +19,7 @@ use std::path::Path;
 
 use glam::{Affine2, Vec2, Vec4};
 
+use super::input::Input;
 use crate::color::srgb_to_linear_table;
 use crate::error::Error;
 pub use lanes::{Chain, Rgb4, Taps4};
@@ -295,57 +296,73 @@ impl Level {
 
 impl Texture {
     /// Decodes PNG, TGA (RLE, either origin), JPEG, BMP, TIFF, Radiance
-    /// HDR, DDS or KTX2 by content.
-    pub fn load(path: &Path, srgb: bool) -> Result<Texture, Error> {
-        let open_err =
-            |e: std::io::Error| Error::asset(path, None, format!("cannot open texture: {e}"));
-        let mut magic = Vec::with_capacity(12);
-        std::io::Read::read_to_end(
-            &mut std::io::Read::take(std::fs::File::open(path).map_err(open_err)?, 12),
-            &mut magic,
-        )
-        .map_err(open_err)?;
-        if super::dds::is_dds(&magic) || super::ktx2::is_ktx2(&magic) {
-            return Texture::from_bytes(&std::fs::read(path).map_err(open_err)?, path, srgb);
-        }
-        // The image crate guesses by content, then by the extension (TGA
-        // has no magic number).
-        let reader = image::ImageReader::open(path)
-            .map_err(open_err)?
-            .with_guessed_format()
-            .map_err(|e| Error::asset(path, None, format!("cannot read texture: {e}")))?;
-        Texture::decode_image(reader, path, srgb)
+    /// HDR, DDS or KTX2 by content, read through `input` (a regular file,
+    /// at most its cap; the sandbox).
+    pub fn load(path: &Path, srgb: bool, input: &Input) -> Result<Texture, Error> {
+        let bytes = input.read(path, None, None)?;
+        Texture::from_bytes(&bytes, path, srgb, input)
     }
 
-    /// Decodes an image held in memory (a glTF image in a buffer or a data
-    /// URI); `name` stands for it in errors.
-    pub fn from_bytes(bytes: &[u8], name: &Path, srgb: bool) -> Result<Texture, Error> {
-        let special = if super::dds::is_dds(bytes) {
-            Some(super::dds::decode(bytes))
+    /// Decodes an image held in memory (a file's bytes, a glTF image in a
+    /// buffer or a data URI); `name` stands for it in errors. The size
+    /// it will take (the decode, its RGBA expansion, the block layout and
+    /// the mip chain) is read from the header and checked against the
+    /// memory budget before anything is decoded.
+    pub fn from_bytes(
+        bytes: &[u8],
+        name: &Path,
+        srgb: bool,
+        input: &Input,
+    ) -> Result<Texture, Error> {
+        let refuse = |m: String| Error::asset(name, None, m);
+        type Decode = fn(&[u8]) -> Result<super::dds::Decoded, String>;
+        let special: Option<(Option<u64>, Decode)> = if super::dds::is_dds(bytes) {
+            Some((super::dds::decode_bytes(bytes), super::dds::decode))
         } else if super::ktx2::is_ktx2(bytes) {
-            Some(super::ktx2::decode(bytes))
+            Some((super::ktx2::decode_bytes(bytes), super::ktx2::decode))
         } else {
             None
         };
-        if let Some(d) = special {
-            let d =
-                d.map_err(|e| Error::asset(name, None, format!("cannot decode texture: {e}")))?;
-            return Ok(Texture::from_rgba8(d.width, d.height, d.texels, srgb));
+        if let Some((need, decode)) = special {
+            if let Some(need) = need {
+                // The decode (its RGBA8 texels and any inflated level),
+                // then the level and its chain: at most three times that.
+                input.check_file(name, "texture", need.saturating_mul(3))?;
+            }
+            let d = decode(bytes).map_err(|e| refuse(format!("cannot decode texture: {e}")))?;
+            let t = Texture::from_rgba8(d.width, d.height, d.texels, srgb);
+            input.keep(t.kept_bytes());
+            return Ok(t);
         }
-        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        // The image crate guesses by content, then by the name's extension
+        // (TGA has no magic number).
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
-            .map_err(|e| Error::asset(name, None, format!("cannot read texture: {e}")))?;
-        Texture::decode_image(reader, name, srgb)
+            .map_err(|e| refuse(format!("cannot read texture: {e}")))?;
+        if reader.format().is_none() {
+            reader.set_format(
+                image::ImageFormat::from_path(name)
+                    .map_err(|e| refuse(format!("cannot read texture: {e}")))?,
+            );
+        }
+        let t = Texture::decode_image(reader, name, srgb, input)?;
+        input.keep(t.kept_bytes());
+        Ok(t)
+    }
+
+    /// The bytes this texture keeps for the render: its level 0 in blocks
+    /// and (once built) its mip chain, a third more.
+    fn kept_bytes(&self) -> u64 {
+        self.width as u64 * self.height as u64 * 4 * 4 / 3
     }
 
     fn decode_image<R: std::io::BufRead + std::io::Seek>(
         reader: image::ImageReader<R>,
         path: &Path,
         srgb: bool,
+        input: &Input,
     ) -> Result<Texture, Error> {
-        let img = reader
-            .decode()
-            .map_err(|e| Error::asset(path, None, format!("cannot decode texture: {e}")))?;
+        let img = decode_within(reader, input, path, "texture", 4 + 4 + 4 * 4 / 3)?;
         let (width, height) = (img.width(), img.height());
         if width == 0 || height == 0 {
             return Err(Error::asset(path, None, "texture has no pixels"));
@@ -818,6 +835,34 @@ impl TextureRef {
         }
         self.texture.sample_grad(uv, g, mode, f)
     }
+}
+
+/// Decodes an image whose size, taken from its header, fits the memory
+/// budget: the decoder's own buffer plus `per_texel` bytes a texel for
+/// what is made from it (an RGBA copy, a level, a chain). The image
+/// library's allocation limit is the budget too.
+/// `path` names the image in errors.
+pub fn decode_within<R: std::io::BufRead + std::io::Seek>(
+    mut reader: image::ImageReader<R>,
+    input: &Input,
+    path: &Path,
+    what: &str,
+    per_texel: u64,
+) -> Result<image::DynamicImage, Error> {
+    let bad = |e: image::ImageError| Error::asset(path, None, format!("cannot decode {what}: {e}"));
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(input.budget());
+    reader.limits(limits);
+    let decoder = reader.into_decoder().map_err(bad)?;
+    let (w, h) = image::ImageDecoder::dimensions(&decoder);
+    let decoded = image::ImageDecoder::total_bytes(&decoder);
+    let made = (w as u64 * h as u64).saturating_mul(per_texel);
+    input.check_file(
+        path,
+        &format!("{what} ({w}x{h})"),
+        decoded.saturating_add(made),
+    )?;
+    image::DynamicImage::from_decoder(decoder).map_err(bad)
 }
 
 #[cfg(test)]

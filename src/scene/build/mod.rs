@@ -21,7 +21,9 @@ use super::desc::{self, Ctx, S, SceneDesc};
 use super::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::EnvImage;
+use crate::assets::input::Input;
 use crate::error::Error;
+use crate::scene::settings::RenderSettings;
 use std::sync::Arc;
 
 /// Options that come from outside the scene file.
@@ -42,9 +44,31 @@ pub struct LoadOptions {
     /// `--cache DIR`: decoded textures and their mip chains kept between
     /// runs (`assets::texture_cache`).
     pub cache: Option<PathBuf>,
+    /// `--max-memory`: the memory budget (wins over `render.max_memory`;
+    /// neither: `assets::input::default_budget`). Sizes read from asset
+    /// headers are checked against it before anything is allocated.
+    pub max_memory: Option<u64>,
+    /// `--sandbox`: every read stays in the scene's folder (as
+    /// `render.sandbox = true`).
+    pub sandbox: bool,
 }
 
 impl LoadOptions {
+    /// How the scene's files are read: the budget (`--max-memory`, else
+    /// `render.max_memory`, else what the machine has) and the sandbox.
+    pub fn input(&self, settings: &RenderSettings, scene_dir: &Path) -> Input {
+        let budget = self
+            .max_memory
+            .or(settings.max_memory)
+            .unwrap_or_else(crate::assets::input::default_budget);
+        let input = Input::new(budget);
+        if self.sandbox || settings.sandbox {
+            input.sandboxed(&[scene_dir])
+        } else {
+            input
+        }
+    }
+
     /// Version 1's defaults for scenes without lights (`plain_look`).
     pub fn plain() -> LoadOptions {
         LoadOptions {
@@ -64,13 +88,22 @@ impl Scene {
             return Scene::from_text(path, &edited, opts)
                 .map_err(|e| overrides::blame(path, &text, &opts.sets, e));
         }
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
-            location: crate::error::Location {
-                file: path.to_path_buf(),
-                line: 1,
-                column: 1,
-            },
-            message: format!("cannot read the scene file: {e}"),
+        // A regular file, at most the read cap: not a directory, FIFO or
+        // device.
+        let input = Input::new(
+            opts.max_memory
+                .unwrap_or_else(crate::assets::input::default_budget),
+        );
+        let bytes = input.read(path, None, None)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            Error::asset(
+                path,
+                None,
+                format!(
+                    "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl or .ply",
+                    e.utf8_error().valid_up_to()
+                ),
+            )
         })?;
         let edited = overrides::apply(path, &text, &opts.sets)?;
         Scene::from_text(path, &edited, opts)
@@ -137,34 +170,17 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         Some(dir) => Some(crate::assets::texture_cache::TextureCache::new(dir)?),
         None => None,
     };
-    let mut models = models::build(d, ctx, &settings, &scene_dir, cache.as_ref(), &mut warnings)?;
-    // Point and line sizes without points or lines to draw.
-    for (key, v, has) in [
-        (
-            "render.point_size",
-            &d.render.point_size,
-            models.models.iter().any(|m| !m.mesh.points.is_empty()),
-        ),
-        (
-            "render.line_width",
-            &d.render.line_width,
-            models.models.iter().any(|m| !m.mesh.lines.is_empty()),
-        ),
-    ] {
-        if let Some(v) = v
-            && !has
-        {
-            warnings.push(format!(
-                "{}: {key} has no effect: no model has {}",
-                ctx.location(v.span()),
-                if key.ends_with("point_size") {
-                    "points"
-                } else {
-                    "lines"
-                }
-            ));
-        }
-    }
+    let input = opts.input(&settings, &scene_dir);
+    let mut models = models::build(
+        d,
+        ctx,
+        &settings,
+        &scene_dir,
+        cache.as_ref(),
+        &input,
+        &mut warnings,
+    )?;
+    size_warnings(d, ctx, &models.models, &mut warnings);
     // The clips' frames first: their motion counts in the bounds.
     let mut animation = animation(&d.animation, Vec3::ZERO, &models.models);
     models::sweep(&mut models.models, &animation);
@@ -190,7 +206,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
     let environment = match &d.environment {
         Some(e) => {
-            let (env, sun) = environment(e.get_ref(), ctx, &scene_dir)?;
+            let (env, sun) = environment(e.get_ref(), ctx, &scene_dir, &input)?;
             if let Some(v) = &e.get_ref().sun
                 && *v.get_ref()
                 && sun.is_none()
@@ -231,6 +247,36 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     })
 }
 
+/// Point and line sizes without points or lines to draw.
+fn size_warnings(d: &SceneDesc, ctx: &Ctx, models: &[super::Model], warnings: &mut Vec<String>) {
+    for (key, v, has) in [
+        (
+            "render.point_size",
+            &d.render.point_size,
+            models.iter().any(|m| !m.mesh.points.is_empty()),
+        ),
+        (
+            "render.line_width",
+            &d.render.line_width,
+            models.iter().any(|m| !m.mesh.lines.is_empty()),
+        ),
+    ] {
+        if let Some(v) = v
+            && !has
+        {
+            warnings.push(format!(
+                "{}: {key} has no effect: no model has {}",
+                ctx.location(v.span()),
+                if key.ends_with("point_size") {
+                    "points"
+                } else {
+                    "lines"
+                }
+            ));
+        }
+    }
+}
+
 /// The catcher's plane: at the models' lowest point at rest (and over
 /// their clips).
 fn ground_plane(models: &[super::Model], bounds: cameras::Bounds) -> super::GroundPlane {
@@ -258,11 +304,13 @@ fn environment(
     e: &desc::EnvironmentDesc,
     ctx: &Ctx,
     scene_dir: &Path,
+    input: &Input,
 ) -> Result<(Environment, Option<super::Light>), Error> {
     let mut image = match (&e.path, e.preset.as_ref().map(|p| *p.get_ref())) {
         (Some(p), _) => {
             let path = scene_dir.join(p.get_ref().replace('\\', "/"));
-            if !path.is_file() {
+            input.confine(&path, Some(ctx.file))?;
+            if std::fs::symlink_metadata(&path).is_err() {
                 return Err(Error::asset(
                     &path,
                     None,
@@ -272,7 +320,7 @@ fn environment(
                     ),
                 ));
             }
-            EnvImage::load(&path)?
+            EnvImage::load(&path, input)?
         }
         (None, Some(desc::EnvPreset::Neutral)) => EnvImage::uniform(glam::Vec3::ONE),
         // Validation leaves only the studio here.

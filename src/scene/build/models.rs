@@ -15,6 +15,7 @@ use super::cameras::Bounds;
 use super::materials::{self, MtlSource, SourceMaterial};
 use super::{get, lights};
 use crate::assets::gltf::{GltfCamera, GltfModel, ImageSource};
+use crate::assets::input::Input;
 use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
 use crate::assets::rig::Parts;
@@ -68,11 +69,13 @@ pub(super) fn build(
     settings: &RenderSettings,
     scene_dir: &Path,
     cache: Option<&TextureCache>,
+    input: &Input,
     warnings: &mut Vec<String>,
 ) -> Result<Models, Error> {
-    let files = load_files(d, ctx, scene_dir)?;
+    let files = load_files(d, ctx, scene_dir, input)?;
     warnings.extend(files.loaded.iter().flat_map(|m| m.warnings.clone()));
     let model_mats = source_materials(d, ctx, &files, scene_dir)?;
+    confine_images(d, &files, &model_mats, input)?;
     // Depth and wireframe views read no texture; the normals view reads
     // normal and bump maps only.
     let textured = !matches!(
@@ -81,7 +84,7 @@ pub(super) fn build(
     );
     let normals_view = settings.shading == crate::scene::settings::ShadingMode::Normals;
     let (textures, by_key) = if textured {
-        decode_textures(d, &files, &model_mats, normals_view, cache, warnings)?
+        decode_textures(d, &files, &model_mats, normals_view, cache, input, warnings)?
     } else {
         (Vec::new(), BTreeMap::new())
     };
@@ -109,7 +112,7 @@ pub(super) fn build(
             {
                 // Lenient: a displacement map that cannot be read leaves
                 // the surface as it is.
-                if let Err(e) = displace(&mut mesh, gi, spec, mm.disp_scale) {
+                if let Err(e) = displace(&mut mesh, gi, spec, mm.disp_scale, input) {
                     warnings.push(format!("{e}; the surface is not displaced"));
                 }
             }
@@ -254,12 +257,14 @@ pub(super) fn sweep(models: &mut [Model], animation: &crate::scene::Animation) {
 
 /// Reads every model file once, in parallel; a missing file is an error
 /// naming the `path` key that points at it.
-fn load_files(d: &SceneDesc, ctx: &Ctx, scene_dir: &Path) -> Result<Files, Error> {
+fn load_files(d: &SceneDesc, ctx: &Ctx, scene_dir: &Path, input: &Input) -> Result<Files, Error> {
     let mut index: BTreeMap<PathBuf, usize> = BTreeMap::new();
     let mut list = Vec::new();
     for m in &d.models {
         let p = resolve(scene_dir, m.get_ref().path.get_ref());
-        if !p.is_file() {
+        input.confine(&p, Some(ctx.file))?;
+        // A directory, FIFO or device is named as such when it is read.
+        if std::fs::symlink_metadata(&p).is_err() {
             return Err(Error::Asset {
                 path: p,
                 line: None,
@@ -276,7 +281,7 @@ fn load_files(d: &SceneDesc, ctx: &Ctx, scene_dir: &Path) -> Result<Files, Error
     }
     let loaded = list
         .par_iter()
-        .map(|p| SourceModel::load(p))
+        .map(|p| SourceModel::load(p, input))
         .collect::<Result<_, _>>()?;
     Ok(Files {
         index,
@@ -329,6 +334,35 @@ fn source_materials(
     Ok(out)
 }
 
+/// In the sandbox, every image a material names (and every displacement
+/// map) stays in the scene's folder; the error names the model file.
+fn confine_images(
+    d: &SceneDesc,
+    files: &Files,
+    model_mats: &[Vec<SourceMaterial>],
+    input: &Input,
+) -> Result<(), Error> {
+    if !input.is_sandboxed() {
+        return Ok(());
+    }
+    for (m, mats) in d.models.iter().zip(model_mats) {
+        let model = resolve(&files.scene_dir, m.get_ref().path.get_ref());
+        for mm in mats {
+            for (img, _) in mm.images(false) {
+                if let ImageSource::File(p) = img {
+                    input.confine(&p, Some(&model))?;
+                }
+            }
+            if let SourceMaterial::Mtl(x) = mm
+                && let Some(spec) = &x.mtl.disp
+            {
+                input.confine(&spec.path, Some(&model))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 type TextureKeys = BTreeMap<(PathBuf, bool), Arc<Texture>>;
 
 /// Decodes, in parallel and once per (image, sRGB), the images that the
@@ -340,6 +374,7 @@ fn decode_textures(
     model_mats: &[Vec<SourceMaterial>],
     normals_view: bool,
     cache: Option<&TextureCache>,
+    input: &Input,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<Arc<Texture>>, TextureKeys), Error> {
     let mut wanted: BTreeMap<(PathBuf, bool), ImageSource> = BTreeMap::new();
@@ -363,19 +398,20 @@ fn decode_textures(
         .map(|((_, srgb), img)| {
             let srgb = *srgb;
             match (img, cache) {
-                (ImageSource::File(p), None) => Ok((Texture::load(p, srgb)?, None)),
+                (ImageSource::File(p), None) => Ok((Texture::load(p, srgb, input)?, None)),
                 (ImageSource::Memory { name, bytes }, None) => {
-                    Ok((Texture::from_bytes(bytes, name, srgb)?, None))
+                    Ok((Texture::from_bytes(bytes, name, srgb, input)?, None))
                 }
                 (ImageSource::File(p), Some(c)) => {
-                    let bytes = std::fs::read(p)
-                        .map_err(|e| Error::asset(p, None, format!("cannot open texture: {e}")))?;
-                    let (t, _, w) = c.load(&bytes, srgb, || Texture::load(p, srgb))?;
+                    let bytes = input.read(p, None, None)?;
+                    let (t, _, w) =
+                        c.load(&bytes, srgb, || Texture::from_bytes(&bytes, p, srgb, input))?;
                     Ok((t, w))
                 }
                 (ImageSource::Memory { name, bytes }, Some(c)) => {
-                    let (t, _, w) =
-                        c.load(bytes, srgb, || Texture::from_bytes(bytes, name, srgb))?;
+                    let (t, _, w) = c.load(bytes, srgb, || {
+                        Texture::from_bytes(bytes, name, srgb, input)
+                    })?;
                     Ok((t, w))
                 }
             }
@@ -395,6 +431,8 @@ fn decode_textures(
                 decoded.push(t.clone());
                 by_key.insert((*key).clone(), t);
             }
+            // The sandbox and the memory budget are not lenient.
+            Err(e @ (Error::Sandbox { .. } | Error::Memory { .. })) => return Err(e),
             Err(e) => {
                 if !warnings.iter().any(|w| w.starts_with(&e.to_string())) {
                     warnings.push(format!("{e}; rendering without this map"));
@@ -480,13 +518,13 @@ pub(super) fn bounds(models: &[Model]) -> Bounds {
 }
 
 impl SourceModel {
-    fn load(path: &Path) -> Result<SourceModel, Error> {
+    fn load(path: &Path, input: &Input) -> Result<SourceModel, Error> {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         if ext == "gltf" || ext == "glb" {
-            let mut g = crate::assets::gltf::load(path)?;
+            let mut g = crate::assets::gltf::load(path, input)?;
             Ok(SourceModel {
                 mesh: std::mem::take(&mut g.mesh),
                 materials: g
@@ -499,9 +537,9 @@ impl SourceModel {
             })
         } else if ext == "stl" || ext == "ply" {
             let mesh = if ext == "stl" {
-                crate::assets::stl::load(path)?
+                crate::assets::stl::load(path, input)?
             } else {
-                crate::assets::ply::load(path)?
+                crate::assets::ply::load(path, input)?
             };
             Ok(SourceModel {
                 mesh,
@@ -516,7 +554,7 @@ impl SourceModel {
                 warnings: Vec::new(),
             })
         } else {
-            let o = obj::load(path)?;
+            let o = obj::load(path, input)?;
             Ok(SourceModel {
                 mesh: o.mesh,
                 materials: o
@@ -602,6 +640,7 @@ fn displace(
     group_material: usize,
     spec: &MapSpec,
     scale: Option<f32>,
+    input: &Input,
 ) -> Result<(), Error> {
     let used: Vec<bool> = {
         let mut used = vec![false; mesh.positions.len()];
@@ -624,7 +663,7 @@ fn displace(
             "disp: the model has no texture coordinates to read heights with",
         ));
     }
-    let tex = Texture::load(&spec.path, false)?;
+    let tex = Texture::load(&spec.path, false, input)?;
     let (base, gain) = spec.mm.unwrap_or((0.0, 1.0));
     let scale = scale.unwrap_or(1.0);
     let mode = if spec.clamp {

@@ -52,6 +52,7 @@ pub(super) fn render(d: &SceneDesc, default_look: bool) -> RenderSettings {
         address: pick(&r.address),
         cull: pick(&r.cull),
         max_memory: r.max_memory.as_ref().map(|m| m.get_ref().0),
+        sandbox: get(&r.sandbox, false),
         point_size: get(&r.point_size, 4.0),
         line_width: get(&r.line_width, 1.5),
         depth: pick(&r.depth),

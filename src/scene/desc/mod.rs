@@ -178,6 +178,9 @@ pub struct RenderDesc {
     /// Extension: refuse to render when the memory estimate exceeds this
     /// (`"512M"`, `"2G"`, or bytes).
     pub max_memory: Option<S<MemorySize>>,
+    /// Version 3: every read stays inside the scene's folder (no `..`,
+    /// absolute path or URI scheme); `--sandbox` sets it too.
+    pub sandbox: Option<S<bool>>,
     /// Points (OBJ `p`, glTF points) are discs this many output pixels
     /// across (default 4).
     pub point_size: Option<S<f32>>,
