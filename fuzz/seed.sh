@@ -5,7 +5,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 corpus="$root/fuzz/corpus"
-mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture}
+mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture,output_names}
 
 # obj_mtl: OBJ bytes, a NUL, MTL bytes (the first .mtl in the same folder).
 n=0
@@ -41,5 +41,10 @@ while IFS= read -r -d '' img; do
   [ "$size" -gt 200000 ] && continue
   cp "$img" "$corpus/texture/$(basename "$img")"
 done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.png' -o -name '*.dds' -o -name '*.tga' -o -name '*.bmp' -o -name '*.tif' -o -name '*.jpg' -o -name '*.hdr' -o -name '*.ktx2' \) -print0)
+
+# output_names: name, gif, video, scene camera, glTF camera (NUL-separated).
+printf '{camera}_{frame:04}\0t.gif\0t.mp4\0front\0cam' > "$corpus/output_names/seed_plain"
+printf '{scene}-{camera}\0../t.gif\0/tmp/t.mp4\0../../x\0a/b' > "$corpus/output_names/seed_escape"
+printf '{camera}\0sub/{camera}.gif\0\0..\0.' > "$corpus/output_names/seed_dots"
 
 echo "seeded $(ls "$corpus"/obj_mtl | wc -l) obj_mtl, $(ls "$corpus"/gltf | wc -l) gltf, $(ls "$corpus"/scene_toml | wc -l) scene_toml, $(ls "$corpus"/render | wc -l) render, $(ls "$corpus"/texture | wc -l) texture inputs in $corpus"

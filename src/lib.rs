@@ -5,7 +5,7 @@
 //! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
 //! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
-//! frame by [`batch`]. [`color`], [`error`], [`powers`], [`raster`], [`raytrace`] and
+//! frame by [`batch`]. [`color`], [`error`], [`files`], [`powers`], [`raster`], [`raytrace`] and
 //! [`simd`] are the ground floor: they import nothing of the layers above.
 //!
 //! The library is the renderer alone with `--no-default-features`; the
@@ -44,6 +44,7 @@ pub mod batch;
 pub mod bigbuf;
 pub mod color;
 pub mod error;
+pub mod files;
 pub mod output;
 pub mod powers;
 pub mod procedural;

@@ -23,7 +23,12 @@ fuzz_target!(|data: &[u8]| {
     }
     let name = std::path::Path::new("fuzz.img");
     for srgb in [true, false] {
-        if let Ok(t) = Texture::from_bytes(data, name, srgb, &softraster::assets::input::Input::new(256 << 20)) {
+        if let Ok(t) = Texture::from_bytes(
+            data,
+            name,
+            srgb,
+            &softraster::assets::input::Input::new(256 << 20),
+        ) {
             // Keep the work per input small: mip chains of big images
             // would only slow the fuzzer down.
             if (t.width as u64) * (t.height as u64) <= 1 << 16 {

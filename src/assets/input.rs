@@ -95,7 +95,7 @@ impl Input {
         let kept = self.kept.load(Ordering::Relaxed);
         if kept.saturating_add(bytes) > self.budget {
             return Err(format!(
-                "{what} would take {}{}, more than the memory budget of {} (--max-memory)",
+                "{what} would take {}{}, more than the memory budget of {} (--max-memory sets it)",
                 human(bytes),
                 if kept > 0 {
                     format!(" beside the {} already loaded", human(kept))
@@ -187,7 +187,7 @@ impl Input {
             return Err(Error::asset(
                 path,
                 None,
-                format!("{}, not a regular file", kind(&meta)),
+                format!("{}, not a regular file", crate::files::kind(&meta)),
             ));
         }
         Ok((file, meta.len()))
@@ -252,28 +252,6 @@ fn looks_like_scheme(n: &std::ffi::OsStr) -> bool {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
     })
-}
-
-/// What a file that is not a regular file is, for messages.
-pub fn kind(meta: &std::fs::Metadata) -> &'static str {
-    let t = meta.file_type();
-    if t.is_dir() {
-        return "a directory";
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    "not a regular file"
 }
 
 #[cfg(unix)]

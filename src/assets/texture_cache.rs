@@ -85,10 +85,14 @@ impl TextureCache {
     }
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it.
+/// Writes `bytes` to a temporary file beside `path` (created
+/// exclusively, with a random name), then renames it.
 fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    let r = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
+    use std::io::Write;
+    let (mut file, tmp) = crate::files::temp_file(path).map_err(std::io::Error::other)?;
+    let r = file
+        .write_all(bytes)
+        .and_then(|_| std::fs::rename(&tmp, path));
     if r.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -41,11 +41,7 @@ const TRAINING_PIXELS: usize = 1 << 21;
 const BATCH: usize = 8;
 
 fn read_rgba(path: &Path) -> Result<image::RgbaImage, Error> {
-    let img = image::open(path).map_err(|e| match e {
-        image::ImageError::IoError(io) => Error::io(path, io),
-        other => Error::asset(path, None, format!("cannot read the frame: {other}")),
-    })?;
-    Ok(img.to_rgba8())
+    Ok(super::png::read_any(path)?.to_rgba8())
 }
 
 /// Assembles `frames` (PNG files, in order) into `out`.

@@ -25,9 +25,10 @@ pub fn write(path: &Path, img: &Image8) -> Result<(), Error> {
     })
 }
 
-/// Reads a PNG back as 8-bit RGB(A) (for golden comparisons).
+/// Reads a PNG back as 8-bit RGB(A) (for golden comparisons, GIFs and
+/// videos): its size from the header first, against the memory budget.
 pub fn read(path: &Path) -> Result<Image8, Error> {
-    let img = image::open(path).map_err(|e| Error::asset(path, None, e.to_string()))?;
+    let img = read_any(path)?;
     let (channels, data) = if img.color().has_alpha() {
         (4, img.to_rgba8().into_raw())
     } else {
@@ -39,4 +40,20 @@ pub fn read(path: &Path) -> Result<Image8, Error> {
         channels,
         data,
     })
+}
+
+/// Any image the image library reads, decoded only when its size (the
+/// decode and an 8-bit RGBA copy) fits the default memory budget.
+pub fn read_any(path: &Path) -> Result<image::DynamicImage, Error> {
+    let input = crate::assets::input::Input::default();
+    let (file, _) = input.open(path, None)?;
+    let mut reader = image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .map_err(|e| Error::asset(path, None, e.to_string()))?;
+    if reader.format().is_none()
+        && let Ok(f) = image::ImageFormat::from_path(path)
+    {
+        reader.set_format(f);
+    }
+    crate::assets::texture::decode_within(reader, &input, path, "the image", 4)
 }

@@ -16,7 +16,6 @@
 //! does) is not covered by that licence. See the `openh264` crate's
 //! documentation.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use openh264::encoder::{
@@ -196,13 +195,14 @@ fn ycbcr_to_rgb(y: f32, u: f32, v: f32) -> [u8; 3] {
 /// A video being written: frames go in one at a time.
 pub struct VideoWriter {
     path: PathBuf,
-    tmp: PathBuf,
     opts: VideoOptions,
     /// The frames' size (all frames must have it) and the stream's.
     size: (u32, u32),
     padded: (u32, u32),
     encoder: Encoder,
-    muxer: Option<muxide::api::Muxer<std::io::BufWriter<std::fs::File>>>,
+    /// Muxed in memory (the file appears whole, when finished: a killed
+    /// render leaves nothing behind).
+    muxer: Option<muxide::api::Muxer<Vec<u8>>>,
     frames: usize,
     nal: Vec<u8>,
 }
@@ -260,25 +260,14 @@ impl VideoWriter {
         };
         let encoder = Encoder::with_api_config(OpenH264API::from_source(), config)
             .map_err(|e| enc_err(path, format!("cannot start the H.264 encoder: {e}")))?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        let muxer = muxide::api::MuxerBuilder::new(std::io::BufWriter::new(file))
+        super::check_target(path)?;
+        let muxer = muxide::api::MuxerBuilder::new(Vec::new())
             .video(muxide::api::VideoCodec::H264, padded.0, padded.1, opts.fps)
             .with_fast_start(true)
             .build()
-            .map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                enc_err(path, e)
-            })?;
+            .map_err(|e| enc_err(path, e))?;
         Ok(VideoWriter {
             path: path.to_path_buf(),
-            tmp,
             opts,
             size: (width, height),
             padded,
@@ -335,7 +324,7 @@ impl VideoWriter {
         Ok(())
     }
 
-    /// Writes the index and moves the file into place.
+    /// Writes the index, then the file (atomically).
     pub fn finish(mut self) -> Result<VideoInfo, Error> {
         if self.frames == 0 {
             return Err(enc_err(&self.path, "a video needs at least one frame"));
@@ -347,15 +336,9 @@ impl VideoWriter {
         muxer
             .finish_in_place()
             .map_err(|e| enc_err(&self.path, e))?;
-        let mut w = muxer.into_writer();
-        w.flush().map_err(|e| Error::io(&self.tmp, e))?;
-        let file = w
-            .into_inner()
-            .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
-        file.sync_data().map_err(|e| Error::io(&self.tmp, e))?;
-        let bytes = file.metadata().map_err(|e| Error::io(&self.tmp, e))?.len();
-        drop(file);
-        std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
+        let data = muxer.into_writer();
+        super::write_bytes_atomic(&self.path, &data)?;
+        let bytes = data.len() as u64;
         Ok(VideoInfo {
             frames: self.frames,
             width: self.padded.0,
@@ -366,21 +349,16 @@ impl VideoWriter {
     }
 }
 
-impl Drop for VideoWriter {
-    /// An unfinished video leaves no file behind.
-    fn drop(&mut self) {
-        if self.muxer.is_some() {
-            self.muxer = None;
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
 /// Assembles `frames` (PNG files, in order, all of one size) into `out`.
 pub fn assemble(frames: &[PathBuf], out: &Path, opts: VideoOptions) -> Result<VideoInfo, Error> {
     let first = frames
         .first()
         .ok_or_else(|| Error::Argument("a video needs at least one frame".into()))?;
+    // The size from the header first: a frame too large for a video is
+    // refused before it is decoded.
+    let (w, h) = image::image_dimensions(first)
+        .map_err(|e| Error::asset(first, None, format!("cannot read the frame: {e}")))?;
+    check_video_size(w, h).map_err(|m| Error::asset(first, None, m))?;
     let img = super::png::read(first)?;
     let mut writer = VideoWriter::create(out, img.width, img.height, opts)?;
     writer.push(&img)?;

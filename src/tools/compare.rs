@@ -328,6 +328,10 @@ impl Report {
     /// 0: every pair passed; 1: some pair failed or a file is on one side
     /// only; 2: some file could not be read.
     pub fn exit_code(&self) -> i32 {
+        if self.files.is_empty() {
+            // A gate that compared nothing has not passed.
+            return 1;
+        }
         if self
             .files
             .iter()
@@ -398,6 +402,9 @@ impl Report {
             self.files.len() - failed,
             self.files.len()
         ));
+        if self.files.is_empty() {
+            out.push_str("nothing to compare: neither side has an image (.png, .jpg, .tga)\n");
+        }
         out
     }
 }
@@ -413,7 +420,7 @@ pub fn read_image(p: &Path) -> Result<Image8, String> {
     if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
         return png::read(p).map_err(|e| e.to_string());
     }
-    let img = image::open(p).map_err(|e| format!("{}: {e}", p.display()))?;
+    let img = png::read_any(p).map_err(|e| e.to_string())?;
     let rgba = img.to_rgba8();
     Ok(Image8 {
         width: rgba.width(),

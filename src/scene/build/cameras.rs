@@ -156,6 +156,10 @@ pub(super) fn build(
                     "camera".into()
                 }
             });
+        if let Err(m) = check_name(&name) {
+            let span = c.get_ref().name.as_ref().map_or(c.span(), |n| n.span());
+            return Err(ctx.err(span, format!("camera.name = {name:?}: {m}")));
+        }
         if cams.iter().any(|c| c.name == name) {
             return Err(ctx.err(c.span(), format!("two cameras are named `{name}`")));
         }
@@ -170,6 +174,15 @@ pub(super) fn build(
         cams.push(cam);
     }
     for (g, world) in imported {
+        if let Err(m) = check_name(&g.name) {
+            return Err(Error::SceneGlobal {
+                file: ctx.file.to_path_buf(),
+                message: format!(
+                    "a glTF camera imported by model.cameras = true is named {:?}: {m}",
+                    g.name
+                ),
+            });
+        }
         let mut name = g.name.clone();
         let mut k = 1;
         while cams.iter().any(|c| c.name == name) {
@@ -179,6 +192,18 @@ pub(super) fn build(
         cams.push(from_gltf(g, *world, name, bounds));
     }
     Ok(cams)
+}
+
+/// A camera's name goes into output file names (`{camera}`): it may not
+/// lead out of the output folder.
+fn check_name(name: &str) -> Result<(), String> {
+    if name.contains(['/', '\\', '\0']) || name == ".." || name == "." {
+        return Err(
+            "a camera's name goes into output file names, so it may not contain `/`, `\\` or be `.` or `..`"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// One `[[camera]]`. Without `eye` and `target`: fitted (with its fov or

@@ -149,11 +149,31 @@ pub(super) fn output(
         (Some(f), _) | (None, Some(f)) => *f.get_ref() as f64,
         (None, None) => 1000.0 / get(&o.gif_delay_ms, 40) as f64,
     };
+    for (key, v) in [("output.gif", &o.gif), ("output.video", &o.video)] {
+        if let Some(v) = v
+            && let Err(m) = check_output_file(v.get_ref())
+        {
+            return Err(ctx.err(v.span(), format!("{key} = {:?}: {m}", v.get_ref())));
+        }
+    }
     let dir = match (out_dir, &o.dir) {
         (Some(out), _) => out.to_path_buf(),
         (None, Some(dir)) => scene_dir.join(dir.get_ref()),
         (None, None) => PathBuf::from("out").join(stem),
     };
+    if let Ok(m) = std::fs::metadata(&dir)
+        && !m.is_dir()
+    {
+        let what = format!(
+            "the output folder {} is {}, not a folder",
+            dir.display(),
+            crate::files::kind(&m)
+        );
+        return Err(match (out_dir, &o.dir) {
+            (None, Some(d)) => ctx.err(d.span(), format!("output.dir: {what}")),
+            _ => Error::Argument(format!("--out: {what}")),
+        });
+    }
     Ok(OutputSettings {
         dir,
         name,
@@ -171,6 +191,31 @@ pub(super) fn output(
         position: get(&o.position, false),
         id: get(&o.id, false),
     })
+}
+
+/// `output.gif` and `output.video` are files inside the output folder:
+/// a relative path to a file, without `..`.
+fn check_output_file(name: &str) -> Result<(), String> {
+    let p = Path::new(name);
+    if name.trim().is_empty() || name.contains('\0') {
+        return Err("expected a file name, such as \"turntable.gif\"".into());
+    }
+    if name.ends_with('/') || name.ends_with('\\') || p.file_name().is_none() {
+        return Err("names a folder, not a file".into());
+    }
+    for c in p.components() {
+        match c {
+            std::path::Component::Normal(_) | std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                return Err("`..` would write outside the output folder".into());
+            }
+            _ => return Err("an absolute path would write outside the output folder".into()),
+        }
+    }
+    if name.contains('\\') {
+        return Err("`\\` is not a path separator here; use `/`".into());
+    }
+    Ok(())
 }
 
 fn shadow_bias(r: &desc::RenderDesc) -> ShadowBias {

@@ -856,7 +856,21 @@ fn source_excerpt(text: &str, offset: usize) -> String {
     if line.is_empty() {
         return String::new();
     }
-    format!("\n  {line_no} | {line}")
+    // A long line (a generated or hostile file) is shown around the
+    // place, at most 100 characters of it.
+    const SHOWN: usize = 100;
+    if line.chars().count() <= SHOWN {
+        return format!("\n  {line_no} | {line}");
+    }
+    let at = text[start..offset].chars().count();
+    let from = at.saturating_sub(SHOWN / 2);
+    let piece: String = line.chars().skip(from).take(SHOWN).collect();
+    let more = line.chars().count() > from + SHOWN;
+    format!(
+        "\n  {line_no} | {}{piece}{}",
+        if from > 0 { "..." } else { "" },
+        if more { "..." } else { "" }
+    )
 }
 
 #[cfg(test)]
@@ -865,6 +879,13 @@ mod tests {
 
     fn parse(t: &str) -> Result<SceneDesc, Error> {
         SceneDesc::parse(Path::new("t.toml"), t)
+    }
+
+    #[test]
+    fn a_long_line_is_shown_around_the_error_only() {
+        let deep = format!("a = {}1{}\n", "[".repeat(50_000), "]".repeat(50_000));
+        let e = parse(&deep).unwrap_err().to_string();
+        assert!(e.len() < 1_000, "{} bytes: {}", e.len(), &e[..300]);
     }
 
     #[test]
