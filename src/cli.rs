@@ -253,6 +253,14 @@ fn compare(args: CompareArgs) -> i32 {
         args.diff.as_deref(),
     ) {
         Ok(report) => {
+            if report.files.is_empty() {
+                // A gate that compared nothing has not passed (exit 1).
+                eprintln!(
+                    "error: nothing to compare: neither {} nor {} holds an image (.png, .jpg, .jpeg, .tga)",
+                    args.reference.display(),
+                    args.test.display()
+                );
+            }
             if args.json {
                 println!("{}", report.to_json());
             } else {

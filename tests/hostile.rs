@@ -27,6 +27,16 @@ struct Outcome {
     seconds: f64,
 }
 
+impl Outcome {
+    /// Exit status `code`, and a message with every one of `words`.
+    fn expect(&self, code: i32, words: &[&str]) {
+        assert_eq!(self.code, code, "{}", self.err);
+        for w in words {
+            assert!(self.err.contains(w), "no `{w}` in: {}", self.err);
+        }
+    }
+}
+
 /// Runs the binary in `cwd` under `LIMIT` and `TIMEOUT`. The child is
 /// reaped by `wait4` (which also gives its peak memory), which clippy
 /// cannot see.
@@ -236,12 +246,7 @@ fn unbounded_reads_stop_at_what_the_file_declares() {
     c.write("buf.gltf", gltf(Some(("zero.bin", 60)), "none.png", ""));
     c.write("buf.toml", scene("buf.gltf", ""));
     let o = c.render("buf.toml", &[]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(
-        o.err.contains("zero.bin") && o.err.contains("a device"),
-        "{}",
-        o.err
-    );
+    o.expect(2, &["zero.bin", "a device"]);
     assert!(o.peak_kib < 512 << 10, "peak {} KiB", o.peak_kib);
 }
 
@@ -364,12 +369,7 @@ fn tiny_files_claiming_huge_sizes_are_refused_before_allocating() {
     c.write("sparse.gltf", gltf(None, "none.png", sparse));
     c.write("sparse.toml", scene("sparse.gltf", ""));
     let o = c.render("sparse.toml", &[]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(
-        o.err.contains("accessor 2") && o.err.contains("memory budget"),
-        "{}",
-        o.err
-    );
+    o.expect(2, &["accessor 2", "memory budget"]);
     // An EXR environment whose header claims 100000x50000.
     c.write("tri.obj", TRIANGLE);
     c.write("huge.exr", exr_header(100_000, 50_000));
@@ -378,12 +378,7 @@ fn tiny_files_claiming_huge_sizes_are_refused_before_allocating() {
         scene("tri.obj", "[environment]\npath = \"huge.exr\"\n"),
     );
     let o = c.render("exr.toml", &[]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(
-        o.err.contains("huge.exr") && o.err.contains("memory budget"),
-        "{}",
-        o.err
-    );
+    o.expect(2, &["huge.exr", "memory budget"]);
     // A greyscale PNG within the image library's own limit, whose RGBA
     // expansion and mip chain are not: refused from its header, with or
     // without --max-memory (the default budget comes from the
@@ -394,12 +389,7 @@ fn tiny_files_claiming_huge_sizes_are_refused_before_allocating() {
     c.write("grey.toml", scene("grey.obj", ""));
     for extra in [&[][..], &["--max-memory", "256M"][..]] {
         let o = c.render("grey.toml", extra);
-        assert_eq!(o.code, 2, "{}", o.err);
-        assert!(
-            o.err.contains("grey.png") && o.err.contains("memory budget"),
-            "{}",
-            o.err
-        );
+        o.expect(2, &["grey.png", "memory budget"]);
         assert!(o.peak_kib < 256 << 10, "peak {} KiB", o.peak_kib);
     }
 }
@@ -420,8 +410,7 @@ fn nothing_is_written_outside_the_output_folder() {
     ] {
         c.write("s.toml", scene("tri.obj", output) + tail);
         let o = c.render("s.toml", &[]);
-        assert_eq!(o.code, 2, "{output}{tail}: {}", o.err);
-        assert!(o.err.contains(key), "{output}{tail}: {}", o.err);
+        o.expect(2, &[key]);
         assert_eq!(
             c.frames(),
             0,
@@ -436,8 +425,7 @@ fn nothing_is_written_outside_the_output_folder() {
         "[output]\nwidth = 32\nheight = 32\n[[model]]\npath = \"cam.gltf\"\ncameras = true\n",
     );
     let o = c.render("cam.toml", &[]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(o.err.contains("\"../../x\""), "{}", o.err);
+    o.expect(2, &["\"../../x\""]);
     // A FIFO where a frame goes is refused, not replaced.
     std::fs::create_dir_all(c.dir.join("out")).unwrap();
     let p = std::ffi::CString::new(c.dir.join("out/camera_0000.png").to_str().unwrap()).unwrap();
@@ -445,8 +433,7 @@ fn nothing_is_written_outside_the_output_folder() {
     assert_eq!(unsafe { libc::mkfifo(p.as_ptr(), 0o644) }, 0);
     c.write("plain.toml", scene("tri.obj", ""));
     let o = c.render("plain.toml", &[]);
-    assert_eq!(o.code, 1, "{}", o.err);
-    assert!(o.err.contains("a FIFO"), "{}", o.err);
+    o.expect(1, &["a FIFO"]);
     use std::os::unix::fs::FileTypeExt;
     let t = std::fs::symlink_metadata(c.dir.join("out/camera_0000.png")).unwrap();
     assert!(t.file_type().is_fifo());
@@ -461,12 +448,7 @@ fn without_max_memory_the_budget_is_what_the_process_may_have() {
         "[output]\nwidth = 16384\nheight = 16384\n[render]\nmsaa = 4\n[[model]]\npath = \"tri.obj\"\n",
     );
     let o = c.render("big.toml", &[]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(
-        o.err.contains("the render needs about") && o.err.contains("default budget"),
-        "{}",
-        o.err
-    );
+    o.expect(2, &["the render needs about", "default budget"]);
     assert_eq!(c.frames(), 0);
 }
 
@@ -483,20 +465,18 @@ fn bad_output_settings_exit_2_at_load_and_empty_compares_fail() {
     ] {
         c.write("s.toml", scene("tri.obj", extra));
         let o = run_in(&c.dir, &["render", "s.toml", "--quiet"]);
-        assert_eq!(o.code, 2, "{extra}: {}", o.err);
-        assert!(o.err.contains(key), "{extra}: {}", o.err);
+        o.expect(2, &[key]);
         assert!(!c.dir.join("out").exists() || c.frames() == 0);
     }
     // `compare` with nothing on either side is not a pass.
     std::fs::create_dir_all(c.dir.join("a")).unwrap();
     std::fs::create_dir_all(c.dir.join("b")).unwrap();
     let o = run_in(&c.dir, &["compare", "a", "b"]);
-    assert_eq!(o.code, 1, "{}", o.err);
+    o.expect(1, &["nothing to compare"]);
     // A frame too large for a video: refused from its header.
     c.write("big.png", grey_png(8000, 8000));
     let o = run_in(&c.dir, &["video", "big.png", "-o", "v.mp4"]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(o.err.contains("3840x2160"), "{}", o.err);
+    o.expect(2, &["3840x2160"]);
     assert!(o.peak_kib < 128 << 10, "peak {} KiB", o.peak_kib);
     c.assert_nothing_outside();
 }
@@ -513,8 +493,7 @@ fn messages_name_what_a_path_is() {
     ] {
         c.write("s.toml", scene(model, ""));
         let o = c.render("s.toml", &[]);
-        assert_eq!(o.code, 2, "{model}: {}", o.err);
-        assert!(o.err.contains(what), "{model}: {}", o.err);
+        o.expect(2, &[what]);
     }
     // A deeply nested value: the error quotes the place, not the line.
     let deep = format!("a = {}1{}\n", "[".repeat(100_000), "]".repeat(100_000));
@@ -537,12 +516,7 @@ fn the_sandbox_keeps_reads_in_the_scene_folder() {
     // With it: refused, naming the path and the file that asked.
     for flags in [&["--sandbox"][..], &["--set", "render.sandbox=true"][..]] {
         let o = c.render("s.toml", flags);
-        assert_eq!(o.code, 2, "{}", o.err);
-        assert!(
-            o.err.contains("secret.png") && o.err.contains("--sandbox") && o.err.contains("m.gltf"),
-            "{}",
-            o.err
-        );
+        o.expect(2, &["secret.png", "--sandbox", "m.gltf"]);
     }
     // A link inside the folder that leads out, and a model named by an
     // absolute path.
@@ -550,13 +524,11 @@ fn the_sandbox_keeps_reads_in_the_scene_folder() {
     c.write("l.gltf", gltf(None, "sub/in.png", ""));
     c.write("l.toml", scene("l.gltf", ""));
     let o = c.render("l.toml", &["--sandbox"]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(o.err.contains("leads outside"), "{}", o.err);
+    o.expect(2, &["leads outside"]);
     let abs = c.dir.join("l.gltf");
     c.write("a.toml", scene(abs.to_str().unwrap(), ""));
     let o = c.render("a.toml", &["--sandbox"]);
-    assert_eq!(o.code, 2, "{}", o.err);
-    assert!(o.err.contains("absolute path"), "{}", o.err);
+    o.expect(2, &["absolute path"]);
 }
 
 #[test]

@@ -402,9 +402,6 @@ impl Report {
             self.files.len() - failed,
             self.files.len()
         ));
-        if self.files.is_empty() {
-            out.push_str("nothing to compare: neither side has an image (.png, .jpg, .tga)\n");
-        }
         out
     }
 }
