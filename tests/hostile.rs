@@ -537,7 +537,7 @@ fn a_killed_video_render_leaves_no_partial_file() {
     c.write("tri.obj", TRIANGLE);
     c.write(
         "v.toml",
-        "[output]\nwidth = 64\nheight = 64\nvideo = \"v.mp4\"\n[animation]\nframes = 400\n[animation.turntable]\n[[model]]\npath = \"tri.obj\"\n",
+        "[output]\nwidth = 256\nheight = 256\nvideo = \"v.mp4\"\n[animation]\nframes = 1000\n[animation.turntable]\n[[model]]\npath = \"tri.obj\"\n",
     );
     let mut child = std::process::Command::new(common::BIN)
         .args(["render", "v.toml", "--out", "out", "--quiet"])
@@ -549,7 +549,11 @@ fn a_killed_video_render_leaves_no_partial_file() {
         std::thread::sleep(Duration::from_millis(10));
     }
     child.kill().unwrap();
-    child.wait().unwrap();
+    let status = child.wait().unwrap();
+    assert!(
+        !status.success(),
+        "the render finished before it was killed"
+    );
     // The video is muxed in memory: no file of it, whole or partial.
     let left: Vec<_> = std::fs::read_dir(c.dir.join("out"))
         .unwrap()
