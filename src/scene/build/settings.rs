@@ -181,7 +181,7 @@ pub(super) fn output(
         depth: get(&o.depth, false),
         ao: get(&o.ao, false),
         gif: o.gif.as_ref().map(|g| g.get_ref().clone()),
-        gif_delay_ms: get(&o.gif_delay_ms, 40) as u32,
+        gif_delay_ms: gif_delay_ms(d),
         gif_dither: pick(&o.gif_dither),
         video: o.video.as_ref().map(|v| v.get_ref().clone()),
         video_fps,
@@ -191,6 +191,19 @@ pub(super) fn output(
         position: get(&o.position, false),
         id: get(&o.id, false),
     })
+}
+
+/// `output.gif_delay_ms`, else one frame of `animation.fps` (a GIF stores
+/// hundredths of a second: 24 fps gives 40 ms, 12 fps 80 ms), else 40 ms.
+fn gif_delay_ms(d: &SceneDesc) -> u32 {
+    match (&d.output.gif_delay_ms, &d.animation.fps) {
+        (Some(ms), _) => *ms.get_ref() as u32,
+        (None, Some(fps)) => {
+            let ms = 1000.0 / *fps.get_ref() as f64;
+            ((ms / 10.0).round() * 10.0).clamp(10.0, 655_350.0) as u32
+        }
+        (None, None) => 40,
+    }
 }
 
 /// `output.gif` and `output.video` are files inside the output folder:
@@ -415,6 +428,20 @@ mod tests {
         assert_eq!(o.name, "{camera}_{frame:04}");
         assert!(o.color && !o.depth && !o.ao && o.gif.is_none());
         assert_eq!((o.gif_delay_ms, o.gif_dither), (40, GifDither::None));
+    }
+
+    #[test]
+    fn the_gif_delay_follows_the_animations_rate() {
+        for (text, ms) in [
+            ("[animation]\nfps = 12\n", 80),
+            ("[animation]\nfps = 24\n", 40),
+            ("[animation]\nfps = 30\n", 30),
+            ("[animation]\nfps = 12\n[output]\ngif_delay_ms = 100\n", 100),
+            ("", 40),
+        ] {
+            let d = parse(&format!("[[model]]\npath = \"m.obj\"\n{text}"));
+            assert_eq!(gif_delay_ms(&d), ms, "{text}");
+        }
     }
 
     #[test]
