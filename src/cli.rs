@@ -245,6 +245,14 @@ fn compare(args: CompareArgs) -> i32 {
         eprintln!("error: --threshold must be a finite number");
         return 2;
     }
+    // Blessing into a folder that does not exist yet: make it.
+    if args.update && args.test.is_dir() && !args.reference.exists() {
+        if let Err(e) = std::fs::create_dir_all(&args.reference) {
+            eprintln!("error: {}: {e}", args.reference.display());
+            return 1;
+        }
+        eprintln!("created {}", args.reference.display());
+    }
     match compare_paths(
         &args.reference,
         &args.test,
@@ -253,7 +261,7 @@ fn compare(args: CompareArgs) -> i32 {
         args.diff.as_deref(),
     ) {
         Ok(report) => {
-            if report.files.is_empty() {
+            if report.files.is_empty() && !args.update {
                 // A gate that compared nothing has not passed (exit 1).
                 eprintln!(
                     "error: nothing to compare: neither {} nor {} holds an image (.png, .jpg, .jpeg, .tga)",
@@ -263,6 +271,11 @@ fn compare(args: CompareArgs) -> i32 {
             }
             if args.json {
                 println!("{}", report.to_json());
+            } else if args.update {
+                // The verdicts, without the pass count: the blessing's
+                // summary says what happened.
+                let text = report.to_text();
+                print!("{}", text.strip_suffix(&report.summary()).unwrap_or(&text));
             } else {
                 print!("{}", report.to_text());
             }
@@ -273,11 +286,13 @@ fn compare(args: CompareArgs) -> i32 {
                 }
                 eprintln!("report: {}", page.display());
             }
-            if args.update && report.exit_code() == 1 {
+            if args.update && report.exit_code() != 2 {
+                // Exit 0 when every failing or new image was blessed (a
+                // reference the test set lacks is left alone).
                 return match softraster::tools::report::update_references(&report, &args.reference)
                 {
-                    Ok(files) => {
-                        eprintln!("updated {} reference(s)", files.len());
+                    Ok(blessed) => {
+                        println!("{blessed}");
                         0
                     }
                     Err(e) => {

@@ -381,6 +381,31 @@ fn gifs_per_camera_and_their_keys_are_checked() {
 }
 
 #[test]
+fn update_makes_a_missing_golden_folder_and_says_what_it_blessed() {
+    let dir = common::scratch("compare_bless_new");
+    let (refs, tests) = (dir.join("golden"), dir.join("out"));
+    std::fs::create_dir_all(&tests).unwrap();
+    for name in ["a.png", "b.png"] {
+        png(&tests.join(name), |x, y| [x as u8, y as u8, 9]);
+    }
+    let (r, t) = (refs.to_str().unwrap(), tests.to_str().unwrap());
+    let (code, out, err) = run(&["compare", r, t, "--update"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.contains("created"), "{err}");
+    assert!(out.contains("blessed 2 new, 0 changed (0 unchanged)"), "{out}");
+    for name in ["a.png", "b.png"] {
+        assert_eq!(
+            std::fs::read(refs.join(name)).unwrap(),
+            std::fs::read(tests.join(name)).unwrap()
+        );
+    }
+    // Blessed: the gate passes now.
+    let (code, out, _) = run(&["compare", r, t]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("2 of 2 passed"), "{out}");
+}
+
+#[test]
 fn review_report_lists_failures_first_and_update_blesses_them() {
     let dir = common::scratch("compare_report");
     let (refs, tests) = (dir.join("ref"), dir.join("test"));
@@ -424,11 +449,16 @@ fn review_report_lists_failures_first_and_update_blesses_them() {
     assert!(!html.contains("src=\"/") && !html.contains("src=\"ref"));
     // --update copies the failing and the new test images into the
     // references and prints what changed; then everything passes.
-    let (code, _, err) = args(&["--update"]);
+    let (code, out, err) = args(&["--update"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("b_changed.png") && err.contains("c_new.png"),
         "{err}"
+    );
+    // The summary says what was done, not the pass count before it.
+    assert!(
+        out.contains("blessed 1 new, 1 changed (1 unchanged)") && !out.contains("passed"),
+        "{out}"
     );
     for name in ["b_changed.png", "c_new.png"] {
         assert_eq!(

@@ -369,6 +369,20 @@ impl Report {
         })
     }
 
+    /// The last line of `to_text`: how many pairs passed.
+    pub fn summary(&self) -> String {
+        let failed = self
+            .files
+            .iter()
+            .filter(|f| f.status != Status::Pass)
+            .count();
+        format!(
+            "{} of {} passed\n",
+            self.files.len() - failed,
+            self.files.len()
+        )
+    }
+
     pub fn to_text(&self) -> String {
         let mut out = String::new();
         for f in &self.files {
@@ -392,16 +406,7 @@ impl Report {
             let sep = if detail.is_empty() { "" } else { ": " };
             out.push_str(&format!("{tag} {}{value}{sep}{detail}\n", f.name));
         }
-        let failed = self
-            .files
-            .iter()
-            .filter(|f| f.status != Status::Pass)
-            .count();
-        out.push_str(&format!(
-            "{} of {} passed\n",
-            self.files.len() - failed,
-            self.files.len()
-        ));
+        out.push_str(&self.summary());
         out
     }
 }

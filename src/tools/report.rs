@@ -165,8 +165,8 @@ fn escape(s: &str) -> String {
 /// `--update`: copies each failing test image over its reference (and,
 /// for two directories, adds test images the references lack to
 /// `references`), printing what changed. Returns the files updated.
-pub fn update_references(report: &Report, references: &Path) -> Result<Vec<PathBuf>, Error> {
-    let mut updated = Vec::new();
+pub fn update_references(report: &Report, references: &Path) -> Result<Blessed, Error> {
+    let mut blessed = Blessed::default();
     for f in &report.files {
         let target = match (&f.status, &f.reference, &f.test) {
             (Status::Fail, Some(r), Some(_)) => r.clone(),
@@ -185,7 +185,37 @@ pub fn update_references(report: &Report, references: &Path) -> Result<Vec<PathB
             (_, None) => f.message.clone().unwrap_or_default(),
         };
         eprintln!("updated {} <- {} ({why})", target.display(), test.display());
-        updated.push(target);
+        if f.status == Status::Extra {
+            blessed.new.push(target);
+        } else {
+            blessed.changed.push(target);
+        }
     }
-    Ok(updated)
+    blessed.unchanged = report
+        .files
+        .iter()
+        .filter(|f| f.status == Status::Pass)
+        .count();
+    Ok(blessed)
+}
+
+/// What `update_references` wrote: references added, references replaced,
+/// and the pairs that already passed.
+#[derive(Debug, Default)]
+pub struct Blessed {
+    pub new: Vec<PathBuf>,
+    pub changed: Vec<PathBuf>,
+    pub unchanged: usize,
+}
+
+impl std::fmt::Display for Blessed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "blessed {} new, {} changed ({} unchanged)",
+            self.new.len(),
+            self.changed.len(),
+            self.unchanged
+        )
+    }
 }
