@@ -53,7 +53,8 @@ enum Command {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or a model file to render as the one-line
+    /// scene that names it: .gltf, .glb, .obj, .stl or .ply.
     scene: PathBuf,
     /// Output directory; wins over `output.dir`.
     #[arg(long)]
@@ -78,7 +79,7 @@ struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// No progress output.
+    /// No progress output (warnings and errors are still shown).
     #[arg(long)]
     quiet: bool,
     /// Treat every warning (a missing material library or texture, an
@@ -551,10 +552,9 @@ fn render(args: RenderArgs) -> Result<(), Error> {
         } else if auto && !args.quiet {
             eprintln!("exposure: auto, {:+.2} stops", scene.settings.exposure);
         }
-        if !args.quiet {
-            for w in &scene.warnings {
-                eprintln!("warning: {w}");
-            }
+        // Warnings are shown with --quiet too: it silences progress only.
+        for w in &scene.warnings {
+            eprintln!("warning: {w}");
         }
         check_memory(&scene, args.max_memory, &args)?;
         let plan = FramePlan::select(&scene, args.frames.as_deref(), args.camera.as_deref())?;
@@ -657,6 +657,10 @@ impl Reporter {
     fn finish(&self, summary: &JobSummary) {
         if let Some(b) = &self.bar {
             b.finish();
+            // indicatif leaves the cursor at the end of the bar's line
+            // (padded to the terminal's width): end it, so the next line
+            // starts on its own.
+            eprintln!();
         }
         for g in &summary.gifs {
             if self.json {
@@ -672,13 +676,12 @@ impl Reporter {
                 eprintln!("video: {}", v.display());
             }
         }
+        // Why a GIF or video was not written: shown with --quiet too.
         for why in [&summary.gif_skipped, &summary.video_skipped]
             .into_iter()
             .flatten()
         {
-            if !self.quiet {
-                eprintln!("note: {why}");
-            }
+            eprintln!("note: {why}");
         }
     }
 }

@@ -749,3 +749,54 @@ fn every_lane_width_gives_the_same_bytes_and_others_exit_2() {
         }
     }
 }
+
+/// The first hour's small fixes: warnings survive `--quiet`, the help
+/// names model files, shadow-map keys without a shadow-casting light warn,
+/// and the GIF plays at the animation's rate.
+#[test]
+fn quiet_keeps_warnings_and_the_gif_follows_fps() {
+    let dir = common::scratch("first_hour");
+    write(
+        &dir,
+        "tri.obj",
+        "mtllib none.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let scene = write(
+        &dir,
+        "s.toml",
+        "[output]\nwidth = 16\nheight = 16\ngif = \"t.gif\"\n[animation]\nframes = 2\nfps = 12\n\
+         [animation.turntable]\n[render]\nshadow_map_size = 1024\nshadows = \"pcf\"\n\
+         [[light]]\n[[model]]\npath = \"tri.obj\"\n",
+    );
+    let out = dir.join("out");
+    let (code, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning:") && err.contains("none.mtl"),
+        "{err}"
+    );
+    assert!(
+        err.contains("render.shadow_map_size has no effect: no light casts shadows"),
+        "{err}"
+    );
+    // 12 fps: 80 ms a frame (8 hundredths), as the video would play it.
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::RGBA);
+    let mut dec = opts
+        .read_info(std::fs::File::open(out.join("t.gif")).unwrap())
+        .unwrap();
+    let first = dec.read_next_frame().unwrap().unwrap();
+    assert_eq!(first.delay, 8);
+    // The help says a model file is a scene.
+    let (_, help, _) = common::run(&["render", "--help"]);
+    assert!(
+        help.contains(".glb") && help.contains("model file"),
+        "{help}"
+    );
+}

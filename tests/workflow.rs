@@ -392,7 +392,10 @@ fn update_makes_a_missing_golden_folder_and_says_what_it_blessed() {
     let (code, out, err) = run(&["compare", r, t, "--update"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(err.contains("created"), "{err}");
-    assert!(out.contains("blessed 2 new, 0 changed (0 unchanged)"), "{out}");
+    assert!(
+        out.contains("blessed 2 new, 0 changed (0 unchanged)"),
+        "{out}"
+    );
     for name in ["a.png", "b.png"] {
         assert_eq!(
             std::fs::read(refs.join(name)).unwrap(),

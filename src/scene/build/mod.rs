@@ -228,6 +228,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         }),
         None => None,
     };
+    shadow_warnings(d, ctx, &settings, &lights, &mut warnings);
     Ok(Scene {
         file: ctx.file.to_path_buf(),
         stem,
@@ -245,6 +246,39 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         textures: models.textures,
         warnings,
     })
+}
+
+/// Shadow-map keys without a light that casts shadows.
+fn shadow_warnings(
+    d: &SceneDesc,
+    ctx: &Ctx,
+    settings: &RenderSettings,
+    lights: &[super::Light],
+    warnings: &mut Vec<String>,
+) {
+    use crate::scene::settings::ShadowMethod;
+    if !matches!(settings.shadows, ShadowMethod::Hard | ShadowMethod::Pcf)
+        || lights.iter().any(|l| l.shadows)
+    {
+        return;
+    }
+    for (key, span) in [
+        (
+            "render.shadow_map_size",
+            d.render.shadow_map_size.as_ref().map(|v| v.span()),
+        ),
+        (
+            "render.shadow_bias",
+            d.render.shadow_bias.as_ref().map(|v| v.span()),
+        ),
+    ] {
+        if let Some(span) = span {
+            warnings.push(format!(
+                "{}: {key} has no effect: no light casts shadows (give a [[light]] shadows = true)",
+                ctx.location(span)
+            ));
+        }
+    }
 }
 
 /// Point and line sizes without points or lines to draw.
