@@ -76,6 +76,12 @@ struct RenderArgs {
     /// Override a scene key, e.g. `--set render.msaa=4` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     sets: Vec<String>,
+    /// A turntable: N frames (default 72) of a 360-degree turn of the
+    /// models (`animation.frames = N` and `[animation.turntable]`; `--set`
+    /// wins).
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "72",
+          value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    turntable: Option<u32>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -531,12 +537,20 @@ fn load_options(
 }
 
 fn render(args: RenderArgs) -> Result<(), Error> {
-    let mut opts = load_options(
-        &args.sets,
-        args.out.clone(),
-        args.strict,
-        args.cache.clone(),
-    )?;
+    // --turntable N: two overrides before the user's own.
+    let sets: Vec<String> = args
+        .turntable
+        .map(|n| {
+            vec![
+                format!("animation.frames={n}"),
+                "animation.turntable.degrees=360".to_string(),
+            ]
+        })
+        .unwrap_or_default()
+        .into_iter()
+        .chain(args.sets.iter().cloned())
+        .collect();
+    let mut opts = load_options(&sets, args.out.clone(), args.strict, args.cache.clone())?;
     opts.max_memory = args.max_memory;
     opts.sandbox = args.sandbox;
     let pool = thread_pool(args.threads)?;

@@ -800,3 +800,116 @@ fn quiet_keeps_warnings_and_the_gif_follows_fps() {
         "{help}"
     );
 }
+
+/// Slips a new user makes, and what they are told: the user's words (no
+/// Rust types), the place they can fix (their line, their `--set`, never
+/// generated text), and a hint.
+#[test]
+fn messages_are_in_the_users_words() {
+    let dir = common::scratch("messages_words");
+    write(&dir, "t.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+    let model = dir.join("t.obj");
+    let out = dir.join("out");
+    let render = |target: &Path, extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            target.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    for (text, want) in [
+        (
+            "[output]\nwidth = \"320\"\n",
+            "s.toml:2:9: found text \"320\", expected a whole number",
+        ),
+        (
+            "[camera]\nazimuth = 3.0\n",
+            "write [[camera]] (double brackets)",
+        ),
+        (
+            "[render]\nmsaaa = 4\n",
+            "unknown key `msaaa`: did you mean `msaa`?",
+        ),
+        (
+            "[[light]]\ncolor = \"red\"\n",
+            "found text \"red\", expected a list of 3 numbers",
+        ),
+    ] {
+        let scene = write(
+            &dir,
+            "s.toml",
+            &format!("{text}[[model]]\npath = \"t.obj\"\n"),
+        );
+        let (code, err) = render(&scene, &[]);
+        assert_eq!(code, 2, "{text}: {err}");
+        assert!(err.contains(want), "{text}: {err}");
+    }
+    for (set, want) in [
+        (
+            "camera.0.azimuth=35",
+            "add one with --set 'camera=[{azimuth=35}]'",
+        ),
+        ("model.animation=\"Run\"", "e.g. `model.0.animation`"),
+    ] {
+        let (code, err) = render(&model, &["--set", set]);
+        assert_eq!(code, 2, "{set}: {err}");
+        assert!(err.contains(want), "{set}: {err}");
+    }
+    // The hint works.
+    let (code, err) = render(&model, &["--set", "camera=[{azimuth=35}]"]);
+    assert_eq!(code, 0, "{err}");
+    // A model file's scene is generated text: a message names the --set
+    // as typed, or the model file, never a line of the generated scene.
+    let (code, err) = render(&model, &["--set", "render.msaa=3"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.starts_with("error: --set render.msaa=3: ") && !err.contains(" | "),
+        "{err}"
+    );
+    let (code, err) = render(&model, &["--set", "animation.frames=3"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning: --set animation.frames=3: animation.frames = 3 but nothing moves")
+            && !err.contains("t.obj:"),
+        "{err}"
+    );
+    // Neither TOML nor a model; not there at all.
+    let notes = write(&dir, "notes.txt", "hello\n");
+    let (code, err) = render(&notes, &[]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("notes.txt: neither a scene (TOML) nor a model file"),
+        "{err}"
+    );
+    let (code, err) = render(&dir.join("nothing.toml"), &[]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("nothing.toml: cannot read: No such file") && !err.contains(":1:1"),
+        "{err}"
+    );
+    // --turntable: 5 frames of a turn, and no warning.
+    let _ = std::fs::remove_dir_all(&out);
+    let (code, err) = render(
+        &model,
+        &[
+            "--turntable",
+            "5",
+            "--set",
+            "output.width=16",
+            "--set",
+            "output.height=16",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("nothing moves"), "{err}");
+    let pngs = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+        .count();
+    assert_eq!(pngs, 5);
+}

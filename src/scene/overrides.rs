@@ -103,10 +103,33 @@ pub fn blame(file: &Path, text: &str, sets: &[SetOverride], error: Error) -> Err
             return error;
         };
         if let Err(Error::Scene { message, .. }) = SceneDesc::parse(file, &edited) {
+            // Without the excerpt: it quotes the merged text, not what
+            // the user typed.
+            let message = message.split("\n  ").next().unwrap_or(&message);
             return Error::Argument(format!("--set {}: {message}", sets[k - 1].raw));
         }
     }
     error
+}
+
+/// `--set camera.0.azimuth=35` on a scene without `[[camera]]`: how to
+/// add one instead.
+fn no_array(k: &str, rest: &[PathPart], value: &Value) -> String {
+    let mut v = value.clone();
+    v.decor_mut().clear();
+    match rest {
+        [PathPart::Key(field)] => format!(
+            "the scene has no [[{k}]] to change; add one with --set '{k}=[{{{field}={v}}}]'"
+        ),
+        _ => format!("the scene has no [[{k}]] array"),
+    }
+}
+
+fn part_name(p: &PathPart) -> String {
+    match p {
+        PathPart::Key(k) => k.clone(),
+        PathPart::Index(n) => n.to_string(),
+    }
 }
 
 fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
@@ -121,7 +144,7 @@ fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
             let arr = table
                 .get_mut(k)
                 .and_then(Item::as_array_of_tables_mut)
-                .ok_or_else(|| bad(format!("the scene has no [[{k}]] array")))?;
+                .ok_or_else(|| bad(no_array(k, &s.path[i + 2..], &s.value)))?;
             let len = arr.len();
             table = arr
                 .get_mut(*n)
@@ -138,9 +161,18 @@ fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
                 let t = std::mem::take(it).into_table();
                 *entry = Item::Table(t);
             }
-            table = entry
-                .as_table_mut()
-                .ok_or_else(|| bad(format!("`{k}` is not a table")))?;
+            let array = entry.is_array_of_tables();
+            table = entry.as_table_mut().ok_or_else(|| {
+                let rest: Vec<String> = s.path[i + 1..].iter().map(part_name).collect();
+                bad(if array {
+                    format!(
+                        "`{k}` is a list ([[{k}]]): say which entry, e.g. `{k}.0.{}`",
+                        rest.join(".")
+                    )
+                } else {
+                    format!("`{k}` is not a table")
+                })
+            })?;
             i += 1;
         }
     }
@@ -149,6 +181,82 @@ fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
     };
     table.insert(last, Item::Value(s.value.clone()));
     Ok(())
+}
+
+/// Where a loaded scene's text came from, to name in messages what the
+/// user can fix: `text` is the scene file's own text (None: a model
+/// file's generated one-line scene), `edited` the text after `sets`.
+pub struct Origin<'a> {
+    pub file: &'a Path,
+    pub text: Option<&'a str>,
+    pub edited: &'a str,
+    pub sets: &'a [SetOverride],
+}
+
+impl Origin<'_> {
+    /// Where line `line` of the edited text came from: None when it is
+    /// the scene file's own line; else the `--set` that wrote it, or ""
+    /// for generated text no `--set` wrote.
+    fn source(&self, line: usize) -> Option<String> {
+        let l = self.edited.lines().nth(line.checked_sub(1)?)?.trim();
+        if let Some(text) = self.text
+            && text.lines().any(|t| t.trim() == l)
+        {
+            return None;
+        }
+        // The `--set` whose last key this line sets (the last such: the
+        // one that wins).
+        let set = self.sets.iter().rev().find(|s| {
+            matches!(s.path.last(), Some(PathPart::Key(k))
+                if l.strip_prefix(k.as_str()).is_some_and(|r| r.trim_start().starts_with('=')))
+        });
+        match set {
+            Some(s) => Some(format!("--set {}", s.raw)),
+            None if self.text.is_none() => Some(String::new()),
+            None => None,
+        }
+    }
+
+    /// `file:line:col: rest` pointing into text the user did not write:
+    /// `--set key=value: rest`, or `model.obj: rest`.
+    pub fn warning(&self, w: String) -> String {
+        let prefix = format!("{}:", self.file.display());
+        let Some(rest) = w.strip_prefix(&prefix) else {
+            return w;
+        };
+        let mut parts = rest.splitn(3, ':');
+        let (Some(line), Some(col), Some(msg)) = (parts.next(), parts.next(), parts.next()) else {
+            return w;
+        };
+        let (Ok(line), true) = (line.parse::<usize>(), col.parse::<usize>().is_ok()) else {
+            return w;
+        };
+        match self.source(line) {
+            None => w,
+            Some(s) if s.is_empty() => format!("{}:{msg}", self.file.display()),
+            Some(s) => format!("{s}:{msg}"),
+        }
+    }
+
+    /// `warning` for an error at a place in the edited text; the excerpt
+    /// of a generated line is dropped.
+    pub fn error(&self, e: Error) -> Error {
+        let Error::Scene { location, message } = e else {
+            return e;
+        };
+        if location.file != self.file {
+            return Error::Scene { location, message };
+        }
+        let short = || message.split("\n  ").next().unwrap_or(&message).to_string();
+        match self.source(location.line) {
+            None => Error::Scene { location, message },
+            Some(s) if s.is_empty() => Error::SceneGlobal {
+                file: self.file.to_path_buf(),
+                message: short(),
+            },
+            Some(s) => Error::Argument(format!("{s}: {}", short())),
+        }
+    }
 }
 
 #[cfg(test)]

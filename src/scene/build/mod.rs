@@ -83,31 +83,44 @@ impl Scene {
     /// (`.gltf`, `.glb`, `.obj`) is a scene too: the one-line scene that
     /// names it, read from its directory (output in `out/<model stem>/`).
     pub fn load(path: &Path, opts: &LoadOptions) -> Result<Scene, Error> {
-        if let Some(text) = model_as_scene(path) {
-            let edited = overrides::apply(path, &text, &opts.sets)?;
-            return Scene::from_text(path, &edited, opts)
-                .map_err(|e| overrides::blame(path, &text, &opts.sets, e));
-        }
-        // A regular file, at most the read cap: not a directory, FIFO or
-        // device.
-        let input = Input::new(
-            opts.max_memory
-                .unwrap_or_else(crate::assets::input::default_budget),
-        );
-        let bytes = input.read(path, None, None)?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            Error::asset(
+        let (text, generated) = match model_as_scene(path) {
+            Some(text) => (text, true),
+            None => (read_scene_file(path, opts)?, false),
+        };
+        let toml_ext = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if !generated && !toml_ext && text.parse::<toml_edit::DocumentMut>().is_err() {
+            return Err(Error::asset(
                 path,
                 None,
-                format!(
-                    "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl or .ply",
-                    e.utf8_error().valid_up_to()
-                ),
-            )
-        })?;
+                "neither a scene (TOML) nor a model file softraster reads (.gltf, .glb, .obj, .stl, .ply)",
+            ));
+        }
         let edited = overrides::apply(path, &text, &opts.sets)?;
-        Scene::from_text(path, &edited, opts)
-            .map_err(|e| overrides::blame(path, &text, &opts.sets, e))
+        // Messages name what the user can fix: the scene file's line, the
+        // `--set` as typed, or the model file, never generated text.
+        let origin = overrides::Origin {
+            file: path,
+            text: (!generated).then_some(text.as_str()),
+            edited: &edited,
+            sets: &opts.sets,
+        };
+        match Scene::from_text(path, &edited, opts) {
+            Ok(mut scene) => {
+                scene.warnings = scene
+                    .warnings
+                    .into_iter()
+                    .map(|w| origin.warning(w))
+                    .collect();
+                Ok(scene)
+            }
+            Err(Error::Strict { file, warnings }) => Err(Error::Strict {
+                file,
+                warnings: warnings.into_iter().map(|w| origin.warning(w)).collect(),
+            }),
+            Err(e) => Err(origin.error(overrides::blame(path, &text, &opts.sets, e))),
+        }
     }
 
     /// Loads a scene from text; `path` names the file in errors and is the
@@ -124,6 +137,29 @@ impl Scene {
         }
         Ok(scene)
     }
+}
+
+/// A scene file's text: a regular file, at most the read cap (not a
+/// directory, FIFO or device), UTF-8.
+fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<String, Error> {
+    // A regular file, at most the read cap: not a directory, FIFO or
+    // device.
+    let input = Input::new(
+        opts.max_memory
+            .unwrap_or_else(crate::assets::input::default_budget),
+    );
+    let bytes = input.read(path, None, None)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        Error::asset(
+        path,
+        None,
+        format!(
+            "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl or .ply",
+            e.utf8_error().valid_up_to()
+        ),
+        )
+    })?;
+    Ok(text)
 }
 
 /// The one-line scene of a model file, or None for other files.
@@ -229,6 +265,9 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         None => None,
     };
     shadow_warnings(d, ctx, &settings, &lights, &mut warnings);
+    if let Some(w) = still_frames(d, ctx, &animation, cameras_move(&cameras)) {
+        warnings.push(w);
+    }
     Ok(Scene {
         file: ctx.file.to_path_buf(),
         stem,
@@ -246,6 +285,31 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         textures: models.textures,
         warnings,
     })
+}
+
+/// Whether any camera moves over the frames (a keyed path).
+fn cameras_move(cameras: &[super::Camera]) -> bool {
+    cameras.iter().any(|c| c.path.is_some())
+}
+
+/// `animation.frames > 1` with nothing that changes between frames (no
+/// turntable, no clip playing, no camera path): every frame the same.
+fn still_frames(
+    d: &SceneDesc,
+    ctx: &Ctx,
+    animation: &Animation,
+    cameras_move: bool,
+) -> Option<String> {
+    let frames = d.animation.frames.as_ref()?;
+    let playing = d.models.iter().any(|m| m.get_ref().animation.is_some());
+    if animation.frames <= 1 || animation.turntable.is_some() || playing || cameras_move {
+        return None;
+    }
+    Some(format!(
+        "{}: animation.frames = {} but nothing moves: every frame is the same; turn the models with --turntable (or [animation.turntable]), or play a clip with model.animation",
+        ctx.location(frames.span()),
+        animation.frames
+    ))
 }
 
 /// Shadow-map keys without a light that casts shadows.
