@@ -388,19 +388,27 @@ fn presets_light_without_a_file() {
     let f = render_frame(&load(&dir, &text), 0, 0);
     let (ul, lr) = (f.color[20 * 64 + 20].x, f.color[44 * 64 + 44].x);
     assert!(ul > 2.0 * lr && lr > 0.05, "{ul} {lr}");
-    // Both, or neither: refused at the table.
-    for (keys, msg) in [("preset = \"studio\"", "not both"), ("", "needs `path`")] {
-        let t = sphere_scene(&dir, [0.0, 0.0, 5.0], keys, "");
-        let t = if keys.is_empty() {
-            t.replace("path = \"env.exr\"\n", "")
-        } else {
-            t
-        };
-        std::fs::write(dir.join("s.toml"), t).unwrap();
-        let e =
-            softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_err();
-        assert!(e.to_string().contains(msg), "{e}");
-    }
+    // Both: refused at the table.
+    let t = sphere_scene(&dir, [0.0, 0.0, 5.0], "preset = \"studio\"", "");
+    std::fs::write(dir.join("s.toml"), t).unwrap();
+    let e = softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_err();
+    assert!(e.to_string().contains("not both"), "{e}");
+    // Neither (version 3): the studio, turned by the table's rotation;
+    // `preset = "studio"` alone is the default look itself.
+    let t = sphere_scene(&dir, [0.0, 0.0, 5.0], "rotation = 90.0", "")
+        .replace("path = \"env.exr\"\n", "");
+    let turned = load(&dir, &t);
+    let env = turned.environment.as_ref().expect("the studio");
+    assert_eq!(env.rotation, 90.0);
+    let preset = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+        .replace("path = \"env.exr\"", "preset = \"studio\"");
+    let plain = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
+        .replace("[environment]\npath = \"env.exr\"\n", "");
+    let (a, b) = (
+        render_frame(&load(&dir, &preset), 0, 0),
+        render_frame(&load(&dir, &plain), 0, 0),
+    );
+    assert!(a.color == b.color, "preset = \"studio\" differs from the default look");
 }
 
 #[test]
@@ -635,4 +643,67 @@ fn prefilter_size_is_checked_and_changes_only_the_glossy_levels() {
     let mut f = Frame::new(0, 0);
     r.render(&s, 0, 0, &mut f);
     assert_eq!(f.color, default.color);
+}
+
+/// Version 3: the studio look composes. A one-line white model plus one
+/// directional light keeps the studio's blurred background and the ground
+/// shadow, and is not clipped; `[environment]` with only a rotation turns
+/// the studio; `[ambient]` asks for version 1's look.
+#[test]
+fn a_light_adds_to_the_studio_look() {
+    let dir = scratch("look_composes");
+    let obj = softraster::procedural::sphere(1.0, 64, 32).to_obj("ball", "none.mtl", "m");
+    let files = [("ball.obj", obj.text.as_str())];
+    let base = "[output]\nwidth = 96\nheight = 96\n[[model]]\npath = \"ball.obj\"\n";
+    let lit = scene_in(
+        &dir,
+        &format!("{base}[[light]]\nkind = \"directional\"\n"),
+        &files,
+    );
+    assert!(lit.environment.is_some() && lit.ground.is_some());
+    assert_eq!(
+        lit.settings.tonemap,
+        softraster::scene::settings::Tonemap::PbrNeutral
+    );
+    let img = softraster::output::resolve(&render_frame(&lit, 0, 0), &lit.settings);
+    let px = |x: usize, y: usize| {
+        let i = (y * 96 + x) * img.channels as usize;
+        [img.data[i], img.data[i + 1], img.data[i + 2]]
+    };
+    // The corner is the studio's grey, not black.
+    assert!(px(2, 2).iter().all(|&c| c > 60), "{:?}", px(2, 2));
+    // Of the ball's pixels (those the depth buffer covers), at most 2%
+    // pure white.
+    let frame = render_frame(&lit, 0, 0);
+    let covered: Vec<usize> = (0..96 * 96)
+        .filter(|&i| frame.depth[i].is_finite() && frame.depth[i] != 0.0)
+        .collect();
+    let white = covered
+        .iter()
+        .filter(|&&i| px(i % 96, i / 96) == [255, 255, 255])
+        .count();
+    assert!(
+        !covered.is_empty() && white * 50 <= covered.len(),
+        "{white} of {} pure white",
+        covered.len()
+    );
+    // `[environment]` with a rotation only: the studio, turned.
+    let turned = scene_in(
+        &dir,
+        &format!("{base}[environment]\nrotation = 90.0\n"),
+        &files,
+    );
+    assert_eq!(turned.environment.as_ref().map(|e| e.rotation), Some(90.0));
+    assert!(turned.ground.is_some());
+    // `[ambient]`: version 1's look.
+    let v1 = scene_in(
+        &dir,
+        &format!("{base}[[light]]\n[ambient]\ncolor = [0.03, 0.03, 0.03]\n"),
+        &files,
+    );
+    assert!(v1.environment.is_none() && v1.ground.is_none());
+    assert_eq!(
+        v1.settings.background,
+        softraster::scene::settings::Background::Color(Vec3::ZERO)
+    );
 }

@@ -21,16 +21,21 @@ fn pick<T: Copy + Default>(v: &Option<desc::S<T>>) -> T {
     v.as_ref().map(|v| *v.get_ref()).unwrap_or_default()
 }
 
-/// The default look (version 2): a scene with no `[[light]]`, no
-/// `[environment]` and no model importing its file's lights is lit by the
-/// built-in studio, over its blurred background, with a ground shadow.
+/// The default look (version 3): every scene without `[ambient]` and
+/// without an `[environment]` that names a `path` or another `preset` is
+/// lit by the built-in studio (its `[environment]` keys, such as
+/// `rotation`, modify it), over its blurred background, with a ground
+/// shadow and PBR Neutral, each unless its own key is set. `[[light]]`s
+/// add to it.
 pub(super) fn default_look(d: &SceneDesc) -> bool {
-    d.lights.is_empty()
-        && d.environment.is_none()
-        && !d
-            .models
-            .iter()
-            .any(|m| m.get_ref().lights.as_ref().is_some_and(|l| *l.get_ref()))
+    d.ambient.color.is_none()
+        && d.environment.as_ref().is_none_or(|e| {
+            let e = e.get_ref();
+            e.path.is_none()
+                && e.preset
+                    .as_ref()
+                    .is_none_or(|p| *p.get_ref() == desc::EnvPreset::Studio)
+        })
 }
 
 /// `[render]`, `output.width/height/background` and `[ambient]`, with the
@@ -410,15 +415,24 @@ mod tests {
         assert_eq!(s.shadow_map_size, 2048);
         assert_eq!(s.shadow_bias, ShadowBias::default());
         assert_eq!(s.ao.method, AoMethod::Off);
-        // A light: version 1's defaults.
+        // A light adds to the look (version 3).
         let lit = parse("[[model]]\npath = \"m.obj\"\n[[light]]\n");
-        assert!(!default_look(&lit));
+        assert!(default_look(&lit));
+        // [environment] keys without a path or another preset modify the
+        // studio; the look stays.
+        let turned = parse("[[model]]\npath = \"m.obj\"\n[environment]\nrotation = 90.0\n");
+        assert!(default_look(&turned));
+        let neutral = parse("[[model]]\npath = \"m.obj\"\n[environment]\npreset = \"neutral\"\n");
+        assert!(!default_look(&neutral));
+        // [ambient]: version 1's defaults.
+        let v1 = parse("[[model]]\npath = \"m.obj\"\n[[light]]\n[ambient]\ncolor = [0.03, 0.03, 0.03]\n");
+        assert!(!default_look(&v1));
         assert_eq!(
-            render(&lit, default_look(&lit)).background,
+            render(&v1, default_look(&v1)).background,
             Background::Color(Vec3::ZERO)
         );
-        assert_eq!(render(&lit, default_look(&lit)).ambient, Vec3::splat(0.03));
-        assert_eq!(render(&lit, default_look(&lit)).tonemap, Tonemap::Clamp);
+        assert_eq!(render(&v1, default_look(&v1)).ambient, Vec3::splat(0.03));
+        assert_eq!(render(&v1, default_look(&v1)).tonemap, Tonemap::Clamp);
         let ctx = Ctx {
             file: Path::new("dir/s.toml"),
             text: "",

@@ -47,7 +47,6 @@ pub(super) fn get_i64(v: &Option<S<i64>>, default: i64) -> i64 {
 }
 
 pub(super) fn validate_environment(c: &Ctx, e: &S<EnvironmentDesc>) -> Result<(), Error> {
-    let span = e.span();
     let e = e.get_ref();
     match (&e.path, &e.preset) {
         (Some(p), None) if p.get_ref().trim().is_empty() => {
@@ -56,12 +55,7 @@ pub(super) fn validate_environment(c: &Ctx, e: &S<EnvironmentDesc>) -> Result<()
         (Some(_), Some(p)) => {
             return Err(c.err(p.span(), "environment: give `path` or `preset`, not both"));
         }
-        (None, None) => {
-            return Err(c.err(
-                span,
-                "[environment] needs `path` (an .hdr or .exr image) or `preset` (\"studio\" or \"neutral\")",
-            ));
-        }
+        // Version 3: neither modifies the studio (its rotation, intensity).
         _ => {}
     }
     c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
