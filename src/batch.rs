@@ -610,18 +610,23 @@ impl RenderJob {
 }
 
 /// `{scene}_ids.json` in the output directory: what the id pass's numbers
-/// stand for (`object_id` 1 + the model's index, `material_id` 1 + the
-/// material's index over the models' materials in order; 0 = nothing).
+/// stand for (`object_id`: 1 + the index of the model's part over the
+/// models' parts in order, named `model` or `model/node`; `material_id`:
+/// 1 + the material's index over the models' materials in order, with
+/// the model's first object id; 0 = nothing).
 fn write_ids(scene: &Scene) -> Result<(), Error> {
     let mut objects = Vec::new();
     let mut materials = Vec::new();
-    for (i, m) in scene.models.iter().enumerate() {
-        objects.push(serde_json::json!({ "id": i + 1, "name": m.name }));
+    for m in &scene.models {
+        let first = objects.len() + 1;
+        for name in m.object_names() {
+            objects.push(serde_json::json!({ "id": objects.len() + 1, "name": name }));
+        }
         for mat in &m.materials {
             materials.push(serde_json::json!({
                 "id": materials.len() + 1,
                 "name": mat.name,
-                "object_id": i + 1,
+                "object_id": first,
             }));
         }
     }

@@ -216,3 +216,60 @@ fn the_ground_shadow_catcher_is_not_an_object() {
     assert_eq!(p.n[bottom], Vec3::ZERO);
     check(&p, "ground");
 }
+
+/// Object ids are named after the model's file (or `name`) and, in a glTF
+/// file, after each node with a mesh: one id per node.
+#[test]
+fn object_ids_are_named_after_the_file_and_its_nodes() {
+    use base64::Engine;
+    let dir = common::scratch("aov_names");
+    let mut bin = Vec::new();
+    for v in [[-0.8f32, -0.8, 0.0], [0.8, -0.8, 0.0], [0.0, 0.8, 0.0]] {
+        v.iter().for_each(|x| bin.extend(x.to_le_bytes()));
+    }
+    let gltf = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"uri": "data:application/octet-stream;base64,{}", "byteLength": 36}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-0.8, -0.8, 0], "max": [0.8, 0.8, 0]}}],
+  "meshes": [{{"name": "tri", "primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+  "nodes": [{{"mesh": 0, "name": "Left", "translation": [-1, 0, 0]}}, {{"mesh": 0, "translation": [1, 0, 0]}}],
+  "scenes": [{{"nodes": [0, 1]}}]
+}}"#,
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    std::fs::write(dir.join("pair.gltf"), gltf).unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v -1 -1 -2\nv 1 -1 -2\nv 0 1 -2\nf 1 2 3\n",
+    )
+    .unwrap();
+    let s = dir.join("s.toml");
+    std::fs::write(
+        &s,
+        "[output]\nwidth = 64\nheight = 32\nid = true\n[[model]]\npath = \"pair.gltf\"\n\
+         [[model]]\npath = \"tri.obj\"\n[[model]]\npath = \"tri.obj\"\ntranslate = [0.0, 0.0, -1.0]\n\
+         [[camera]]\neye = [0.0, 0.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    render(&s, &out, &[]);
+    let ids: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("s_ids.json")).unwrap()).unwrap();
+    let names: Vec<(u64, &str)> = ids["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| (o["id"].as_u64().unwrap(), o["name"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        names,
+        [(1, "pair/Left"), (2, "pair/tri"), (3, "tri"), (4, "tri_2")]
+    );
+    // The two nodes' triangles carry their own ids: left half 1, right 2.
+    let (w, _, object) = read_channel_u32(&out.join("camera_0000_id.exr"), "object_id").unwrap();
+    let w = w as usize;
+    let at = |x: usize, y: usize| object[y * w + x];
+    // The triangles sit about x = -1 and 1 (pixels 26 and 38 of 64).
+    assert_eq!((at(26, 18), at(38, 18)), (1, 2));
+}

@@ -408,7 +408,10 @@ fn presets_light_without_a_file() {
         render_frame(&load(&dir, &preset), 0, 0),
         render_frame(&load(&dir, &plain), 0, 0),
     );
-    assert!(a.color == b.color, "preset = \"studio\" differs from the default look");
+    assert!(
+        a.color == b.color,
+        "preset = \"studio\" differs from the default look"
+    );
 }
 
 #[test]

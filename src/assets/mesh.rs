@@ -12,6 +12,9 @@ pub struct Group {
     pub triangles: Range<u32>,
     /// Index into the model's material list.
     pub material: usize,
+    /// The named part the triangles belong to (`Mesh::parts`; 0 for a
+    /// mesh without parts): a glTF node, for the object-id pass.
+    pub part: u32,
 }
 
 /// A point or line: its vertices and its material.
@@ -52,6 +55,9 @@ pub struct Mesh {
     /// bitangent sign (w), MikkTSpace; empty unless a normal or bump map
     /// needs them (`compute_tangents`).
     pub tangents: Vec<glam::Vec4>,
+    /// Names of the mesh's parts (glTF nodes with a mesh, by the node's
+    /// name, else its mesh's); empty: the mesh is one part.
+    pub parts: Vec<String>,
 }
 
 impl Mesh {

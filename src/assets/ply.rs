@@ -100,6 +100,7 @@ pub fn load(path: &Path, input: &super::input::Input) -> Result<Mesh, Error> {
     mesh.groups.push(Group {
         triangles: 0..mesh.triangles.len() as u32,
         material: 0,
+        part: 0,
     });
     Ok(mesh)
 }

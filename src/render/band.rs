@@ -160,14 +160,18 @@ impl<'a> FrameData<'a> {
         let n = vis.samples();
         let mut cache = InterpolatorCache::default();
         let models = &self.fs.scene.models;
-        let material_base: Vec<u32> = models
-            .iter()
-            .scan(0u32, |acc, m| {
-                let base = *acc;
-                *acc += m.materials.len() as u32;
-                Some(base)
-            })
-            .collect();
+        let base = |count: fn(&crate::scene::Model) -> u32| -> Vec<u32> {
+            models
+                .iter()
+                .scan(0u32, |acc, m| {
+                    let base = *acc;
+                    *acc += count(m);
+                    Some(base)
+                })
+                .collect()
+        };
+        let material_base = base(|m| m.materials.len() as u32);
+        let object_base = base(crate::scene::Model::object_count);
         for (i, a) in out.iter_mut().enumerate() {
             let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
             let frags = if n == 1 {
@@ -205,7 +209,7 @@ impl<'a> FrameData<'a> {
                 normal,
                 albedo,
                 position: s.position,
-                object: d.model as u32 + 1,
+                object: object_base[d.model] + d.part + 1,
                 material: material_base[d.model] + d.material as u32 + 1,
             };
         }

@@ -21,6 +21,8 @@ use crate::raster::setup::{Projected, SUBPIXEL, Tri, Viewport, project, setup, s
 pub(super) struct Draw {
     pub model: usize,
     pub material: usize,
+    /// The mesh part (`Group::part`), for the object-id pass.
+    pub part: u32,
     pub first: u32,
     pub end: u32,
 }
@@ -80,6 +82,7 @@ pub(super) fn setup_and_bin(
             draws.push(Draw {
                 model: mi,
                 material: g.material,
+                part: g.part,
                 first: g.triangles.start,
                 end: g.triangles.end,
             });

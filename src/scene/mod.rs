@@ -48,6 +48,25 @@ pub struct Model {
 }
 
 impl Model {
+    /// Ids the object-id pass gives the model: one per mesh part (glTF
+    /// nodes), at least one.
+    pub fn object_count(&self) -> u32 {
+        self.mesh.parts.len().max(1) as u32
+    }
+
+    /// The object-id pass's names of the model's parts: the model's name,
+    /// and `name/part` per part where the mesh has parts.
+    pub fn object_names(&self) -> Vec<String> {
+        if self.mesh.parts.is_empty() {
+            return vec![self.name.clone()];
+        }
+        self.mesh
+            .parts
+            .iter()
+            .map(|p| format!("{}/{p}", self.name))
+            .collect()
+    }
+
     /// Every point the model's vertices take (object space): at rest, and
     /// over its clip.
     pub fn reach(&self) -> impl Iterator<Item = &Vec3> {

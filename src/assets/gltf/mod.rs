@@ -171,6 +171,7 @@ pub fn load(path: &Path, input: &Input) -> Result<GltfModel, Error> {
         segments: doc.animations().next().is_some().then(Vec::new),
         rig_error: None,
         budget: input.budget(),
+        part: 0,
     };
     let mut placed = Placed::default();
     walk_nodes(doc, &buffers, &mut materials, &mut b, &mut placed).map_err(err)?;
@@ -353,6 +354,13 @@ fn walk_nodes(
             ));
         }
         if let Some(mesh) = node.mesh() {
+            // A part per node with a mesh, for the object-id pass.
+            b.part = b.mesh.parts.len() as u32;
+            b.mesh.parts.push(
+                node.name()
+                    .or(mesh.name())
+                    .map_or_else(|| format!("node{}", node.index()), str::to_string),
+            );
             let weights = node.weights().or(mesh.weights()).unwrap_or(&[]);
             let skin = node.skin();
             for prim in mesh.primitives() {
@@ -602,6 +610,32 @@ fn image_sources(
         .collect()
 }
 
+/// The source vertex of each mesh vertex a primitive adds, and the face
+/// normals: with normals, every vertex once; without, glTF asks for flat
+/// shading: every corner its own vertex with its face's normal (and any
+/// tangents ignored), `tris` renumbered to match.
+fn vertex_order(
+    has_normals: bool,
+    tris: &mut Vec<[u32; 3]>,
+    positions: &[Vec3],
+) -> (Vec<u32>, Option<Vec<Vec3>>) {
+    if has_normals {
+        return ((0..positions.len() as u32).collect(), None);
+    }
+    let order: Vec<u32> = tris.iter().flatten().copied().collect();
+    let face_normals: Vec<Vec3> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y)
+        })
+        .collect();
+    *tris = (0..tris.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    (order, Some(face_normals))
+}
+
 /// Triangle corner indices of a primitive's index list, per its mode.
 pub fn triangulate(mode: Mode, idx: &[u32]) -> Option<Vec<[u32; 3]>> {
     let n = idx.len();
@@ -642,6 +676,8 @@ struct Builder {
     rig_error: Option<String>,
     /// The memory budget (a Draco stream's decode is bounded by it).
     budget: u64,
+    /// The part (`Mesh::parts`) the primitives being added belong to.
+    part: u32,
 }
 
 /// Vertex `s`'s texture coordinates (both sets) and colour, defaults where
@@ -766,24 +802,7 @@ impl Builder {
         let mirrored = m3.determinant() < 0.0;
         let normal_m = m3.inverse().transpose();
 
-        // Without normals glTF asks for flat shading: every corner its own
-        // vertex with the face normal, and any tangents ignored.
-        let (order, face_normals): (Vec<u32>, Option<Vec<Vec3>>) = if normals.is_some() {
-            ((0..n as u32).collect(), None)
-        } else {
-            let order: Vec<u32> = tris.iter().flatten().copied().collect();
-            let fn_: Vec<Vec3> = tris
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|i| positions[i as usize]);
-                    (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Y)
-                })
-                .collect();
-            tris = (0..tris.len() as u32)
-                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                .collect();
-            (order, Some(fn_))
-        };
+        let (order, face_normals) = vertex_order(normals.is_some(), &mut tris, &positions);
         self.note_sets(&uv, &colors);
         let base = self.mesh.positions.len() as u32;
         if let Some((positions, normals)) = source {
@@ -847,10 +866,12 @@ impl Builder {
             m.triangles
                 .push(if mirrored { [a, c, b] } else { [a, b, c] });
         }
-        let end = m.triangles.len() as u32;
+        let triangles = first..m.triangles.len() as u32;
+        let part = self.part;
         m.groups.push(Group {
-            triangles: first..end,
+            triangles,
             material,
+            part,
         });
         Ok(())
     }

@@ -252,6 +252,7 @@ fn build_mesh(
             _ => b.mesh.groups.push(Group {
                 triangles: range,
                 material,
+                part: 0,
             }),
         }
     }

@@ -138,12 +138,9 @@ pub(super) fn build(
                 }
             }
         }
+        let name = model_name(md, &out.models);
         out.models.push(Model {
-            name: md
-                .name
-                .as_ref()
-                .map(|n| n.get_ref().clone())
-                .unwrap_or_else(|| format!("model{i}")),
+            name,
             // Only `cull = "auto"` asks (a sort over the edges).
             closed: settings.cull == crate::scene::settings::CullMode::Auto && mesh.is_closed(),
             mesh: Arc::new(mesh),
@@ -154,6 +151,24 @@ pub(super) fn build(
         });
     }
     Ok(out)
+}
+
+/// `model.name`, else the file's stem (`bunny`, then `bunny_2` for a
+/// second model of that file): what the object-id pass calls it.
+fn model_name(md: &desc::ModelDesc, before: &[Model]) -> String {
+    if let Some(n) = &md.name {
+        return n.get_ref().clone();
+    }
+    let stem = Path::new(md.path.get_ref())
+        .file_stem()
+        .map_or_else(|| "model".to_string(), |s| s.to_string_lossy().into_owned());
+    let mut name = stem.clone();
+    let mut k = 1;
+    while before.iter().any(|m| m.name == name) {
+        k += 1;
+        name = format!("{stem}_{k}");
+    }
+    name
 }
 
 /// `model.animation`: the clip it names in the model's glTF file, ready to

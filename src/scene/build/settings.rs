@@ -425,7 +425,9 @@ mod tests {
         let neutral = parse("[[model]]\npath = \"m.obj\"\n[environment]\npreset = \"neutral\"\n");
         assert!(!default_look(&neutral));
         // [ambient]: version 1's defaults.
-        let v1 = parse("[[model]]\npath = \"m.obj\"\n[[light]]\n[ambient]\ncolor = [0.03, 0.03, 0.03]\n");
+        let v1 = parse(
+            "[[model]]\npath = \"m.obj\"\n[[light]]\n[ambient]\ncolor = [0.03, 0.03, 0.03]\n",
+        );
         assert!(!default_look(&v1));
         assert_eq!(
             render(&v1, default_look(&v1)).background,
