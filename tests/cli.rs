@@ -877,6 +877,23 @@ fn messages_are_in_the_users_words() {
             && !err.contains("t.obj:"),
         "{err}"
     );
+    // An error whose message names a place: the --set, too.
+    let (code, err) = render(
+        &model,
+        &["--set", "model.0.material.map_kd=\"missing.png\""],
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("(from --set model.0.material.map_kd=\"missing.png\")"),
+        "{err}"
+    );
+    // A turntable of one frame.
+    let (code, err) = render(&model, &["--set", "animation.turntable.degrees=360"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("a turntable of 1 frame does not turn"),
+        "{err}"
+    );
     // Neither TOML nor a model; not there at all.
     let notes = write(&dir, "notes.txt", "hello\n");
     let (code, err) = render(&notes, &[]);

@@ -217,32 +217,57 @@ impl Origin<'_> {
         }
     }
 
-    /// `file:line:col: rest` pointing into text the user did not write:
-    /// `--set key=value: rest`, or `model.obj: rest`.
+    /// A message naming `file:line:col` of text the user did not write
+    /// (at its start, or inside, as "(from file:3:8)"): that place becomes
+    /// the `--set` as typed, or the model file alone.
     pub fn warning(&self, w: String) -> String {
-        let prefix = format!("{}:", self.file.display());
-        let Some(rest) = w.strip_prefix(&prefix) else {
+        let name = format!("{}:", self.file.display());
+        let Some(at) = w.find(&name) else {
             return w;
         };
-        let mut parts = rest.splitn(3, ':');
-        let (Some(line), Some(col), Some(msg)) = (parts.next(), parts.next(), parts.next()) else {
+        let rest = &w[at + name.len()..];
+        let digits = |s: &str| s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+        let n1 = digits(rest);
+        let Some(after_line) = rest[n1..].strip_prefix(':') else {
             return w;
         };
-        let (Ok(line), true) = (line.parse::<usize>(), col.parse::<usize>().is_ok()) else {
+        let n2 = digits(after_line);
+        let (Ok(line), true) = (rest[..n1].parse::<usize>(), n2 > 0) else {
             return w;
         };
+        let end = at + name.len() + n1 + 1 + n2;
         match self.source(line) {
             None => w,
-            Some(s) if s.is_empty() => format!("{}:{msg}", self.file.display()),
-            Some(s) => format!("{s}:{msg}"),
+            Some(s) if s.is_empty() => {
+                format!("{}{}{}", &w[..at], self.file.display(), &w[end..])
+            }
+            Some(s) => format!("{}{s}{}", &w[..at], &w[end..]),
         }
     }
 
     /// `warning` for an error at a place in the edited text; the excerpt
     /// of a generated line is dropped.
     pub fn error(&self, e: Error) -> Error {
-        let Error::Scene { location, message } = e else {
-            return e;
+        let (location, message) = match e {
+            Error::Scene { location, message } => (location, message),
+            Error::Asset {
+                path,
+                line,
+                message,
+            } => {
+                return Error::Asset {
+                    path,
+                    line,
+                    message: self.warning(message),
+                };
+            }
+            Error::SceneGlobal { file, message } => {
+                return Error::SceneGlobal {
+                    file,
+                    message: self.warning(message),
+                };
+            }
+            other => return other,
         };
         if location.file != self.file {
             return Error::Scene { location, message };

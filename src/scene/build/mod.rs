@@ -293,13 +293,22 @@ fn cameras_move(cameras: &[super::Camera]) -> bool {
 }
 
 /// `animation.frames > 1` with nothing that changes between frames (no
-/// turntable, no clip playing, no camera path): every frame the same.
+/// turntable, no clip playing, no camera path): every frame the same; or
+/// a turntable of one frame.
 fn still_frames(
     d: &SceneDesc,
     ctx: &Ctx,
     animation: &Animation,
     cameras_move: bool,
 ) -> Option<String> {
+    if let Some(t) = &d.animation.turntable
+        && animation.frames == 1
+    {
+        return Some(format!(
+            "{}: a turntable of 1 frame does not turn: set animation.frames (72 gives 5 degrees a frame), or use --turntable",
+            ctx.location(t.span())
+        ));
+    }
     let frames = d.animation.frames.as_ref()?;
     let playing = d.models.iter().any(|m| m.get_ref().animation.is_some());
     if animation.frames <= 1 || animation.turntable.is_some() || playing || cameras_move {
