@@ -227,4 +227,18 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
         Err(e) => e.to_string(),
     };
     assert!(err.contains("uncompressed"), "{err}");
+    // The texture target, 2026-11-26 (CI's fuzzing smoke): a KTX2 header
+    // of 4-billion-texel sides; the memory budget's size check overflowed
+    // before `decode` could refuse the size.
+    let path = dir.join("fuzz_ktx2_huge_header_size.ktx2");
+    let err = match Texture::from_bytes(
+        &std::fs::read(&path).unwrap(),
+        &path,
+        true,
+        &softraster::assets::input::Input::default(),
+    ) {
+        Ok(_) => panic!("{} was read", path.display()),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("cannot decode texture"), "{err}");
 }

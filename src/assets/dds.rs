@@ -46,7 +46,9 @@ fn u32_at(b: &[u8], at: usize) -> Option<u32> {
 /// The bytes decoding level 0 takes (its RGBA8 texels), from the header,
 /// or None when the header is cut short.
 pub fn decode_bytes(b: &[u8]) -> Option<u64> {
-    Some(u32_at(b, 12)? as u64 * u32_at(b, 16)? as u64 * 4)
+    let (height, width) = (u32_at(b, 12)?, u32_at(b, 16)?);
+    // Past the largest side `decode` refuses it with its own message.
+    (width <= MAX_SIDE && height <= MAX_SIDE).then(|| width as u64 * height as u64 * 4)
 }
 
 /// Decodes level 0 of a DDS file, or says why it cannot.
@@ -316,6 +318,14 @@ mod tests {
             "{:?}",
             d.texels
         );
+    }
+
+    #[test]
+    fn header_sizes_do_not_overflow() {
+        let mut b = header(u32::MAX, u32::MAX, None);
+        assert_eq!(decode_bytes(&b), None);
+        b.resize(256, 0);
+        assert!(decode(&b).is_err());
     }
 
     #[test]

@@ -228,7 +228,7 @@ fn read_exr(bytes: &[u8], path: &Path, input: &Input) -> Result<Texels, Error> {
     let largest = meta
         .headers
         .iter()
-        .map(|h| h.layer_size.area() as u64)
+        .map(|h| h.layer_size.width() as u64 * h.layer_size.height() as u64)
         .max()
         .unwrap_or(0);
     // The channels decoded as floats (at most four) and the texels kept.

@@ -43,6 +43,10 @@ fn u64_at(b: &[u8], at: usize) -> Option<u64> {
 /// cut short: for the memory budget, before anything is allocated.
 pub fn decode_bytes(b: &[u8]) -> Option<u64> {
     let (vk_format, width, height) = (u32_at(b, 12)?, u32_at(b, 20)?, u32_at(b, 24)?);
+    if width > MAX_SIDE || height > MAX_SIDE {
+        // `decode` refuses it with its own message.
+        return None;
+    }
     let texels = width as u64 * height as u64 * 4;
     let inflated = match (u32_at(b, 44)?, format(vk_format)) {
         (2 | 3, Ok(f)) => level_size(f, width, height),
