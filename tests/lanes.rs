@@ -430,3 +430,98 @@ irradiance = 0.8
         );
     }
 }
+
+/// A 16x16 checker of 4-texel squares: red 0 or 230, green and blue
+/// ramps, alpha 40 or 255.
+fn layer_texture(path: &Path) {
+    let img = image::RgbaImage::from_fn(16, 16, |x, y| {
+        let on = (x / 4 + y / 4) % 2 == 0;
+        image::Rgba([
+            if on { 230 } else { 0 },
+            (x * 16) as u8,
+            (y * 16) as u8,
+            if on { 255 } else { 40 },
+        ])
+    });
+    img.save(path).unwrap();
+}
+
+#[test]
+fn khr_layers_with_maps_are_the_same_with_and_without_lanes() {
+    // The KHR layers with maps of their own (a clearcoat whose factor map
+    // is 0 on half its texels, its roughness and normal maps; sheen colour
+    // and roughness from alpha; specular weight from alpha and colour;
+    // iridescence factor and thickness), each alone and all
+    // together, on a textured cube under lights and the studio look.
+    let dir = scratch("lanes_khr_maps");
+    layer_texture(&dir.join("t.png"));
+    let t = r#"{"index": 0}"#;
+    let layers = [
+        (
+            "clearcoat",
+            format!(
+                r#""KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatTexture": {t}, "clearcoatRoughnessFactor": 0.6, "clearcoatRoughnessTexture": {t}, "clearcoatNormalTexture": {t}}}"#
+            ),
+        ),
+        (
+            "sheen",
+            format!(
+                r#""KHR_materials_sheen": {{"sheenColorFactor": [0.8, 0.8, 1.0], "sheenColorTexture": {t}, "sheenRoughnessFactor": 0.7, "sheenRoughnessTexture": {t}}}"#
+            ),
+        ),
+        (
+            "specular",
+            format!(
+                r#""KHR_materials_specular": {{"specularFactor": 0.9, "specularTexture": {t}, "specularColorTexture": {t}}}"#
+            ),
+        ),
+        (
+            "iridescence",
+            format!(
+                r#""KHR_materials_iridescence": {{"iridescenceFactor": 1.0, "iridescenceTexture": {t}, "iridescenceThicknessTexture": {t}, "iridescenceThicknessMinimum": 100, "iridescenceThicknessMaximum": 500}}"#
+            ),
+        ),
+    ];
+    let all = layers
+        .iter()
+        .map(|(_, l)| l.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut cases: Vec<(&str, String)> = layers.iter().map(|(n, l)| (*n, l.clone())).collect();
+    cases.push(("all", all));
+    let used = r#""KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence""#;
+    let base = r#""pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.3, 0.2, 1.0], "baseColorTexture": {"index": 0}, "metallicFactor": 0.2, "roughnessFactor": 0.5}"#;
+    for (name, ext) in cases {
+        let (text, _) = common::gltf_text(
+            &common::cube(),
+            r#", "material": 0"#,
+            &format!(
+                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                "extensionsUsed": [{used}], "materials": [{{{base}, "extensions": {{{ext}}}}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join("c.gltf"), text).unwrap();
+        let lit = dir.join("lit.toml");
+        std::fs::write(
+            &lit,
+            "[output]\nwidth = 64\nheight = 64\n[ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+             [[model]]\npath = \"c.gltf\"\n\
+             [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n",
+        )
+        .unwrap();
+        same_both_ways(&load_with(&lit, &[]), &[0], &format!("maps, {name}"));
+        let studio = dir.join("studio.toml");
+        std::fs::write(
+            &studio,
+            "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 4\n[[model]]\npath = \"c.gltf\"\n",
+        )
+        .unwrap();
+        same_both_ways(
+            &load_with(&studio, &[]),
+            &[0],
+            &format!("maps, {name}, studio"),
+        );
+    }
+}

@@ -15,7 +15,7 @@ use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
 use crate::shade::lanes::LaneMaterial;
-use crate::shade::lanes::{Lanes, MAX_LANES, MAX_SIZES};
+use crate::shade::lanes::{Coords, Lanes, MAX_LANES, MAX_SIZES};
 use crate::shade::light::LightMask;
 use crate::simd::{F8, Lane, V3, lerp3};
 
@@ -441,7 +441,7 @@ impl<'a> FrameData<'a> {
         p: &'p Prepared,
         corners: &[&Corners; MAX_LANES],
         at: usize,
-    ) -> (Lanes<'p, L>, L) {
+    ) -> (Lanes<L>, Coords<'p, L>, L) {
         let d = self.draws[p.draw];
         let mesh = &self.fs.scene.models[d.model].mesh;
         let ctx = &self.ctx;
@@ -482,18 +482,20 @@ impl<'a> FrameData<'a> {
         let lanes = Lanes {
             position,
             normal,
+            color,
+            geo_normal,
+            ao: L::from_fn(|k| p.ao[at + k]),
+            lights: p.lights,
+        };
+        let coords = Coords {
             u: u0 * l.x + u1 * l.y + u2 * l.z,
             v: v0 * l.x + v1 * l.y + v2 * l.z,
             tangent,
             sign: L::from_fn(|k| c(k).tangent[0].w),
-            color,
-            geo_normal,
-            ao: L::from_fn(|k| p.ao[at + k]),
             footprints: &p.footprints,
             first: at,
-            lights: p.lights,
         };
-        (lanes, depth)
+        (lanes, coords, depth)
     }
 
     /// Shades the fragments of `p`, `width` lanes at a time: per lane,
@@ -529,8 +531,8 @@ impl<'a> FrameData<'a> {
         at: usize,
         out: &mut [(Vec3, f32); MAX_LANES],
     ) {
-        let (lanes, depth) = self.lanes::<L>(p, corners, at);
-        let c = self.ctx.shade_lanes(lm, &lanes);
+        let (lanes, coords, depth) = self.lanes::<L>(p, corners, at);
+        let c = self.ctx.shade_lanes(lm, &lanes, &coords);
         for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
             let c = c.lane(k);
             *o = (if c.is_finite() { c } else { Vec3::ZERO }, depth.lane(k));

@@ -192,8 +192,10 @@ pub fn radiance(
 ) -> Vec3 {
     let (c_diff, spec_weight, roughness) = match lobes {
         Lobes::Pbr(c) => {
-            let s = c.specular_albedo(n.dot(v).abs());
-            (c.c_diff(), luminance(s), c.roughness)
+            let s = c.specular_albedo(n.dot(v).abs()).into();
+            // The diffuse lobe before the transmitted share.
+            let c_diff = Vec3::from(c.base) * (1.0 - c.metallic);
+            (c_diff, luminance(s), c.roughness)
         }
         Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness),
     };
@@ -216,7 +218,10 @@ pub fn radiance(
         }
     } * (1.0 - qc);
     let m = frame(n);
-    let coat_frame = coat.map(|k| (frame(k.normal), k.normal, alpha(k.roughness)));
+    let coat_frame = coat.map(|k| {
+        let nc = Vec3::from(k.normal);
+        (frame(nc), nc, alpha(k.roughness))
+    });
     // GGX's distribution of reflected directions about normal `n`.
     let ggx_pdf = |n: Vec3, a: f32, l: Vec3| {
         let h = (l + v).normalize_or_zero();
@@ -237,7 +242,7 @@ pub fn radiance(
             return Vec3::ZERO;
         }
         match lobes {
-            Lobes::Pbr(c) => pbr::f_cos(n, v, l, c),
+            Lobes::Pbr(c) => pbr::f_cos(n.into(), v.into(), l.into(), ndl, c).into(),
             Lobes::BlinnPhong { kd, ks, .. } => {
                 // The normalized lobe: D (n.h) / (4 v.h) integrates to ~1.
                 let h = (l + v).normalize_or_zero();

@@ -6,8 +6,11 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{ShadeContext, blinn_phong};
+use super::ShadeContext;
+use super::lanes::{Lanes, MAX_LANES};
+use super::light::LightMask;
 use crate::scene::Model;
+use crate::simd::V3;
 
 /// Per vertex of `model` placed at `world` with unit normals `normal`:
 /// the (diffuse, specular) light sums, each vertex lit with the exponent
@@ -36,16 +39,18 @@ pub fn vertex_light(
         .map(|i| {
             let (p, nn) = (world[i], normal[i]);
             let v = ctx.view_vector(p);
-            let shadow = |k: usize, l: Vec3| ctx.shadows.visibility(k, p, nn, l);
-            blinn_phong::light_sums(
-                p,
-                nn,
-                v,
-                ns[i],
-                spec[i],
-                super::light::LightSet::all(ctx.lights),
-                &shadow,
-            )
+            // The vertex as the one-lane instance of the shading code
+            // takes a point (its normal is its plane's for shadows).
+            let f = Lanes::<f32> {
+                position: V3::from(p),
+                normal: V3::from(nn),
+                color: None,
+                geo_normal: [nn; MAX_LANES],
+                ao: 1.0,
+                lights: LightMask::ALL,
+            };
+            let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), ns[i], spec[i]);
+            (d.into(), s.into())
         })
         .collect()
 }

@@ -1,34 +1,29 @@
-//! Shading a lane group of fragments at once: what `ShadeContext::shade`
-//! gives a material, written once over the lane type `L` (`simd::Lane`:
-//! one, four or eight lanes) with the operations of the one-fragment code
-//! in the same order, so each lane is bit for bit that code's answer at
-//! every width.
+//! Shading several fragments at once: the lane type `L` (`simd::Lane`:
+//! one, four or eight lanes) carries one fragment per lane through the
+//! shading code, which is written once over it (`shade_pbr`,
+//! `shade_blinn_phong`); a lone fragment is its one-lane instance, and
+//! every lane of a wider call is bit for bit that instance's answer.
 //!
-//! The renderer shades the visible fragments of a band this way wherever
-//! `ShadeContext::lane_material` accepts the material: Blinn-Phong
-//! (`blinn_phong4`, textured OBJ models) and metallic-roughness with the
-//! KHR specular, clearcoat, sheen and iridescence layers of constant
-//! factors (`pbr4`, most glTF models). Everything else (the data views,
-//! flat and Gouraud shading, unlit, layers with maps of their own,
-//! transmission, bump and object-space normal maps, texture
-//! transforms, the sampled environment) takes the one-fragment path. The
-//! lanes of one call share a material but not a triangle: interpolation
-//! and lighting run `L`-wide; texture lookups, shadow-map lookups and
-//! powers four lanes at a time (`Lane::quad`); texel loads and some
-//! environment lookups per lane.
+//! What differs between the widths is where texels come from (`Fetch`).
+//! A lone fragment reads them through `ShadeContext::sample`, which takes
+//! every map (transforms, samplers of its own, set 1, object-space and
+//! bump maps). The renderer gathers the visible fragments of a band into
+//! wider calls wherever `ShadeContext::lane_material` accepts the
+//! material: its maps are plain lookups of set 0, in at most three
+//! texture sizes, and its normal maps are in tangent space. Their
+//! lookups are found four lanes at a time for all maps of one size
+//! (`Texture::taps4`) and gathered per lane.
 //!
-//! This module holds what both kinds share: the material's maps prepared
-//! for four lookups, the interpolated fragments (`Lanes`), the lights'
-//! incidence and the tangent-space normal map.
+//! The lanes of one call share a material but not a triangle.
 
-// Loops over the four lanes index several per-lane arrays at once.
+// Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use smallvec::SmallVec;
 
-use super::ShadeContext;
 use super::light::{LightMask, LightSet};
+use super::{Fetch, ShadeContext};
 use crate::assets::texture::{
     Chain, Filtering, Footprint, Gradients, Taps4, Texture, TextureFilter as Filter, TextureRef,
     Wrap,
@@ -45,6 +40,9 @@ use crate::simd::{Lane, Mask, V3, clamp01};
 /// (`Texture::taps4`).
 pub const MAX_SIZES: usize = 3;
 
+/// The most lanes a call shades (`simd::F8`).
+pub const MAX_LANES: usize = crate::simd::MAX_WIDTH;
+
 /// One map of a lane material, ready for four lookups.
 pub(super) struct Map<'a> {
     /// The texture with the frame's mip chain.
@@ -53,52 +51,54 @@ pub(super) struct Map<'a> {
     /// Which of the fragment's footprints (by texture size and chain) it
     /// reads, and whose taps.
     pub slot: usize,
-    /// The material reference it came from (to find maps that are the
-    /// same lookup).
+    /// The material reference it came from.
     pub source: &'a TextureRef,
+    /// The first map of the material that is the same lookup (glTF's
+    /// packed occlusion, roughness and metallic texture, referred to
+    /// twice): its texels serve this one.
+    pub same: usize,
+}
+
+/// The shading model of a lane material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    BlinnPhong,
+    Pbr,
 }
 
 /// A material the lanes can shade, prepared for one frame.
 pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
-    pub(super) kind: Kind<'a>,
+    pub(super) kind: Kind,
+    /// Every map its shading may read.
+    maps: SmallVec<[Map<'a>; 8]>,
+    /// Whether the mesh has tangents (without them a tangent-space
+    /// normal map leaves the normal as it is).
+    tangents: bool,
     /// Per slot: the (width, height) of its maps and their number of
     /// levels.
     sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
 }
 
-/// The shading model of a lane material and its maps. (One per draw and
-/// frame, held in place: the variants' sizes differ by two maps.)
-#[allow(clippy::large_enum_variant)]
-pub(super) enum Kind<'a> {
-    BlinnPhong {
-        kd: Option<Map<'a>>,
-        ks: Option<Map<'a>>,
-        /// Tangent-space normal map and its scale.
-        normal: Option<(Map<'a>, f32)>,
-    },
-    Pbr(PbrMaps<'a>),
-}
-
-/// The maps of a metallic-roughness lane material.
-pub(super) struct PbrMaps<'a> {
-    pub base: Option<Map<'a>>,
-    pub metallic_roughness: Option<Map<'a>>,
-    pub occlusion: Option<Map<'a>>,
-    /// Looked up only where the emissive factor is not zero.
-    pub emissive: Option<Map<'a>>,
-    pub normal: Option<(Map<'a>, f32)>,
-}
-
-/// The most lanes a call shades (`simd::F8`).
-pub const MAX_LANES: usize = 8;
-
-/// Fragments of one material, one per lane of `L`, as `Surface` holds
-/// one.
-pub struct Lanes<'p, L: Lane = Vec4> {
+/// The points of the fragments in the lanes: what shading needs of a
+/// fragment besides its texels.
+pub struct Lanes<L: Lane = Vec4> {
     pub position: V3<L>,
     /// Unit interpolated normal, on the side the camera sees.
     pub normal: V3<L>,
+    /// Vertex colour (RGB), where the mesh has one.
+    pub color: Option<V3<L>>,
+    /// The triangles' plane normals (shadow lookups), per lane (the
+    /// first `L::WIDTH`).
+    pub geo_normal: [Vec3; MAX_LANES],
+    pub ao: L,
+    /// The lights that may reach some lane (the union of the lanes'
+    /// tiles'); the others give every lane nothing.
+    pub lights: LightMask,
+}
+
+/// Where the lanes' fragments read a lane material's maps.
+pub struct Coords<'p, L: Lane = Vec4> {
     /// Texture coordinates (set 0).
     pub u: L,
     pub v: L,
@@ -106,22 +106,13 @@ pub struct Lanes<'p, L: Lane = Vec4> {
     /// a normal map).
     pub tangent: V3<L>,
     pub sign: L,
-    /// Vertex colour (RGB), where the mesh has one.
-    pub color: Option<V3<L>>,
-    /// The triangles' plane normals (shadow lookups), per lane (the
-    /// first `L::WIDTH`).
-    pub geo_normal: [Vec3; MAX_LANES],
-    pub ao: L,
     /// Per texture size of the material (`LaneMaterial::footprints`), per
     /// lane from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
     pub first: usize,
-    /// The lights that may reach some lane (the union of the lanes'
-    /// tiles'); the others give every lane nothing.
-    pub lights: LightMask,
 }
 
-impl<L: Lane> Lanes<'_, L> {
+impl<L: Lane> Lanes<L> {
     /// The frame's `lights` that may reach the lanes.
     #[inline(always)]
     pub fn light_set<'l>(&self, lights: &'l [Light]) -> LightSet<'l> {
@@ -129,16 +120,6 @@ impl<L: Lane> Lanes<'_, L> {
             lights,
             mask: self.lights,
         }
-    }
-
-    /// Quad `q`'s footprints of slot `slot`.
-    #[inline(always)]
-    fn footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
-        let f = &self.footprints[slot][self.first..];
-        if L::WIDTH == 1 {
-            return [f[0]; 4];
-        }
-        [f[4 * q], f[4 * q + 1], f[4 * q + 2], f[4 * q + 3]]
     }
 
     /// Quad `q`'s plane normals.
@@ -152,10 +133,22 @@ impl<L: Lane> Lanes<'_, L> {
     }
 }
 
-impl LaneMaterial<'_> {
+impl<L: Lane> Coords<'_, L> {
+    /// Quad `q`'s footprints of slot `slot`.
+    #[inline(always)]
+    fn footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
+        let f = &self.footprints[slot][self.first..];
+        if L::WIDTH == 1 {
+            return [f[0]; 4];
+        }
+        [f[4 * q], f[4 * q + 1], f[4 * q + 2], f[4 * q + 3]]
+    }
+}
+
+impl<'a> LaneMaterial<'a> {
     /// The footprints of a fragment whose texture coordinates change by
     /// `g` across its quad: one per texture size the maps have, in the
-    /// order `Lanes::footprints` takes them (as `ShadeContext::sample`
+    /// order `Coords::footprints` takes them (as `ShadeContext::sample`
     /// derives them).
     pub fn footprints(&self, ctx: &ShadeContext, g: Gradients) -> [Footprint; MAX_SIZES] {
         let mut out = [Footprint::Lod(0.0); MAX_SIZES];
@@ -172,61 +165,29 @@ impl LaneMaterial<'_> {
         }
         out
     }
-}
 
-/// Collects a lane material's maps, assigning each a footprint slot by
-/// its texture's size and chain.
-pub(super) struct MapSet<'c, 'a> {
-    ctx: &'c ShadeContext<'a>,
-    uvs: bool,
-    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
-}
-
-/// Whether two maps are the same lookup (glTF's packed occlusion,
-/// roughness and metallic texture, referred to twice).
-pub(super) fn same_lookup(a: &Map, b: &Map) -> bool {
-    std::sync::Arc::ptr_eq(&a.source.texture, &b.source.texture) && a.mode == b.mode
-}
-
-impl Kind<'_> {
-    /// Each map the shading of `m` with these maps reads, in the order it
-    /// reads them (a map read twice, once).
+    /// Which of the maps `t` is.
     #[inline]
-    fn for_each_map(&self, m: &Material, mut visit: impl FnMut(&Map)) {
-        match self {
-            Kind::BlinnPhong { kd, ks, normal } => {
-                kd.iter().for_each(&mut visit);
-                if m.illum != 0 {
-                    ks.iter().for_each(&mut visit);
-                    normal.iter().for_each(|(map, _)| visit(map));
-                }
-            }
-            Kind::Pbr(maps) => {
-                maps.base.iter().for_each(&mut visit);
-                maps.metallic_roughness.iter().for_each(&mut visit);
-                if let Some(o) = &maps.occlusion {
-                    let shared = maps
-                        .metallic_roughness
-                        .as_ref()
-                        .is_some_and(|mr| same_lookup(o, mr));
-                    if !shared {
-                        visit(o);
-                    }
-                }
-                if m.pbr.emissive != Vec3::ZERO {
-                    maps.emissive.iter().for_each(&mut visit);
-                }
-                maps.normal.iter().for_each(|(map, _)| visit(map));
-            }
-        }
+    fn index_of(&self, t: &TextureRef) -> Option<usize> {
+        self.maps.iter().position(|m| std::ptr::eq(m.source, t))
     }
 }
 
+/// Collects a lane material's maps, assigning each a footprint slot by
+/// its texture's size and chain; None where the lanes cannot look one up
+/// as `ShadeContext::sample` does (a transform, a sampler of its own, set
+/// 1, a mesh without coordinates, a fourth texture size, a normal map
+/// that is not in tangent space).
+struct MapSet<'c, 'a> {
+    ctx: &'c ShadeContext<'a>,
+    uvs: bool,
+    tangents: bool,
+    maps: SmallVec<[Map<'a>; 8]>,
+    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
+}
+
 impl<'a> MapSet<'_, 'a> {
-    /// `t` ready for four lookups, or None where the lanes cannot look it
-    /// up as `ShadeContext::sample` does (a transform, a sampler of its
-    /// own, set 1, a mesh without coordinates, a fourth texture size).
-    pub fn map(&mut self, t: &'a TextureRef) -> Option<Map<'a>> {
+    fn map(&mut self, t: &'a TextureRef) -> Option<()> {
         if !t.is_plain() || t.texcoord != 0 || !self.uvs {
             return None;
         }
@@ -241,45 +202,90 @@ impl<'a> MapSet<'_, 'a> {
             }
             None => return None,
         };
-        Some(Map {
+        let mode = t.address.unwrap_or(self.ctx.address.into());
+        let same = self
+            .maps
+            .iter()
+            .position(|m| std::sync::Arc::ptr_eq(&m.source.texture, &t.texture) && m.mode == mode)
+            .unwrap_or(self.maps.len());
+        self.maps.push(Map {
             chain: tex.chain(mips),
-            mode: t.address.unwrap_or(self.ctx.address.into()),
+            mode,
             slot,
             source: t,
-        })
+            same,
+        });
+        Some(())
     }
 
-    /// An optional map: Some(None) without one, None where the lanes
-    /// cannot look it up.
-    pub fn optional(&mut self, t: &'a Option<TextureRef>) -> Option<Option<Map<'a>>> {
+    fn optional(&mut self, t: &'a Option<TextureRef>) -> Option<()> {
         match t {
-            Some(t) => Some(Some(self.map(t)?)),
-            None => Some(None),
+            Some(t) => self.map(t),
+            None => Some(()),
         }
     }
 
-    /// The material's tangent-space normal map and its scale: Some(None)
-    /// without one (or without tangents, where the map leaves the normal
-    /// as it is), None for the kinds the lanes do not take.
-    pub fn normal(&mut self, m: &'a Material, tangents: bool) -> Option<Option<(Map<'a>, f32)>> {
-        match &m.normal_map {
-            None => Some(None),
+    fn normal(&mut self, m: &'a Option<NormalMap>) -> Option<()> {
+        match m {
+            None => Some(()),
             Some(NormalMap::Normals {
                 map: t,
                 space: NormalSpace::Tangent,
-                scale,
-            }) => {
-                if !self.uvs {
-                    return None;
+                ..
+            }) if self.uvs => {
+                if self.tangents {
+                    self.map(t)?;
                 }
-                if tangents {
-                    Some(Some((self.map(t)?, *scale)))
-                } else {
-                    Some(None)
-                }
+                Some(())
             }
             Some(_) => None,
         }
+    }
+
+    /// The maps a metallic-roughness material's shading reads.
+    fn pbr(&mut self, m: &'a Material) -> Option<()> {
+        let p = &m.pbr;
+        for t in [
+            &p.base_color_map,
+            &p.metallic_roughness_map,
+            &p.roughness_map,
+            &p.metallic_map,
+            &p.occlusion_map,
+            &p.emissive_map,
+        ] {
+            self.optional(t)?;
+        }
+        self.normal(&m.normal_map)?;
+        if let Some(d) = &p.specular {
+            self.optional(&d.color_map)?;
+            self.optional(&d.weight_map)?;
+        }
+        if let Some(k) = &p.clearcoat {
+            self.optional(&k.map)?;
+            self.optional(&k.roughness_map)?;
+            self.normal(&k.normal_map)?;
+        }
+        if let Some(t) = &p.transmission {
+            self.optional(&t.map)?;
+            self.optional(&t.thickness_map)?;
+        }
+        if let Some(k) = &p.sheen {
+            self.optional(&k.color_map)?;
+            self.optional(&k.roughness_map)?;
+        }
+        if let Some(k) = &p.iridescence {
+            self.optional(&k.map)?;
+            self.optional(&k.thickness_map)?;
+        }
+        Some(())
+    }
+
+    /// The maps a Blinn-Phong material's shading reads.
+    fn blinn_phong(&mut self, m: &'a Material) -> Option<()> {
+        for t in [&m.map_kd, &m.map_ks, &m.map_ka, &m.map_ns, &m.map_ke] {
+            self.optional(t)?;
+        }
+        self.normal(&m.normal_map)
     }
 }
 
@@ -296,69 +302,57 @@ impl<'a> ShadeContext<'a> {
         if m.unlit || self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
             return None;
         }
+        let kind = match self.mode {
+            ShadingMode::BlinnPhong => Kind::BlinnPhong,
+            ShadingMode::Pbr => Kind::Pbr,
+            ShadingMode::Auto if m.native == Native::BlinnPhong => Kind::BlinnPhong,
+            ShadingMode::Auto => Kind::Pbr,
+            _ => return None,
+        };
         let mut maps = MapSet {
             ctx: self,
             uvs,
+            tangents,
+            maps: SmallVec::new(),
             sizes: SmallVec::new(),
         };
-        let kind = match self.mode {
-            ShadingMode::BlinnPhong => Kind::blinn_phong(m, &mut maps, tangents)?,
-            ShadingMode::Pbr => Kind::pbr(m, &mut maps, tangents)?,
-            ShadingMode::Auto if m.native == Native::BlinnPhong => {
-                Kind::blinn_phong(m, &mut maps, tangents)?
-            }
-            ShadingMode::Auto => Kind::pbr(m, &mut maps, tangents)?,
-            _ => return None,
-        };
+        match kind {
+            Kind::BlinnPhong => maps.blinn_phong(m)?,
+            Kind::Pbr => maps.pbr(m)?,
+        }
         Some(LaneMaterial {
             material: m,
             kind,
+            maps: maps.maps,
+            tangents,
             sizes: maps.sizes,
         })
     }
 
     /// Linear RGB of the fragments of `lm`'s material in `f`'s lanes,
-    /// lane by lane `shade` of each (before its non-finite guard).
-    pub fn shade_lanes<L: Lane>(&self, lm: &LaneMaterial<'a>, f: &Lanes<'_, L>) -> V3<L> {
-        let mut lookups = Lookups::new(f);
-        lm.kind
-            .for_each_map(lm.material, |map| lookups.prefetch(map));
-        match &lm.kind {
-            Kind::BlinnPhong { kd, ks, normal } => {
-                self.blinn_phong_lanes(lm.material, [kd, ks], normal, &mut lookups, f)
-            }
-            Kind::Pbr(maps) => self.pbr_lanes(lm.material, maps, &mut lookups, f),
-        }
-    }
-
-    /// `apply_normal_map` of a tangent-space map whose texels are `c`
-    /// (RGB).
-    pub(super) fn normal_map_lanes<L: Lane>(
+    /// reading its maps at `coords`: lane by lane `shade` of each (before
+    /// its non-finite guard).
+    pub fn shade_lanes<L: Lane>(
         &self,
-        f: &Lanes<'_, L>,
-        c: V3<L>,
-        scale: f32,
+        lm: &LaneMaterial<'a>,
+        f: &Lanes<L>,
+        coords: &Coords<'_, L>,
     ) -> V3<L> {
-        let n = f.normal;
-        let (one, two) = (L::splat(1.0), L::splat(2.0));
-        let c = V3 {
-            x: c.x * two - one,
-            y: c.y * two - one,
-            z: c.z * two - one,
+        let mut fetch = LaneFetch {
+            lm,
+            lookups: Lookups::new(coords),
+            normal: f.normal,
+            read: [None; 8],
         };
-        let t = f.tangent;
-        let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
-        let tt = if ok.all() {
-            tt
-        } else {
-            let fallback = V3::from_fn(|k| n.lane(k).any_orthonormal_vector());
-            V3::select(ok, tt, fallback)
-        };
-        let sign = L::select(f.sign.cmplt(L::splat(0.0)), -one, one);
-        let b = n.cross(tt).scale(sign);
-        let scale = L::splat(scale);
-        let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
-        mapped.normalize_or(n)
+        for (i, map) in lm.maps.iter().enumerate() {
+            if map.same == i {
+                fetch.lookups.prefetch(map);
+            }
+        }
+        match lm.kind {
+            Kind::BlinnPhong => self.shade_blinn_phong(lm.material, &mut fetch, f, None),
+            Kind::Pbr => self.shade_pbr(lm.material, &mut fetch, f),
+        }
     }
 
     /// The unit view vectors of the points `p` (`view_vector`).
@@ -371,15 +365,15 @@ impl<'a> ShadeContext<'a> {
         }
     }
 
-    /// Light `i`'s light on the lanes' points with unit normals `n`, as
-    /// `for_each_lit` hands it on: the unit directions towards it, the
-    /// irradiance times n.l times the shadow, and the lanes it lights.
+    /// Light `i`'s light on the lanes' points with unit normals `n`: the
+    /// unit directions towards it, the irradiance times n.l times the
+    /// shadow, and the lanes it lights.
     #[inline(always)]
     pub(super) fn lit_lanes<L: Lane>(
         &self,
         i: usize,
         light: &Light,
-        f: &Lanes<'_, L>,
+        f: &Lanes<L>,
         n: V3<L>,
     ) -> Lit<L> {
         let p = f.position;
@@ -415,14 +409,93 @@ impl<'a> ShadeContext<'a> {
     }
 }
 
-/// A light's contribution at the lanes' points
-/// (`ShadeContext::lit_lanes`).
+/// A light's contribution at the lanes' points (`ShadeContext::lit_lanes`).
 pub(super) struct Lit<L: Lane> {
     pub l: V3<L>,
     pub ndl: L,
     /// Irradiance times n.l times the shadow.
     pub e: V3<L>,
     pub lit: L::Mask,
+}
+
+/// Texels of a lane material's maps for the lanes (`Fetch`): through
+/// `Lookups`, each distinct lookup once.
+struct LaneFetch<'x, 'a, 'p, L: Lane> {
+    lm: &'x LaneMaterial<'a>,
+    lookups: Lookups<'x, 'p, L>,
+    /// The interpolated normals.
+    normal: V3<L>,
+    /// Per map (by `Map::same`), its texels once read.
+    read: [Option<V3<L>>; 8],
+}
+
+impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
+    #[inline]
+    fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
+        let i = self.lm.index_of(t)?;
+        let same = self.lm.maps[i].same;
+        if let Some(Some(c)) = self.read.get(same) {
+            return Some(*c);
+        }
+        let c = self.lookups.read(&self.lm.maps[same]);
+        if let Some(slot) = self.read.get_mut(same) {
+            *slot = Some(c);
+        }
+        Some(c)
+    }
+
+    fn rgba(&mut self, t: &TextureRef) -> Option<(V3<L>, L)> {
+        let i = self.lm.index_of(t)?;
+        let map = &self.lm.maps[i];
+        let c = self.lookups.coords;
+        let mut texels = [Vec4::ZERO; MAX_LANES];
+        for (k, o) in texels.iter_mut().enumerate().take(L::WIDTH) {
+            let uv = Vec2::new(c.u.lane(k), c.v.lane(k));
+            *o = map
+                .chain
+                .sample1(uv, c.footprints[map.slot][c.first + k], map.mode);
+        }
+        let rgb = V3::from_fn(|k| texels[k].truncate());
+        Some((rgb, L::from_fn(|k| texels[k].w)))
+    }
+
+    fn normal(&mut self, m: &NormalMap) -> V3<L> {
+        let (t, scale) = match m {
+            NormalMap::Normals { map, scale, .. } => (map, *scale),
+            NormalMap::Height { .. } => return self.normal,
+        };
+        if !self.lm.tangents {
+            return self.normal;
+        }
+        match self.rgb(t) {
+            Some(c) => normal_map_lanes(self.normal, self.lookups.coords, c, scale),
+            None => self.normal,
+        }
+    }
+}
+
+/// A tangent-space normal map whose texels are `c` (RGB) applied to unit
+/// normals `n` (`ShadeContext::apply_normal_map`).
+fn normal_map_lanes<L: Lane>(n: V3<L>, coords: &Coords<'_, L>, c: V3<L>, scale: f32) -> V3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    let c = V3 {
+        x: c.x * two - one,
+        y: c.y * two - one,
+        z: c.z * two - one,
+    };
+    let t = coords.tangent;
+    let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
+    let tt = if ok.all() {
+        tt
+    } else {
+        let fallback = V3::from_fn(|k| n.lane(k).any_orthonormal_vector());
+        V3::select(ok, tt, fallback)
+    };
+    let sign = L::select(coords.sign.cmplt(L::splat(0.0)), -one, one);
+    let b = n.cross(tt).scale(sign);
+    let scale = L::splat(scale);
+    let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
+    mapped.normalize_or(n)
 }
 
 /// `light::incidence(light, p)` at each lane's point: direction,
@@ -488,7 +561,7 @@ fn incidence<L: Lane>(light: &Light, p: V3<L>) -> (V3<L>, V3<L>, L::Mask) {
 /// lookups fall, found once for all its maps (`Texture::taps4`), four
 /// lanes at a time.
 pub(super) struct Lookups<'f, 'p, L: Lane> {
-    f: &'f Lanes<'p, L>,
+    coords: &'f Coords<'p, L>,
     /// Per quad and slot, once found (bit k of `found` for slot k): where
     /// its lookups fall, or None where some lane takes anisotropic probes.
     taps: [[Option<Taps4>; MAX_SIZES]; 2],
@@ -496,9 +569,9 @@ pub(super) struct Lookups<'f, 'p, L: Lane> {
 }
 
 impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
-    fn new(f: &'f Lanes<'p, L>) -> Lookups<'f, 'p, L> {
+    fn new(coords: &'f Coords<'p, L>) -> Lookups<'f, 'p, L> {
         Lookups {
-            f,
+            coords,
             taps: [[None, None, None], [None, None, None]],
             found: 0,
         }
@@ -507,7 +580,7 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     /// Finds where the lanes' lookups of `map` fall (once per slot).
     #[inline(always)]
     fn find(&mut self, map: &Map) {
-        let (f, s) = (self.f, map.slot);
+        let (f, s) = (self.coords, map.slot);
         if self.found & (1 << s) == 0 {
             self.found |= 1 << s;
             for q in 0..L::QUADS {
@@ -536,7 +609,7 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     #[inline]
     pub fn read(&mut self, map: &Map) -> V3<L> {
         self.find(map);
-        let f = self.f;
+        let f = self.coords;
         let mut rgb = [[Vec4::ZERO; 3]; 2];
         for (q, out) in rgb.iter_mut().enumerate().take(L::QUADS) {
             *out = match &self.taps[q][map.slot] {
@@ -562,38 +635,18 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::scene::material::{Clearcoat, Native};
-    use crate::scene::settings::AddressMode;
+    use crate::scene::material::Clearcoat;
     use crate::shade::shadow::Shadows;
-
-    fn context<'a>(shadows: &'a Shadows<'a>, mode: ShadingMode) -> ShadeContext<'a> {
-        ShadeContext {
-            mode,
-            lights: &[],
-            ambient: Vec3::ZERO,
-            eye: Vec3::Z,
-            forward: -Vec3::Z,
-            orthographic: false,
-            filter: TextureFilter::Trilinear,
-            max_anisotropy: 16.0,
-            address: AddressMode::Repeat,
-            mips: &[],
-            depth_range: (0.0, 1.0),
-            shadows,
-            env: None,
-            env_sampled: None,
-            pixel_scale: 1.0,
-        }
-    }
+    use crate::shade::testing::context;
 
     fn map(size: u32) -> TextureRef {
         let texels = vec![[200, 100, 50, 255]; (size * size) as usize];
         TextureRef::new(Arc::new(Texture::from_rgba8(size, size, texels, false)))
     }
 
-    /// The lane materials the e2e tests (tests/lanes.rs) count on: glTF's
-    /// packed pbr maps and MTL maps go to the lanes; layers, unlit,
-    /// texture transforms and a fourth texture size do not.
+    /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
+    /// maps and the KHR layers with their maps do; unlit, texture
+    /// transforms and a fourth texture size do not.
     #[test]
     fn which_materials_the_lanes_take() {
         let shadows = Shadows::none();
@@ -609,25 +662,22 @@ mod tests {
             space: NormalSpace::Tangent,
             scale: 1.0,
         });
-        let kind = |ctx: &ShadeContext, m| match ctx.lane_material(m, true, true) {
-            Some(LaneMaterial {
-                kind: Kind::Pbr(p), ..
-            }) => Some(("pbr", p.occlusion.is_some() && p.normal.is_some())),
-            Some(LaneMaterial {
-                kind: Kind::BlinnPhong { kd, .. },
-                ..
-            }) => Some(("blinn-phong", kd.is_some())),
-            None => None,
+        let kind = |ctx: &ShadeContext, m| {
+            ctx.lane_material(m, true, true).map(|lm| {
+                let distinct = lm.maps.iter().enumerate().filter(|(i, m)| m.same == *i);
+                (lm.kind, lm.maps.len(), distinct.count())
+            })
         };
-        assert_eq!(kind(&auto, &gltf), Some(("pbr", true)));
+        // The packed texture is one lookup, read twice.
+        assert_eq!(kind(&auto, &gltf), Some((Kind::Pbr, 4, 3)));
         // Without coordinates its maps cannot be looked up.
         assert!(auto.lane_material(&gltf, false, true).is_none());
         let mut obj = Material::default_named("obj");
         obj.map_kd = Some(map(16));
-        assert_eq!(kind(&auto, &obj), Some(("blinn-phong", true)));
+        assert_eq!(kind(&auto, &obj), Some((Kind::BlinnPhong, 1, 1)));
         // Forced pbr shading takes the OBJ material's pbr view.
         let pbr = context(&shadows, ShadingMode::Pbr);
-        assert_eq!(kind(&pbr, &obj), Some(("pbr", false)));
+        assert_eq!(kind(&pbr, &obj), Some((Kind::Pbr, 0, 0)));
         let flat = context(&shadows, ShadingMode::Flat);
         assert_eq!(kind(&flat, &obj), None);
 
@@ -636,16 +686,10 @@ mod tests {
             factor: 1.0,
             map: None,
             roughness: 0.1,
-            roughness_map: None,
+            roughness_map: Some(map(16)),
             normal_map: None,
         });
-        // A constant clearcoat is shaded in lanes; one with a map is not.
-        assert_eq!(kind(&auto, &coat), Some(("pbr", true)));
-        let mut coat_map = coat.clone();
-        if let Some(k) = &mut coat_map.pbr.clearcoat {
-            k.roughness_map = Some(map(16));
-        }
-        assert_eq!(kind(&auto, &coat_map), None);
+        assert_eq!(kind(&auto, &coat), Some((Kind::Pbr, 5, 4)));
         let mut unlit = gltf.clone();
         unlit.unlit = true;
         assert_eq!(kind(&auto, &unlit), None);
@@ -657,9 +701,17 @@ mod tests {
         let mut sizes = gltf.clone();
         sizes.pbr.emissive = Vec3::ONE;
         sizes.pbr.emissive_map = Some(map(32));
-        assert_eq!(kind(&auto, &sizes), Some(("pbr", true)));
+        assert_eq!(kind(&auto, &sizes), Some((Kind::Pbr, 5, 4)));
         let mut four = sizes.clone();
         four.pbr.base_color_map = Some(map(4));
         assert_eq!(kind(&auto, &four), None);
+        // An object-space normal map is the one-fragment path's.
+        let mut object = gltf.clone();
+        object.normal_map = Some(NormalMap::Normals {
+            map: map(16),
+            space: NormalSpace::Object,
+            scale: 1.0,
+        });
+        assert_eq!(kind(&auto, &object), None);
     }
 }

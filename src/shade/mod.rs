@@ -3,7 +3,6 @@
 
 pub mod ao;
 pub mod blinn_phong;
-pub mod blinn_phong4;
 pub mod env;
 pub mod env_sampled;
 pub mod gouraud;
@@ -11,7 +10,6 @@ pub mod iridescence;
 pub mod lanes;
 pub mod light;
 pub mod pbr;
-mod pbr4;
 pub mod shadow;
 pub mod sheen;
 pub mod tonemap;
@@ -26,8 +24,9 @@ use crate::assets::texture::{
 use crate::scene::material::{Native, NormalMap, NormalSpace};
 use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
-use blinn_phong::SurfaceColor;
-use light::{LightMask, LightSet};
+use crate::simd::{Lane, V3};
+use lanes::Lanes;
+use light::LightMask;
 use pbr::PbrColor;
 
 /// Everything about the frame that shading needs, fixed for the frame.
@@ -161,8 +160,10 @@ impl ShadeContext<'_> {
     pub fn shade(&self, s: &Surface) -> Vec3 {
         // KHR_materials_unlit: the base colour, in every lit mode.
         if s.material.unlit && !self.mode.is_data_view() {
-            return self.pbr_color(s).base;
+            return self.pbr_color_at(s).base.into();
         }
+        let f = Lanes::of(s);
+        let mut fetch = One { ctx: self, s };
         match self.mode {
             // The shading normal (normal and bump maps applied), world space.
             ShadingMode::Normals => self.mapped_normal(s) * 0.5 + Vec3::splat(0.5),
@@ -182,35 +183,27 @@ impl ShadeContext<'_> {
             }
             ShadingMode::Unlit => {
                 if s.material.native == Native::Pbr {
-                    let c = self.pbr_color(s);
-                    c.base + c.emissive
+                    let c = self.pbr_color_at(s);
+                    Vec3::from(c.base) + Vec3::from(c.emissive)
                 } else {
-                    let c = self.surface_color(s.material, &s.tc, s.color);
-                    c.kd + c.ke
+                    let c = self.surface_color(s.material, &mut fetch, f.color);
+                    Vec3::from(c.kd) + Vec3::from(c.ke)
                 }
             }
             ShadingMode::Gouraud => {
-                let c = self.surface_color(s.material, &s.tc, s.color);
                 let (d, sp) = s.vertex_light.unwrap_or((Vec3::ZERO, Vec3::ZERO));
-                let env = self.env_blinn_phong(s.position, s.normal, s.geo_normal, s.ao, &c);
-                blinn_phong::combine(&c, self.ambient * s.ao, d, sp) + env
+                let sums = Some((V3::from(d), V3::from(sp)));
+                self.shade_blinn_phong(s.material, &mut fetch, &f, sums)
+                    .into()
             }
-            ShadingMode::Auto if s.material.native == Native::Pbr => self.shade_pbr(s),
-            ShadingMode::Pbr => self.shade_pbr(s),
-            ShadingMode::BlinnPhong | ShadingMode::Auto | ShadingMode::Flat => {
-                let c = self.surface_color(s.material, &s.tc, s.color);
-                let v = self.view_vector(s.position);
-                // Flat: the triangle's normal (already in `s.normal`).
-                let n = if self.mode == ShadingMode::Flat {
-                    s.normal
-                } else {
-                    self.mapped_normal(s)
-                };
-                let ambient = self.ambient * s.ao;
-                let env = self.env_blinn_phong(s.position, n, s.geo_normal, s.ao, &c);
-                let lights = self.light_set(s);
-                blinn_phong::radiance(s.position, n, v, &c, ambient, lights, &self.shadow(s)) + env
+            ShadingMode::Auto if s.material.native == Native::Pbr => {
+                self.shade_pbr(s.material, &mut fetch, &f).into()
             }
+            ShadingMode::Pbr => self.shade_pbr(s.material, &mut fetch, &f).into(),
+            // Flat: the triangle's normal (already in `s.normal`).
+            ShadingMode::BlinnPhong | ShadingMode::Auto | ShadingMode::Flat => self
+                .shade_blinn_phong(s.material, &mut fetch, &f, None)
+                .into(),
         }
     }
 
@@ -230,180 +223,19 @@ impl ShadeContext<'_> {
             _ => s.material.native == Native::Pbr,
         };
         let albedo = if pbr {
-            self.pbr_color(s).base
+            self.pbr_color_at(s).base
         } else {
-            self.surface_color(s.material, &s.tc, s.color).kd
+            let f = Lanes::of(s);
+            self.surface_color(s.material, &mut One { ctx: self, s }, f.color)
+                .kd
         };
-        (normal.normalize_or(Vec3::Z), albedo)
+        (normal.normalize_or(Vec3::Z), albedo.into())
     }
 
-    /// Metallic-roughness shading of a point.
-    fn shade_pbr(&self, s: &Surface) -> Vec3 {
-        let c = self.pbr_color(s);
-        let v = self.view_vector(s.position);
-        let n = self.mapped_normal(s);
-        let ambient = self.ambient * s.ao;
-        let direct = pbr::radiance(
-            s.position,
-            n,
-            v,
-            &c,
-            ambient,
-            self.light_set(s),
-            &self.shadow(s),
-        );
-        if let Some((e, tracer, samples)) = self.env_sampled {
-            let lobes = env_sampled::Lobes::Pbr(&c);
-            let l =
-                env_sampled::radiance(e, tracer, (s.position, n, s.geo_normal), v, &lobes, samples);
-            return direct + l * c.occlusion;
-        }
-        match self.env {
-            Some(env) => direct + pbr::environment(env, n, v, &c, s.ao),
-            None => direct,
-        }
-    }
-
-    /// The environment's light on a Blinn-Phong surface with unit normal
-    /// `n`: Kd E(n) / pi (times AO) plus Ks times the radiance prefiltered
-    /// along the reflection with the GGX lobe that matches Ns (zero
-    /// without an environment).
-    /// `position`, `geo_normal` and `ao` are the surface's.
-    fn env_blinn_phong(
-        &self,
-        position: Vec3,
-        n: Vec3,
-        geo_normal: Vec3,
-        ao: f32,
-        c: &SurfaceColor,
-    ) -> Vec3 {
-        // illum 0 is the colour alone, without any light.
-        let Some(env) = self.env.filter(|_| c.illum > 0) else {
-            return Vec3::ZERO;
-        };
-        let v = self.view_vector(position);
-        let roughness = crate::scene::material::roughness_from_ns(c.ns);
-        if let Some((e, tracer, samples)) = self.env_sampled {
-            let lobes = env_sampled::Lobes::BlinnPhong {
-                kd: c.kd,
-                ks: c.ks,
-                roughness,
-            };
-            return env_sampled::radiance(e, tracer, (position, n, geo_normal), v, &lobes, samples);
-        }
-        let diffuse = c.kd * env.irradiance(n) * (ao / std::f32::consts::PI);
-        if c.ks == Vec3::ZERO {
-            return diffuse;
-        }
-        let r = env::dominant_direction(n, n * (2.0 * n.dot(v)) - v, roughness);
-        diffuse + c.ks * env.prefiltered_phong(r, roughness)
-    }
-
-    /// The lights that may reach the surface point.
-    #[inline(always)]
-    fn light_set(&self, s: &Surface) -> LightSet<'_> {
-        LightSet {
-            lights: self.lights,
-            mask: s.lights,
-        }
-    }
-
-    /// Light `i`'s shadow at the surface point, towards unit `l`.
-    #[inline(always)]
-    fn shadow<'s>(&'s self, s: &'s Surface) -> impl Fn(usize, Vec3) -> f32 + 's {
-        move |i, l| self.shadows.visibility(i, s.position, s.geo_normal, l)
-    }
-
-    /// The material's metallic-roughness factors times its maps.
-    pub fn pbr_color(&self, s: &Surface) -> PbrColor {
-        let p = &s.material.pbr;
-        let tc = &s.tc;
-        let get = |t: &Option<TextureRef>| t.as_ref().and_then(|t| self.sample(t, tc));
-        let base = p.base_color.truncate()
-            * get(&p.base_color_map).map_or(Vec3::ONE, |c| c.truncate())
-            * s.color.truncate();
-        let (mut roughness, mut metallic) = match get(&p.metallic_roughness_map) {
-            Some(mr) => (p.roughness * mr.y, p.metallic * mr.z),
-            None => (p.roughness, p.metallic),
-        };
-        if let Some(r) = get(&p.roughness_map) {
-            roughness *= r.x;
-        }
-        if let Some(m) = get(&p.metallic_map) {
-            metallic *= m.x;
-        }
-        let occlusion = match get(&p.occlusion_map) {
-            Some(o) => 1.0 + p.occlusion_strength * (o.x - 1.0),
-            None => 1.0,
-        };
-        let emissive = if p.emissive == Vec3::ZERO {
-            Vec3::ZERO
-        } else {
-            p.emissive * get(&p.emissive_map).map_or(Vec3::ONE, |c| c.truncate())
-        };
-        let dielectric = p.specular.as_ref().map(|d| {
-            let color = get(&d.color_map).map_or(Vec3::ONE, |c| c.truncate());
-            let weight = d.weight * get(&d.weight_map).map_or(1.0, |c| c.w);
-            ((d.f0 * color).min(Vec3::ONE) * weight, weight)
-        });
-        let coat = p.clearcoat.as_ref().and_then(|k| {
-            let factor = (k.factor * get(&k.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
-            (factor > 0.0).then(|| pbr::Coat {
-                factor,
-                roughness: (k.roughness * get(&k.roughness_map).map_or(1.0, |c| c.y))
-                    .clamp(0.0, 1.0),
-                normal: match &k.normal_map {
-                    Some(m) => self.apply_normal_map(s, m),
-                    None => s.normal,
-                },
-            })
-        });
-        let (transmission, attenuation) = match &p.transmission {
-            None => (0.0, Vec3::ONE),
-            Some(t) => {
-                let factor = (t.factor * get(&t.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
-                let thickness = t.thickness * get(&t.thickness_map).map_or(1.0, |c| c.y);
-                let attenuation = if t.attenuation_distance.is_finite() && thickness > 0.0 {
-                    let k = thickness / t.attenuation_distance;
-                    Vec3::new(
-                        t.attenuation_color.x.powf(k),
-                        t.attenuation_color.y.powf(k),
-                        t.attenuation_color.z.powf(k),
-                    )
-                } else {
-                    Vec3::ONE
-                };
-                (factor, attenuation)
-            }
-        };
-        let sheen = p.sheen.as_ref().map(|k| pbr::Sheen {
-            color: k.color * get(&k.color_map).map_or(Vec3::ONE, |c| c.truncate()),
-            roughness: (k.roughness * get(&k.roughness_map).map_or(1.0, |c| c.w)).clamp(0.0, 1.0),
-        });
-        let iridescence = p.iridescence.as_ref().and_then(|k| {
-            let factor = (k.factor * get(&k.map).map_or(1.0, |c| c.x)).clamp(0.0, 1.0);
-            (factor > 0.0).then(|| pbr::Iridescence {
-                factor,
-                ior: k.ior,
-                thickness: match get(&k.thickness_map) {
-                    Some(c) => k.thickness_min + (k.thickness_max - k.thickness_min) * c.y,
-                    None => k.thickness_max,
-                },
-            })
-        });
-        PbrColor {
-            iridescence,
-            base,
-            metallic: metallic.clamp(0.0, 1.0),
-            roughness: roughness.clamp(0.0, 1.0),
-            occlusion,
-            emissive,
-            dielectric,
-            coat,
-            sheen,
-            transmission,
-            attenuation,
-        }
+    /// The material's metallic-roughness factors times its maps at a
+    /// surface point.
+    pub fn pbr_color_at(&self, s: &Surface) -> PbrColor {
+        self.pbr_color(s.material, &mut One { ctx: self, s }, &Lanes::of(s))
     }
 
     /// Whether a point of `m` is shaded with metallic-roughness.
@@ -423,9 +255,9 @@ impl ShadeContext<'_> {
     pub fn layer(&self, s: &Surface) -> (Vec3, Vec3, f32) {
         let c = self.shade(s);
         if s.material.pbr.transmission.is_some() && self.shades_pbr(s.material) {
-            let pc = self.pbr_color(s);
+            let pc = self.pbr_color_at(s);
             let n = self.mapped_normal(s);
-            let t = pbr::transmittance(n, self.view_vector(s.position), &pc);
+            let t = pc.transmittance(n, self.view_vector(s.position));
             let t = t.clamp(Vec3::ZERO, Vec3::ONE);
             return (c, t, 1.0 - (t.x + t.y + t.z) / 3.0);
         }
@@ -462,42 +294,6 @@ impl ShadeContext<'_> {
             return Some(tex.sample_footprint(uv, fp, mode, f.mips));
         }
         Some(t.sample_grad(uv, tc.grads[set], self.address, f))
-    }
-
-    /// The material's constants times its texture maps (and the vertex
-    /// color) at the point.
-    #[inline]
-    pub fn surface_color(&self, m: &Material, tc: &TexCoords, color: Vec4) -> SurfaceColor {
-        let sample = |t: &Option<TextureRef>| -> Vec3 {
-            t.as_ref()
-                .and_then(|t| self.sample(t, tc))
-                .map_or(Vec3::ONE, |c| c.truncate())
-        };
-        let kd = m.kd * sample(&m.map_kd) * color.truncate();
-        let ka = match m.ka {
-            Some(ka) => ka * sample(&m.map_ka),
-            None => kd,
-        };
-        let ns = match m.map_ns.as_ref().and_then(|t| self.sample(t, tc)) {
-            Some(c) => m.ns * c.x,
-            None => m.ns,
-        };
-        SurfaceColor {
-            ka,
-            kd,
-            ks: if m.illum >= 2 {
-                m.ks * sample(&m.map_ks)
-            } else {
-                Vec3::ZERO
-            },
-            ke: if m.ke == Vec3::ZERO {
-                Vec3::ZERO
-            } else {
-                m.ke * sample(&m.map_ke)
-            },
-            ns,
-            illum: m.illum,
-        }
     }
 
     /// Opacity at the point: d (glTF: the base color's alpha) times map_d
@@ -598,6 +394,76 @@ impl ShadeContext<'_> {
     }
 }
 
+/// Where shading code (written once over the lane type `L`) reads a
+/// material's texels and perturbs its normals: one fragment's through
+/// `ShadeContext::sample` (`One`), a lane call's through its prepared
+/// maps (`shade::lanes`).
+pub(crate) trait Fetch<L: Lane> {
+    /// Red, green, blue and alpha of `t` at the lanes' points; None where
+    /// the mesh has no coordinates of its set (the map then counts as 1).
+    fn rgba(&mut self, t: &TextureRef) -> Option<(V3<L>, L)>;
+
+    /// The lanes' interpolated normals perturbed by `map`, unit.
+    fn normal(&mut self, map: &NormalMap) -> V3<L>;
+
+    /// Red, green and blue of `t` (`rgba`).
+    #[inline(always)]
+    fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
+        self.rgba(t).map(|c| c.0)
+    }
+
+    /// `rgb` of an optional map.
+    #[inline(always)]
+    fn rgb_of(&mut self, t: &Option<TextureRef>) -> Option<V3<L>> {
+        t.as_ref().and_then(|t| self.rgb(t))
+    }
+
+    /// `rgba` of an optional map.
+    #[inline(always)]
+    fn rgba_of(&mut self, t: &Option<TextureRef>) -> Option<(V3<L>, L)> {
+        t.as_ref().and_then(|t| self.rgba(t))
+    }
+}
+
+/// One fragment's texels: every kind of map, filtered as the frame asks.
+struct One<'c, 's> {
+    ctx: &'c ShadeContext<'c>,
+    s: &'s Surface<'s>,
+}
+
+impl Fetch<f32> for One<'_, '_> {
+    #[inline]
+    fn rgba(&mut self, t: &TextureRef) -> Option<(V3<f32>, f32)> {
+        let c = self.ctx.sample(t, &self.s.tc)?;
+        Some((V3::from(c.truncate()), c.w))
+    }
+
+    #[inline]
+    fn normal(&mut self, map: &NormalMap) -> V3<f32> {
+        // Flat shading keeps the triangle's normal.
+        if self.ctx.mode == ShadingMode::Flat {
+            return V3::from(self.s.normal);
+        }
+        V3::from(self.ctx.apply_normal_map(self.s, map))
+    }
+}
+
+impl Lanes<f32> {
+    /// A surface point as the one-lane instance of the shading code
+    /// takes it.
+    #[inline]
+    pub fn of(s: &Surface) -> Lanes<f32> {
+        Lanes {
+            position: V3::from(s.position),
+            normal: V3::from(s.normal),
+            color: Some(V3::from(s.color.truncate())),
+            geo_normal: [s.geo_normal; lanes::MAX_LANES],
+            ao: s.ao,
+            lights: s.lights,
+        }
+    }
+}
+
 /// Background pixel: linear color with alpha (0 for transparent); the
 /// environment backgrounds vary per pixel (the renderer looks them up
 /// along each pixel's ray) and are opaque black here.
@@ -606,5 +472,32 @@ pub fn background(bg: Background) -> Vec4 {
         Background::Color(c) => c.extend(1.0),
         Background::Transparent => Vec4::ZERO,
         Background::Environment | Background::Blurred(_) => Vec4::W,
+    }
+}
+
+/// A frame's shading context for unit tests: no lights, no environment,
+/// trilinear filtering.
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::*;
+
+    pub fn context<'a>(shadows: &'a shadow::Shadows<'a>, mode: ShadingMode) -> ShadeContext<'a> {
+        ShadeContext {
+            mode,
+            lights: &[],
+            ambient: Vec3::ZERO,
+            eye: Vec3::Z,
+            forward: -Vec3::Z,
+            orthographic: false,
+            filter: TextureFilter::Trilinear,
+            max_anisotropy: 16.0,
+            address: AddressMode::Repeat,
+            mips: &[],
+            depth_range: (0.0, 1.0),
+            shadows,
+            env: None,
+            env_sampled: None,
+            pixel_scale: 1.0,
+        }
     }
 }

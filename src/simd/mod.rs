@@ -21,6 +21,9 @@ mod lane;
 
 pub use lane::{F8, Lane, M8, Mask};
 
+/// The most lanes any width has (`F8`).
+pub const MAX_WIDTH: usize = 8;
+
 /// The lane widths this build shades with: 8 where it targets AVX
 /// (x86-64-v3, the default x86-64 build), else 1 and 4.
 pub fn widths() -> &'static [usize] {
@@ -294,6 +297,16 @@ impl<L: Lane> V3<L> {
             x: L::select(m, a.x, b.x),
             y: L::select(m, a.y, b.y),
             z: L::select(m, a.z, b.z),
+        }
+    }
+
+    /// `Vec3::min` per lane.
+    #[inline(always)]
+    pub fn min(self, o: V3<L>) -> V3<L> {
+        V3 {
+            x: self.x.min(o.x),
+            y: self.y.min(o.y),
+            z: self.z.min(o.z),
         }
     }
 

@@ -101,6 +101,12 @@ impl Texture {
 }
 
 impl<'t> Chain<'t> {
+    /// `Texture::sample_footprint` (red, green, blue and alpha) of one
+    /// lookup in this chain.
+    pub fn sample1(&self, uv: Vec2, fp: Footprint, mode: Wrap) -> Vec4 {
+        self.texture.sample_footprint(uv, fp, mode, self.mips)
+    }
+
     /// The texture's size and number of levels: taps found in one chain
     /// serve every chain of the same shape.
     fn shape(&self) -> (u32, u32, usize) {

@@ -1,0 +1,275 @@
+//! A metallic-roughness material shaded at the lanes' points: its factors
+//! times its maps (`pbr_color`), every light with its shadow, the ambient
+//! term and the environment (prefiltered or sampled), written once over
+//! the lane type.
+
+use glam::Vec3;
+
+use super::{COAT_F0, Coat, Films, PbrColor, Sheens, brdf, env_brdf, environment, f_cos, splat3};
+use crate::scene::Material;
+use crate::shade::env_sampled::{self, Lobes};
+use crate::shade::lanes::{Lanes, Lit};
+use crate::shade::{Fetch, ShadeContext};
+use crate::simd::{Lane, Mask, V3, clamp01};
+
+impl<L: Lane> PbrColor<L> {
+    /// Lane `k`'s point alone.
+    pub fn at(&self, k: usize) -> PbrColor<f32> {
+        let v = |x: V3<L>| V3::from(x.lane(k));
+        PbrColor {
+            base: v(self.base),
+            metallic: self.metallic.lane(k),
+            roughness: self.roughness.lane(k),
+            occlusion: self.occlusion.lane(k),
+            emissive: v(self.emissive),
+            f0: v(self.f0),
+            f90: self.f90.lane(k),
+            c_diff: v(self.c_diff),
+            a2: self.a2.lane(k),
+            transmission: self.transmission.lane(k),
+            attenuation: v(self.attenuation),
+            coat: self.coat.map(|c| Coat {
+                factor: c.factor.lane(k),
+                roughness: c.roughness.lane(k),
+                normal: v(c.normal),
+            }),
+            sheen: self.sheen.map(|s| Sheens {
+                color: v(s.color),
+                roughness: s.roughness.lane(k),
+            }),
+            iridescence: self.iridescence.map(|f| Films {
+                factor: f.factor.lane(k),
+                ior: f.ior,
+                thickness: f.thickness.lane(k),
+            }),
+        }
+    }
+}
+
+/// `factor` times the red of `t`'s texels, where there are any.
+#[inline(always)]
+fn times<L: Lane>(factor: f32, texel: Option<V3<L>>, channel: fn(V3<L>) -> L) -> L {
+    match texel {
+        Some(c) => L::splat(factor) * channel(c),
+        None => L::splat(factor),
+    }
+}
+
+impl ShadeContext<'_> {
+    /// The material's metallic-roughness factors times its maps (and the
+    /// vertex colour) at the lanes' points.
+    pub(crate) fn pbr_color<L: Lane>(
+        &self,
+        m: &Material,
+        fetch: &mut impl Fetch<L>,
+        f: &Lanes<L>,
+    ) -> PbrColor<L> {
+        let p = &m.pbr;
+        let one = L::splat(1.0);
+        let mut base = V3::splat(p.base_color.truncate());
+        if let Some(c) = fetch.rgb_of(&p.base_color_map) {
+            base = base * c;
+        }
+        if let Some(c) = f.color {
+            base = base * c;
+        }
+        let mr = fetch.rgb_of(&p.metallic_roughness_map);
+        let mut roughness = times(p.roughness, mr, |c| c.y);
+        let mut metallic = times(p.metallic, mr, |c| c.z);
+        if let Some(r) = fetch.rgb_of(&p.roughness_map) {
+            roughness = roughness * r.x;
+        }
+        if let Some(x) = fetch.rgb_of(&p.metallic_map) {
+            metallic = metallic * x.x;
+        }
+        let mut c = PbrColor::new(base, clamp01(metallic), clamp01(roughness));
+        if let Some(o) = fetch.rgb_of(&p.occlusion_map) {
+            c.occlusion = one + L::splat(p.occlusion_strength) * (o.x - one);
+        }
+        if p.emissive != Vec3::ZERO {
+            c.emissive = V3::splat(p.emissive);
+            if let Some(e) = fetch.rgb_of(&p.emissive_map) {
+                c.emissive = c.emissive * e;
+            }
+        }
+        if let Some(d) = &p.specular {
+            let mut f0 = V3::splat(d.f0);
+            if let Some(color) = fetch.rgb_of(&d.color_map) {
+                f0 = f0 * color;
+            }
+            let weight = match fetch.rgba_of(&d.weight_map) {
+                Some((_, a)) => L::splat(d.weight) * a,
+                None => L::splat(d.weight),
+            };
+            c.set_dielectric(f0.min(V3::splat(Vec3::ONE)).scale(weight), weight);
+        }
+        if let Some(k) = &p.clearcoat {
+            let factor = clamp01(times(k.factor, fetch.rgb_of(&k.map), |c| c.x));
+            // Whether there is a coat is the material's to say (lanes of
+            // one call never take different paths).
+            if k.map.is_some() || k.factor.clamp(0.0, 1.0) > 0.0 {
+                let rough = times(k.roughness, fetch.rgb_of(&k.roughness_map), |c| c.y);
+                c.coat = Some(Coat {
+                    factor,
+                    roughness: clamp01(rough),
+                    normal: match &k.normal_map {
+                        Some(map) => fetch.normal(map),
+                        None => f.normal,
+                    },
+                });
+            }
+        }
+        if let Some(t) = &p.transmission {
+            let factor = clamp01(times(t.factor, fetch.rgb_of(&t.map), |c| c.x));
+            let thickness = times(t.thickness, fetch.rgb_of(&t.thickness_map), |c| c.y);
+            let (color, distance) = (t.attenuation_color, t.attenuation_distance);
+            let attenuation = V3::from_fn(|k| {
+                let thickness = thickness.lane(k);
+                if distance.is_finite() && thickness > 0.0 {
+                    let k = thickness / distance;
+                    Vec3::new(color.x.powf(k), color.y.powf(k), color.z.powf(k))
+                } else {
+                    Vec3::ONE
+                }
+            });
+            c.set_transmission(factor, attenuation);
+        }
+        if let Some(k) = &p.sheen {
+            let mut color = V3::splat(k.color);
+            if let Some(t) = fetch.rgb_of(&k.color_map) {
+                color = color * t;
+            }
+            let rough = match fetch.rgba_of(&k.roughness_map) {
+                Some((_, a)) => L::splat(k.roughness) * a,
+                None => L::splat(k.roughness),
+            };
+            c.sheen = Some(Sheens {
+                color,
+                roughness: clamp01(rough),
+            });
+        }
+        if let Some(k) = &p.iridescence
+            && (k.map.is_some() || k.factor.clamp(0.0, 1.0) > 0.0)
+        {
+            let factor = clamp01(times(k.factor, fetch.rgb_of(&k.map), |c| c.x));
+            let thickness = match fetch.rgb_of(&k.thickness_map) {
+                Some(t) => {
+                    L::splat(k.thickness_min) + L::splat(k.thickness_max - k.thickness_min) * t.y
+                }
+                None => L::splat(k.thickness_max),
+            };
+            c.iridescence = Some(Films {
+                factor,
+                ior: k.ior,
+                thickness,
+            });
+        }
+        c
+    }
+
+    /// Metallic-roughness shading of material `m` at the lanes' points.
+    pub(crate) fn shade_pbr<L: Lane>(
+        &self,
+        m: &Material,
+        fetch: &mut impl Fetch<L>,
+        f: &Lanes<L>,
+    ) -> V3<L> {
+        let c = self.pbr_color(m, fetch, f);
+        let v = self.view_lanes(f.position);
+        let n = match &m.normal_map {
+            Some(map) => fetch.normal(map),
+            None => f.normal,
+        };
+        let direct = if c.coat.is_some() || c.sheen.is_some() {
+            self.layered_radiance(f, [n, v], &c)
+        } else {
+            self.radiance(f, [n, v], &c)
+        };
+        if let Some((e, tracer, samples)) = self.env_sampled {
+            let l = V3::from_fn(|k| {
+                let point = (f.position.lane(k), n.lane(k), f.geo_normal[k]);
+                let lobes = Lobes::Pbr(&c.at(k));
+                env_sampled::radiance(e, tracer, point, v.lane(k), &lobes, samples)
+            });
+            return direct + l.scale(c.occlusion);
+        }
+        match self.env {
+            Some(env) => direct + environment(env, [n, v], &c, f.ao),
+            None => direct,
+        }
+    }
+
+    /// The lights' and the ambient light's radiance towards `v` at the
+    /// points with unit normals `n`, plus the emission (without layers).
+    #[inline(always)]
+    fn radiance<L: Lane>(&self, f: &Lanes<L>, [n, v]: [V3<L>; 2], c: &PbrColor<L>) -> V3<L> {
+        let zero = L::splat(0.0);
+        let mut out = c.emissive;
+        f.light_set(self.lights).for_each(|i, light| {
+            let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
+            if lit.any() {
+                let added = out + e * brdf(n, v, l, ndl, c);
+                out = V3::select(lit, added, out);
+            }
+        });
+        let ambient = V3::splat(self.ambient).scale(f.ao);
+        let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
+        if some_ambient.any() {
+            let spec = c.specular_albedo(n.dot(v).abs());
+            let ones = V3::splat(Vec3::ONE);
+            let added = out + ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
+            out = V3::select(some_ambient, added, out);
+        }
+        out
+    }
+
+    /// `radiance` with a sheen or a clearcoat: each light through `f_cos`,
+    /// the base's ambient term scaled by the sheen plus the sheen's own,
+    /// then (with the emission) under the coat, plus the coat's ambient
+    /// term.
+    #[inline(always)]
+    fn layered_radiance<L: Lane>(
+        &self,
+        f: &Lanes<L>,
+        [n, v]: [V3<L>; 2],
+        c: &PbrColor<L>,
+    ) -> V3<L> {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let ndv = n.dot(v).abs();
+        let mut direct = V3::zero();
+        f.light_set(self.lights).for_each(|i, light| {
+            let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
+            if lit.any() {
+                // e carries n.l, and so does f_cos.
+                let added = direct + e * (f_cos(n, v, l, ndl, c) / ndl);
+                direct = V3::select(lit, added, direct);
+            }
+        });
+        let ambient = V3::splat(self.ambient).scale(f.ao);
+        let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
+        let mut under = V3::zero();
+        if some_ambient.any() {
+            let spec = c.specular_albedo(ndv);
+            let ones = V3::splat(Vec3::ONE);
+            let mut lit = ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
+            if let Some(s) = &c.sheen {
+                let k = L::from_fn(|k| s.at(k).scaling(ndv.lane(k), None));
+                let own = V3::from_fn(|k| s.at(k).reflectance(ndv.lane(k)));
+                lit = lit.scale(k) + ambient.scale(c.occlusion) * own;
+            }
+            under = V3::select(some_ambient, lit, under);
+        }
+        under = under + c.emissive;
+        if let Some(coat) = &c.coat {
+            under = under.scale(one - coat.weight(v));
+            if some_ambient.any() {
+                // The specular albedo of F0 0.04 (F90 1) at the coat's n.v.
+                let (a, b) = env_brdf(coat.roughness, coat.normal.dot(v).abs());
+                let s = clamp01(L::splat(COAT_F0) * a + b * one);
+                let added = under + (ambient.scale(c.occlusion) * splat3(s)).scale(coat.factor);
+                under = V3::select(some_ambient, added, under);
+            }
+        }
+        under + direct
+    }
+}
