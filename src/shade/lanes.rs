@@ -57,6 +57,8 @@ pub(super) struct Map<'a> {
     /// packed occlusion, roughness and metallic texture, referred to
     /// twice): its texels serve this one.
     pub same: usize,
+    /// Whether other maps are the same lookup as this one.
+    pub shared: bool,
 }
 
 /// The shading model of a lane material.
@@ -70,7 +72,7 @@ pub(super) enum Kind {
 pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
     pub(super) kind: Kind,
-    /// Every map its shading may read.
+    /// Every map its shading may read, in the order it reads them.
     maps: SmallVec<[Map<'a>; 8]>,
     /// Whether the mesh has tangents (without them a tangent-space
     /// normal map leaves the normal as it is).
@@ -214,6 +216,7 @@ impl<'a> MapSet<'_, 'a> {
             slot,
             source: t,
             same,
+            shared: false,
         });
         Some(())
     }
@@ -242,7 +245,8 @@ impl<'a> MapSet<'_, 'a> {
         }
     }
 
-    /// The maps a metallic-roughness material's shading reads.
+    /// The maps a metallic-roughness material's shading reads, in the
+    /// order it reads them (`pbr_color`, then the normal map).
     fn pbr(&mut self, m: &'a Material) -> Option<()> {
         let p = &m.pbr;
         for t in [
@@ -255,7 +259,6 @@ impl<'a> MapSet<'_, 'a> {
         ] {
             self.optional(t)?;
         }
-        self.normal(&m.normal_map)?;
         if let Some(d) = &p.specular {
             self.optional(&d.color_map)?;
             self.optional(&d.weight_map)?;
@@ -277,12 +280,13 @@ impl<'a> MapSet<'_, 'a> {
             self.optional(&k.map)?;
             self.optional(&k.thickness_map)?;
         }
-        Some(())
+        self.normal(&m.normal_map)
     }
 
-    /// The maps a Blinn-Phong material's shading reads.
+    /// The maps a Blinn-Phong material's shading reads, in the order it
+    /// reads them (`surface_color`, then the normal map).
     fn blinn_phong(&mut self, m: &'a Material) -> Option<()> {
-        for t in [&m.map_kd, &m.map_ks, &m.map_ka, &m.map_ns, &m.map_ke] {
+        for t in [&m.map_kd, &m.map_ka, &m.map_ks, &m.map_ke, &m.map_ns] {
             self.optional(t)?;
         }
         self.normal(&m.normal_map)
@@ -320,10 +324,18 @@ impl<'a> ShadeContext<'a> {
             Kind::BlinnPhong => maps.blinn_phong(m)?,
             Kind::Pbr => maps.pbr(m)?,
         }
+        let mut maps_read = maps.maps;
+        for k in 0..maps_read.len() {
+            let same = maps_read[k].same;
+            if same != k {
+                maps_read[same].shared = true;
+                maps_read[k].shared = true;
+            }
+        }
         Some(LaneMaterial {
             material: m,
             kind,
-            maps: maps.maps,
+            maps: maps_read,
             tangents,
             sizes: maps.sizes,
         })
@@ -342,7 +354,8 @@ impl<'a> ShadeContext<'a> {
             lm,
             lookups: Lookups::new(coords),
             normal: f.normal,
-            read: [None; 8],
+            shared: None,
+            next: 0,
         };
         for (i, map) in lm.maps.iter().enumerate() {
             if map.same == i {
@@ -425,22 +438,33 @@ struct LaneFetch<'x, 'a, 'p, L: Lane> {
     lookups: Lookups<'x, 'p, L>,
     /// The interpolated normals.
     normal: V3<L>,
-    /// Per map (by `Map::same`), its texels once read.
-    read: [Option<V3<L>>; 8],
+    /// The texels of the last lookup that several maps share (by
+    /// `Map::same`), once read.
+    shared: Option<(usize, V3<L>)>,
+    /// The map read next, mostly (the maps are in reading order).
+    next: usize,
 }
 
 impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
-    #[inline]
+    #[inline(always)]
     fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
-        let i = self.lm.index_of(t)?;
-        let same = self.lm.maps[i].same;
-        if let Some(Some(c)) = self.read.get(same) {
-            return Some(*c);
+        let maps = &self.lm.maps;
+        let i = match maps.get(self.next) {
+            Some(m) if std::ptr::eq(m.source, t) => self.next,
+            _ => self.lm.index_of(t)?,
+        };
+        self.next = i + 1;
+        let same = maps[i].same;
+        if !maps[i].shared {
+            return Some(self.lookups.read(&maps[same]));
+        }
+        if let Some((k, c)) = self.shared
+            && k == same
+        {
+            return Some(c);
         }
         let c = self.lookups.read(&self.lm.maps[same]);
-        if let Some(slot) = self.read.get_mut(same) {
-            *slot = Some(c);
-        }
+        self.shared = Some((same, c));
         Some(c)
     }
 
@@ -459,6 +483,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         Some((rgb, L::from_fn(|k| texels[k].w)))
     }
 
+    #[inline]
     fn normal(&mut self, m: &NormalMap) -> V3<L> {
         let (t, scale) = match m {
             NormalMap::Normals { map, scale, .. } => (map, *scale),
@@ -468,22 +493,31 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
             return self.normal;
         }
         match self.rgb(t) {
-            Some(c) => normal_map_lanes(self.normal, self.lookups.coords, c, scale),
+            Some(c) => {
+                let coords = self.lookups.coords;
+                tangent_space(self.normal, (coords.tangent, coords.sign), c, scale)
+            }
             None => self.normal,
         }
     }
 }
 
-/// A tangent-space normal map whose texels are `c` (RGB) applied to unit
-/// normals `n` (`ShadeContext::apply_normal_map`).
-fn normal_map_lanes<L: Lane>(n: V3<L>, coords: &Coords<'_, L>, c: V3<L>, scale: f32) -> V3<L> {
+/// A tangent-space normal map whose texels are `c` (RGB), scaled by
+/// `scale`, applied to unit normals `n` with the interpolated tangents and
+/// their bitangent signs `(t, sign)`.
+#[inline(always)]
+pub(super) fn tangent_space<L: Lane>(
+    n: V3<L>,
+    (t, sign): (V3<L>, L),
+    c: V3<L>,
+    scale: f32,
+) -> V3<L> {
     let (one, two) = (L::splat(1.0), L::splat(2.0));
     let c = V3 {
         x: c.x * two - one,
         y: c.y * two - one,
         z: c.z * two - one,
     };
-    let t = coords.tangent;
     let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
     let tt = if ok.all() {
         tt
@@ -491,7 +525,7 @@ fn normal_map_lanes<L: Lane>(n: V3<L>, coords: &Coords<'_, L>, c: V3<L>, scale: 
         let fallback = V3::from_fn(|k| n.lane(k).any_orthonormal_vector());
         V3::select(ok, tt, fallback)
     };
-    let sign = L::select(coords.sign.cmplt(L::splat(0.0)), -one, one);
+    let sign = L::select(sign.cmplt(L::splat(0.0)), -one, one);
     let b = n.cross(tt).scale(sign);
     let scale = L::splat(scale);
     let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);

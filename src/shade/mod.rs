@@ -343,10 +343,10 @@ impl ShadeContext<'_> {
                 let Some(c) = self.sample(map, tc) else {
                     return n;
                 };
-                let c = c.truncate() * 2.0 - Vec3::ONE;
                 let Some(t) = s.tangent else { return n };
-                let (tt, b) = frame(t);
-                tt * (c.x * scale) + b * (c.y * scale) + n * c.z
+                // The lanes' code at one lane (already unit).
+                let t = (V3::from(t.truncate()), t.w);
+                return lanes::tangent_space(V3::from(n), t, V3::from(c.truncate()), *scale).into();
             }
             NormalMap::Normals {
                 map,

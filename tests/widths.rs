@@ -1,12 +1,15 @@
-//! Shading a lane group at a time (`shade::lanes`: `blinn_phong4` and
-//! `pbr4`), at every lane width this build has (1, 4 and 8 lanes on
-//! x86-64-v3), gives the frames of the one-fragment path bit for bit: colour
-//! and depth of every pixel, over scenes that reach each of its branches
+//! Frames are byte-identical whatever the lane width: the shading code is
+//! written once over the lane type (`shade::lanes`), a lone fragment its
+//! one-lane instance reading texels through `ShadeContext::sample`, and
+//! the renderer gathers fragments into calls of 1, 4 or 8 lanes (every
+//! width this build has: 1, 4 and 8 on x86-64-v3) that read them through
+//! their prepared maps. Each test renders scenes that reach the branches
 //! (maps, normal maps, vertex colours, every light kind with ranges and
 //! shadows, the environment, AO, MSAA, anisotropic and trilinear
 //! filtering, address modes, orthographic cameras, illum 0 and 1; pbr
-//! with packed occlusion-roughness-metallic maps, emission, ambient and
-//! the environment).
+//! with packed occlusion-roughness-metallic maps, emission, the KHR layers
+//! with and without maps of their own) with lone fragments and at each
+//! width, and compares colour and depth bit for bit.
 
 mod common;
 
@@ -33,7 +36,7 @@ fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
 use std::path::Path;
 
 #[test]
-fn the_showcase_is_the_same_with_and_without_lanes() {
+fn the_showcase_is_the_same_at_every_width() {
     // Studio environment, ray-traced shadows, SSAO, MSAA 4, MTL maps.
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
     let small = ["output.width=160", "output.height=120"];
@@ -48,7 +51,7 @@ fn the_showcase_is_the_same_with_and_without_lanes() {
 }
 
 #[test]
-fn textured_character_is_the_same_with_and_without_lanes() {
+fn textured_character_is_the_same_at_every_width() {
     let Some(assets) = shared_assets() else {
         return;
     };
@@ -198,7 +201,7 @@ shadows = true
 "#;
 
 #[test]
-fn vertex_colours_illum_and_repeat_are_the_same_with_and_without_lanes() {
+fn vertex_colours_illum_and_repeat_are_the_same_at_every_width() {
     let dir = scratch("lanes_small");
     // A tiled quad (coordinates up to 3: repeat), vertex colours, and a
     // second object of each illum model.
@@ -228,7 +231,7 @@ fn vertex_colours_illum_and_repeat_are_the_same_with_and_without_lanes() {
 }
 
 #[test]
-fn pbr_models_are_the_same_with_and_without_lanes() {
+fn pbr_models_are_the_same_at_every_width() {
     // The walker: pbr factors without maps under the default look (studio
     // environment, its ground shadow), MSAA 4.
     let walker = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/walker.toml");
@@ -308,7 +311,7 @@ outer_angle = 30
 }
 
 #[test]
-fn clearcoats_are_the_same_with_and_without_lanes() {
+fn clearcoats_are_the_same_at_every_width() {
     // The MTL PBR extension's clearcoat (Pc, Pcr: a constant layer) over
     // a quad and a triangle behind it, under every light kind (the spot
     // with a ray-traced shadow), ambient, the studio environment with and
@@ -354,7 +357,7 @@ fn clearcoats_are_the_same_with_and_without_lanes() {
 }
 
 #[test]
-fn khr_layers_are_the_same_with_and_without_lanes() {
+fn khr_layers_are_the_same_at_every_width() {
     // A turned glTF cube whose material has constant KHR layers (specular,
     // clearcoat, sheen, iridescence: each alone and all together), under
     // a point and a directional light, ambient, and the studio
@@ -447,7 +450,7 @@ fn layer_texture(path: &Path) {
 }
 
 #[test]
-fn khr_layers_with_maps_are_the_same_with_and_without_lanes() {
+fn khr_layers_with_maps_are_the_same_at_every_width() {
     // The KHR layers with maps of their own (a clearcoat whose factor map
     // is 0 on half its texels, its roughness and normal maps; sheen colour
     // and roughness from alpha; specular weight from alpha and colour;
