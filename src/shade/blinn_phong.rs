@@ -47,6 +47,7 @@ fn times<L: Lane>(factor: Vec3, texel: Option<V3<L>>) -> V3<L> {
 impl ShadeContext<'_> {
     /// The material's constants times its texture maps (and the vertex
     /// colours `color`) at the lanes' points.
+    #[inline(always)]
     pub(crate) fn surface_color<L: Lane>(
         &self,
         m: &Material,
@@ -84,6 +85,7 @@ impl ShadeContext<'_> {
     /// Blinn-Phong shading of material `m` at the lanes' points; with
     /// `vertex_light` (Gouraud), the interpolated (diffuse, specular)
     /// light sums replace the lights, about the interpolated normal.
+    #[inline(always)]
     pub(crate) fn shade_blinn_phong<L: Lane>(
         &self,
         m: &Material,

@@ -483,7 +483,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         Some((rgb, L::from_fn(|k| texels[k].w)))
     }
 
-    #[inline]
+    #[inline(always)]
     fn normal(&mut self, m: &NormalMap) -> V3<L> {
         let (t, scale) = match m {
             NormalMap::Normals { map, scale, .. } => (map, *scale),
