@@ -20,7 +20,9 @@
 
 use std::f32::consts::PI;
 
-use glam::{Mat3, Vec3};
+use glam::Vec3;
+
+use crate::simd::{Lane, V3, clamp01};
 
 /// The film at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,100 +36,160 @@ pub struct Iridescence {
     pub thickness: f32,
 }
 
+/// XYZ to linear Rec. 709 (sRGB primaries, D65), by column.
+const XYZ_TO_REC709: [[f32; 3]; 3] = [
+    [3.240_454_2, -0.969_266, 0.055_643_4],
+    [-1.537_138_5, 1.876_010_8, -0.204_025_9],
+    [-0.498_531_4, 0.041_556, 1.057_225_2],
+];
+
 /// Reflectance at normal incidence between indices `a` and `b`.
-#[inline]
-fn r0(a: Vec3, b: f32) -> Vec3 {
-    let d = (a - Vec3::splat(b)) / (a + Vec3::splat(b));
+#[inline(always)]
+fn r0<L: Lane>(a: L, b: f32) -> L {
+    let d = (a - L::splat(b)) / (a + L::splat(b));
     d * d
 }
 
-#[inline]
-fn schlick(f0: Vec3, cos: f32) -> Vec3 {
-    f0 + (Vec3::ONE - f0) * (1.0 - cos).clamp(0.0, 1.0).powi(5)
+/// Schlick's Fresnel from `f0` at cosine `cos`.
+#[inline(always)]
+fn schlick<L: Lane>(f0: L, cos: L) -> L {
+    let x = clamp01(L::splat(1.0) - cos);
+    let x2 = x * x;
+    // `powi(5)` as LLVM makes it: x (x^2 x^2).
+    f0 + (L::splat(1.0) - f0) * (x * (x2 * x2))
 }
-
-/// XYZ to linear Rec. 709 (sRGB primaries, D65).
-const XYZ_TO_REC709: Mat3 = Mat3::from_cols_array(&[
-    3.240_454_2,
-    -0.969_266,
-    0.055_643_4,
-    -1.537_138_5,
-    1.876_010_8,
-    -0.204_025_9,
-    -0.498_531_4,
-    0.041_556,
-    1.057_225_2,
-]);
 
 /// The CIE sensitivities' Fourier transform at optical path difference
 /// `opd` (nm) with phase `shift` per channel, as linear Rec. 709: the
-/// Gaussian fits of Belcour and Barla (their values).
-fn sensitivity(opd: f32, shift: Vec3) -> Vec3 {
-    let phase = 2.0 * PI * opd * 1.0e-9;
-    let val = Vec3::new(5.4856e-13, 4.4201e-13, 5.2481e-13);
-    let pos = Vec3::new(1.6810e+06, 1.7953e+06, 2.2084e+06);
-    let var = Vec3::new(4.3278e+09, 9.3046e+09, 6.6121e+09);
-    let cos = |v: Vec3| Vec3::new(v.x.cos(), v.y.cos(), v.z.cos());
-    let exp = |v: Vec3| Vec3::new(v.x.exp(), v.y.exp(), v.z.exp());
-    let sqrt = |v: Vec3| Vec3::new(v.x.sqrt(), v.y.sqrt(), v.z.sqrt());
-    let mut xyz =
-        val * sqrt(2.0 * PI * var) * cos(pos * phase + shift) * exp(-(phase * phase) * var);
+/// Gaussian fits of Belcour and Barla (their values). Cosines and
+/// exponentials lane by lane (libm's), the rest over the lanes.
+#[inline(always)]
+fn sensitivity<L: Lane>(opd: L, shift: V3<L>) -> V3<L> {
+    let phase = L::splat(2.0 * PI) * opd * L::splat(1.0e-9);
+    let val = [5.4856e-13f32, 4.4201e-13, 5.2481e-13];
+    let pos = [1.6810e+06f32, 1.7953e+06, 2.2084e+06];
+    let var = [4.3278e+09f32, 9.3046e+09, 6.6121e+09];
+    let shift = [shift.x, shift.y, shift.z];
+    let phase2 = -(phase * phase);
+    let mut xyz: [L; 3] = std::array::from_fn(|c| {
+        let a = L::splat(val[c] * (2.0 * PI * var[c]).sqrt());
+        let cos = (L::splat(pos[c]) * phase + shift[c]).map(f32::cos);
+        a * cos * (phase2 * L::splat(var[c])).map(f32::exp)
+    });
     let (v2, p2) = (4.5282e+09f32, 2.2399e+06f32);
-    xyz.x += 9.7470e-14
-        * (2.0 * PI * v2).sqrt()
-        * (p2 * phase + shift.x).cos()
-        * (-v2 * phase * phase).exp();
-    XYZ_TO_REC709 * (xyz / 1.0685e-7)
+    let cos = (L::splat(p2) * phase + shift[0]).map(f32::cos);
+    let exp = (L::splat(-v2) * phase * phase).map(f32::exp);
+    xyz[0] = xyz[0] + L::splat(9.7470e-14 * (2.0 * PI * v2).sqrt()) * cos * exp;
+    let xyz = xyz.map(|v| v / L::splat(1.0685e-7));
+    // `Mat3 * Vec3`: ((x_axis v.x) + (y_axis v.y)) + (z_axis v.z).
+    let m = &XYZ_TO_REC709;
+    let row = |r: usize| {
+        L::splat(m[0][r]) * xyz[0] + L::splat(m[1][r]) * xyz[1] + L::splat(m[2][r]) * xyz[2]
+    };
+    V3 {
+        x: row(0),
+        y: row(1),
+        z: row(2),
+    }
+}
+
+/// The film's reflectance (per linear channel) at the lanes: a film of
+/// index `ior` and `thickness` nanometres, for light at cosine `cos1` to
+/// the microfacet normal outside, over a base of reflectance `base_f0` at
+/// normal incidence.
+#[inline(always)]
+pub fn fresnel<L: Lane>(ior: f32, thickness: L, cos1: L, base_f0: V3<L>) -> V3<L> {
+    let (zero, one, pi) = (L::splat(0.0), L::splat(1.0), L::splat(PI));
+    let cos1 = clamp01(cos1);
+    let outside = 1.0f32;
+    // The film fades in over its first 30 nm.
+    let t = clamp01(thickness / L::splat(30.0));
+    let ior =
+        L::splat(outside) + L::splat(ior - outside) * t * t * (L::splat(3.0) - L::splat(2.0) * t);
+    let k = L::splat(outside) / ior;
+    let sin2_sq = k * k * (one - cos1 * cos1);
+    let cos2_sq = one - sin2_sq;
+    let cos2 = cos2_sq.sqrt();
+    // First interface.
+    let r12 = schlick(r0(ior, outside), cos1);
+    let t121 = one - r12;
+    let phi12 = L::select(ior.cmplt(L::splat(outside)), pi, zero);
+    let phi21 = pi - phi12;
+    // Second interface: the base's index from its F0 (real part only).
+    let channel = |f0: L| {
+        let s = f0.max(zero).min(L::splat(0.9999)).sqrt();
+        let base_ior = (one + s) / (one - s);
+        // Schlick of R0(base, ior), the base's index per lane.
+        let d = (base_ior - ior) / (base_ior + ior);
+        let r23 = schlick(d * d, cos2);
+        let phi23 = L::select(base_ior.cmplt(ior), pi, zero);
+        (r23, phi21 + phi23)
+    };
+    let (rx, px) = channel(base_f0.x);
+    let (ry, py) = channel(base_f0.y);
+    let (rz, pz) = channel(base_f0.z);
+    let (r23, phi) = (
+        V3 {
+            x: rx,
+            y: ry,
+            z: rz,
+        },
+        V3 {
+            x: px,
+            y: py,
+            z: pz,
+        },
+    );
+    // Phase and optical path difference.
+    let opd = L::splat(2.0) * ior * thickness * cos2;
+    // The Airy sum, to second order.
+    let r12v = V3 {
+        x: r12,
+        y: r12,
+        z: r12,
+    };
+    let t121v = V3 {
+        x: t121,
+        y: t121,
+        z: t121,
+    };
+    let clamp = |v: L| v.max(L::splat(1e-5)).min(L::splat(0.9999));
+    let r123 = r12v * r23;
+    let r123 = V3 {
+        x: clamp(r123.x),
+        y: clamp(r123.y),
+        z: clamp(r123.z),
+    };
+    let r123_sqrt = V3 {
+        x: r123.x.sqrt(),
+        y: r123.y.sqrt(),
+        z: r123.z.sqrt(),
+    };
+    let ones = V3::splat(Vec3::ONE);
+    let (num, den) = (t121v * t121v * r23, ones - r123);
+    let rs = V3 {
+        x: num.x / den.x,
+        y: num.y / den.y,
+        z: num.z / den.z,
+    };
+    let mut i = r12v + rs;
+    let mut cm = rs - t121v;
+    for m in 1..=2 {
+        cm = cm * r123_sqrt;
+        let m = m as f32;
+        let s = sensitivity(L::splat(m) * opd, phi.scale(L::splat(m)));
+        i = i + cm.scale(L::splat(2.0)) * s;
+    }
+    // Total internal reflection: all of it.
+    V3::select(cos2_sq.cmplt(zero), ones, i.max(V3::zero()))
 }
 
 impl Iridescence {
     /// The film's reflectance (per linear channel) for light at cosine
     /// `cos1` to the microfacet normal outside, over a base of reflectance
-    /// `base_f0` at normal incidence.
+    /// `base_f0` at normal incidence (`fresnel` at one lane).
     pub fn fresnel(&self, cos1: f32, base_f0: Vec3) -> Vec3 {
-        let cos1 = cos1.clamp(0.0, 1.0);
-        let outside = 1.0f32;
-        // The film fades in over its first 30 nm.
-        let t = (self.thickness / 30.0).clamp(0.0, 1.0);
-        let ior = outside + (self.ior - outside) * t * t * (3.0 - 2.0 * t);
-        let sin2_sq = (outside / ior).powi(2) * (1.0 - cos1 * cos1);
-        let cos2_sq = 1.0 - sin2_sq;
-        if cos2_sq < 0.0 {
-            // Total internal reflection.
-            return Vec3::ONE;
-        }
-        let cos2 = cos2_sq.sqrt();
-        // First interface.
-        let r12 = schlick(r0(Vec3::splat(ior), outside), cos1);
-        let t121 = Vec3::ONE - r12;
-        let phi12 = if ior < outside { PI } else { 0.0 };
-        let phi21 = PI - phi12;
-        // Second interface: the base's index from its F0 (real part only).
-        let s = base_f0
-            .clamp(Vec3::ZERO, Vec3::splat(0.9999))
-            .map(f32::sqrt);
-        let base_ior = (Vec3::ONE + s) / (Vec3::ONE - s);
-        let r23 = schlick(r0(base_ior, ior), cos2);
-        let phi23 = Vec3::select(
-            base_ior.cmplt(Vec3::splat(ior)),
-            Vec3::splat(PI),
-            Vec3::ZERO,
-        );
-        // Phase and optical path difference.
-        let opd = 2.0 * ior * self.thickness * cos2;
-        let phi = Vec3::splat(phi21) + phi23;
-        // The Airy sum, to second order.
-        let r123 = (r12 * r23).clamp(Vec3::splat(1e-5), Vec3::splat(0.9999));
-        let r123_sqrt = r123.map(f32::sqrt);
-        let rs = t121 * t121 * r23 / (Vec3::ONE - r123);
-        let mut i = r12 + rs;
-        let mut cm = rs - t121;
-        for m in 1..=2 {
-            cm *= r123_sqrt;
-            let m = m as f32;
-            i += cm * 2.0 * sensitivity(m * opd, m * phi);
-        }
-        i.max(Vec3::ZERO)
+        fresnel(self.ior, self.thickness, cos1, V3::from(base_f0)).into()
     }
 
     /// `base` (a Fresnel reflectance) blended towards the film's at cosine

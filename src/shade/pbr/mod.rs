@@ -146,13 +146,18 @@ impl<L: Lane> PbrColor<L> {
     pub fn split_sum(&self, ndv: L, a: L, b: L) -> V3<L> {
         let s = self.f0.scale(a) + splat3(b * self.f90);
         match &self.iridescence {
-            Some(film) => V3::from_fn(|k| match film.at(k) {
-                Some(f) => {
-                    let fr = f.fresnel(ndv.lane(k), self.f0.lane(k)).min(Vec3::ONE);
-                    s.lane(k).lerp(fr * (a.lane(k) + b.lane(k)), f.factor)
+            // Towards the film's Fresnel (at most 1) times the lobe's
+            // albedo.
+            Some(film) => {
+                let on = film.factor.cmpgt(L::splat(0.0));
+                if !on.any() {
+                    return s;
                 }
-                None => s.lane(k),
-            }),
+                let fr = super::iridescence::fresnel(film.ior, film.thickness, ndv, self.f0);
+                let fr = fr.min(V3::splat(Vec3::ONE)).scale(a + b);
+                let k = film.factor;
+                V3::select(on, s.scale(L::splat(1.0) - k) + fr.scale(k), s)
+            }
             None => s,
         }
     }
@@ -237,6 +242,28 @@ pub struct Sheens<L: Lane = f32> {
 }
 
 impl<L: Lane> Sheens<L> {
+    /// The lobe's directional albedo E at n.v (or n.l) = `c`, per lane
+    /// (`sheen::albedo`).
+    #[inline(always)]
+    pub fn albedo(&self, c: L) -> L {
+        L::from_fn(|k| super::sheen::albedo(c.lane(k), self.roughness.lane(k)))
+    }
+
+    /// The share of the light below that the layer leaves for an albedo
+    /// `e` of its lobe: 1 - max(C) e (`Sheen::scaling`).
+    #[inline(always)]
+    pub fn keep(&self, e: L) -> L {
+        let c = self.color;
+        L::splat(1.0) - c.x.max(c.y).max(c.z) * e
+    }
+
+    /// The layer's directional albedo per channel for an albedo `e` of
+    /// its lobe: C e (`Sheen::reflectance`).
+    #[inline(always)]
+    pub fn reflectance(&self, e: L) -> V3<L> {
+        self.color.scale(e)
+    }
+
     /// Lane `k`'s layer.
     #[inline(always)]
     pub fn at(&self, k: usize) -> Sheen {
@@ -258,15 +285,19 @@ pub struct Films<L: Lane = f32> {
 }
 
 impl<L: Lane> Films<L> {
-    /// Lane `k`'s film, where its factor is above 0.
+    /// `base` (a Fresnel reflectance) blended towards the film's at
+    /// cosine `cos1` by the factor, over a base of reflectance `f0`
+    /// (`Iridescence::blend` at each lane).
     #[inline(always)]
-    pub fn at(&self, k: usize) -> Option<Iridescence> {
-        let factor = self.factor.lane(k);
-        (factor > 0.0).then(|| Iridescence {
-            factor,
-            ior: self.ior,
-            thickness: self.thickness.lane(k),
-        })
+    pub fn blend(&self, base: V3<L>, cos1: L, f0: V3<L>) -> V3<L> {
+        let on = self.factor.cmpgt(L::splat(0.0));
+        if !on.any() {
+            return base;
+        }
+        let film = super::iridescence::fresnel(self.ior, self.thickness, cos1, f0);
+        let k = self.factor;
+        let mixed = base.scale(L::splat(1.0) - k) + film.scale(k);
+        V3::select(on, mixed, base)
     }
 }
 
@@ -303,10 +334,7 @@ pub fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> V
     let one = V3::splat(Vec3::ONE);
     let mut fresnel = c.f0 + (splat3(c.f90) - c.f0).scale(pow5(L::splat(1.0) - vdh));
     if let Some(film) = &c.iridescence {
-        fresnel = V3::from_fn(|k| match film.at(k) {
-            Some(f) => f.blend(fresnel.lane(k), vdh.lane(k), c.f0.lane(k)),
-            None => fresnel.lane(k),
-        });
+        fresnel = film.blend(fresnel, vdh, c.f0);
     }
     (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(d_vis(n, v, h, ndl, c.a2))
 }
@@ -319,7 +347,7 @@ pub fn f_cos<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> 
     let mut base = brdf(n, v, l, ndl, c).scale(ndl_0);
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs();
-        let k = L::from_fn(|k| s.at(k).scaling(ndv.lane(k), Some(ndl_0.lane(k))));
+        let k = s.keep(s.albedo(ndv)).min(s.keep(s.albedo(ndl_0)));
         let lobe = L::from_fn(|k| s.at(k).lobe_cos(n.lane(k), v.lane(k), l.lane(k)));
         base = base.scale(k) + s.color.scale(lobe);
     }
@@ -384,8 +412,9 @@ pub fn environment<L: Lane>(env: &EnvLight, [n, v]: [V3<L>; 2], c: &PbrColor<L>,
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs().max(L::splat(1e-4));
         let irradiance = env.irradiance_lanes(n);
-        let lobe = V3::from_fn(|k| irradiance.lane(k) * (s.at(k).reflectance(ndv.lane(k)) / PI));
-        let k = L::from_fn(|k| s.at(k).scaling(ndv.lane(k), None));
+        let e = s.albedo(ndv);
+        let lobe = irradiance * (s.reflectance(e) / L::splat(PI));
+        let k = s.keep(e);
         base = base.scale(k) + lobe.scale(ao.min(L::splat(1.0)) * c.occlusion);
     }
     let Some(coat) = &c.coat else {

@@ -253,8 +253,8 @@ impl ShadeContext<'_> {
             let ones = V3::splat(Vec3::ONE);
             let mut lit = ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
             if let Some(s) = &c.sheen {
-                let k = L::from_fn(|k| s.at(k).scaling(ndv.lane(k), None));
-                let own = V3::from_fn(|k| s.at(k).reflectance(ndv.lane(k)));
+                let e = s.albedo(ndv);
+                let (k, own) = (s.keep(e), s.reflectance(e));
                 lit = lit.scale(k) + ambient.scale(c.occlusion) * own;
             }
             under = V3::select(some_ambient, lit, under);
