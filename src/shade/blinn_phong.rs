@@ -35,6 +35,14 @@ pub struct SurfaceColor<L: Lane = f32> {
     pub illum: u8,
 }
 
+/// The specular exponent of a lane call: one for every lane, or one per
+/// lane (an Ns map).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Exponent<L: Lane> {
+    One(f32),
+    PerLane(L),
+}
+
 /// `factor` times texels, where there are any.
 #[inline(always)]
 fn times<L: Lane>(factor: Vec3, texel: Option<V3<L>>) -> V3<L> {
@@ -107,7 +115,12 @@ impl ShadeContext<'_> {
                     Some(map) => fetch.normal(map),
                     None => f.normal,
                 };
-                (n, self.light_sums(f, [n, v], c.ns, specular))
+                // One exponent for every lane unless an Ns map varies it.
+                let ns = match m.map_ns {
+                    None => Exponent::One(m.ns),
+                    Some(_) => Exponent::PerLane(c.ns),
+                };
+                (n, self.light_sums(f, [n, v], ns, specular))
             }
         };
         let ambient = V3::splat(self.ambient).scale(f.ao);
@@ -127,14 +140,12 @@ impl ShadeContext<'_> {
         &self,
         f: &Lanes<L>,
         [n, v]: [V3<L>; 2],
-        ns: L,
+        ns: Exponent<L>,
         specular: bool,
     ) -> (V3<L>, V3<L>) {
         let zero = L::splat(0.0);
         let mut diffuse = V3::zero();
         let mut spec = V3::zero();
-        let ns0 = ns.lane(0);
-        let one_ns = ns.cmpeq(L::splat(ns0)).all();
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, e, lit, .. } = self.lit_lanes(i, light, f, n);
             diffuse = diffuse + V3::select(lit, e, V3::zero());
@@ -145,10 +156,13 @@ impl ShadeContext<'_> {
                 if shine.any() {
                     // Lanes that do not shine give what they give (x = 0:
                     // 2^-126 raised), left out by the select.
-                    let pw = if one_ns {
-                        L::from_quads(|q| crate::powers::pow4(ndh.quad(q), ns0))
-                    } else {
-                        L::from_fn(|k| crate::powers::pow_unit(ndh.lane(k), ns.lane(k)))
+                    let pw = match ns {
+                        Exponent::One(ns) => {
+                            L::from_quads(|q| crate::powers::pow4(ndh.quad(q), ns))
+                        }
+                        Exponent::PerLane(ns) => {
+                            L::from_fn(|k| crate::powers::pow_unit(ndh.lane(k), ns.lane(k)))
+                        }
                     };
                     spec = spec + V3::select(shine, e.scale(pw), V3::zero());
                 }

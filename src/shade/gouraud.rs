@@ -7,6 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::ShadeContext;
+use super::blinn_phong::Exponent;
 use super::lanes::{Lanes, MAX_LANES};
 use super::light::LightMask;
 use crate::scene::Model;
@@ -49,7 +50,7 @@ pub fn vertex_light(
                 ao: 1.0,
                 lights: LightMask::ALL,
             };
-            let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), ns[i], spec[i]);
+            let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), Exponent::One(ns[i]), spec[i]);
             (d.into(), s.into())
         })
         .collect()

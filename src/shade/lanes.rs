@@ -73,7 +73,7 @@ pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
     pub(super) kind: Kind,
     /// Every map its shading may read, in the order it reads them.
-    maps: SmallVec<[Map<'a>; 8]>,
+    maps: Vec<Map<'a>>,
     /// Whether the mesh has tangents (without them a tangent-space
     /// normal map leaves the normal as it is).
     tangents: bool,
@@ -184,7 +184,7 @@ struct MapSet<'c, 'a> {
     ctx: &'c ShadeContext<'a>,
     uvs: bool,
     tangents: bool,
-    maps: SmallVec<[Map<'a>; 8]>,
+    maps: Vec<Map<'a>>,
     sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
 }
 
@@ -317,7 +317,7 @@ impl<'a> ShadeContext<'a> {
             ctx: self,
             uvs,
             tangents,
-            maps: SmallVec::new(),
+            maps: Vec::new(),
             sizes: SmallVec::new(),
         };
         match kind {
