@@ -155,3 +155,64 @@ fn concave_faces_keep_their_notch_and_open_meshes_are_two_sided() {
     let lit: f32 = h.color.iter().map(|c| c.x).sum();
     assert!(lit < 0.01, "{lit}");
 }
+
+#[test]
+fn a_scan_of_bare_vertices_reads_as_a_surface() {
+    // 3,000 vertices on a unit sphere (a Fibonacci lattice), `v` lines
+    // and nothing else, as a scanner writes them; and the same as a PLY
+    // without faces. Drawn as points sized from their number: the
+    // sphere's disc in a 200x200 frame reads as a surface (over 88% of
+    // the pixels within 95% of its radius more than half covered; the rest
+    // are the seams where three discs' anti-aliased edges meet), where
+    // 1-pixel points leave most of it open.
+    let dir = scratch("points-scan");
+    let n = 3_000;
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+    );
+    for i in 0..n {
+        let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let r = (1.0 - y * y).sqrt();
+        let (x, z) = (r * (golden * i as f32).cos(), r * (golden * i as f32).sin());
+        obj.push_str(&format!("v {x} {y} {z}\n"));
+        ply.push_str(&format!("{x} {y} {z}\n"));
+    }
+    let toml = |model: &str, sets: &str| {
+        format!(
+            "[output]\nwidth = 200\nheight = 200\nbackground = \"transparent\"\n\
+             [render]\n{sets}\n[ground]\nshadow = false\n[[model]]\npath = \"{model}\"\n"
+        )
+    };
+    let fill = |scene: &softraster::scene::Scene| {
+        let f = common::render_frame(scene, 0, 0);
+        let (w, h) = (f.width as usize, f.height as usize);
+        let covered: Vec<(f32, f32)> = (0..w * h)
+            .filter(|&i| f.color[i].w > 0.5)
+            .map(|i| ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5))
+            .collect();
+        let (lo, hi) = covered.iter().fold(
+            (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN)),
+            |(lo, hi), &(x, y)| (lo.min(glam::Vec2::new(x, y)), hi.max(glam::Vec2::new(x, y))),
+        );
+        let (c, r) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+        let inside = |x: f32, y: f32| (glam::Vec2::new(x, y) - c).length() < 0.95 * r;
+        let disc = (0..w * h)
+            .filter(|&i| inside((i % w) as f32 + 0.5, (i / w) as f32 + 0.5))
+            .count();
+        let hit = covered.iter().filter(|&&(x, y)| inside(x, y)).count();
+        hit as f32 / disc as f32
+    };
+    std::fs::write(dir.join("scan.ply"), &ply).unwrap();
+    for model in ["scan.obj", "scan.ply"] {
+        let scene = scene_in(&dir, &toml(model, ""), &[("scan.obj", &obj)]);
+        assert!(scene.models[0].mesh.triangles.is_empty());
+        assert_eq!(scene.models[0].mesh.points.len(), n);
+        let closed = fill(&scene);
+        assert!(closed > 0.88, "{model}: {closed}");
+    }
+    let thin = scene_in(&dir, &toml("scan.obj", "point_size = 1.0"), &[]);
+    let open = fill(&thin);
+    assert!(open < 0.5, "1-pixel points: {open}");
+}

@@ -3,14 +3,15 @@
 //! (nx ny nz), colours (red green blue, 0-255 or 0-1) and texture
 //! coordinates (s t, u v or texture_u texture_v); `face` elements with a
 //! `vertex_indices` (or `vertex_index`) list, polygons triangulated like
-//! OBJ faces. Meshes without normals get smooth ones.
+//! OBJ faces. Meshes without normals get smooth ones. A file with
+//! vertices and no faces (a scanner's point cloud) is drawn as points.
 
 use std::path::Path;
 
 use glam::{Vec2, Vec3, Vec4};
 use ply_rs_bw::ply::{DefaultElement, Property};
 
-use super::mesh::{Group, Mesh, smooth_normals};
+use super::mesh::{Group, Mesh, Primitive, smooth_normals};
 use super::obj::triangulate;
 use crate::color::srgb_to_linear;
 use crate::error::Error;
@@ -79,8 +80,17 @@ pub fn load(path: &Path, input: &super::input::Input) -> Result<Mesh, Error> {
             mesh.triangles.push(t.map(|k| idx[k] as u32));
         }
     }
+    if mesh.triangles.is_empty() && mesh.positions.is_empty() {
+        return Err(err("the model has no vertices".into()));
+    }
+    // A scan's point cloud (vertices, no faces): drawn as its points.
     if mesh.triangles.is_empty() {
-        return Err(err("the model has no faces (a point cloud?)".into()));
+        mesh.points = (0..mesh.positions.len() as u32)
+            .map(|v| Primitive {
+                vertices: [v],
+                material: 0,
+            })
+            .collect();
     }
     if !any_uv {
         mesh.uvs.clear();

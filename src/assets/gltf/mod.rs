@@ -95,6 +95,25 @@ pub struct GltfModel {
     pub rig: Option<Result<Arc<Rig>, String>>,
 }
 
+/// The top-level collections of a glTF file: arrays in 2.0, objects keyed
+/// by id in 1.0.
+const COLLECTIONS: [&str; 14] = [
+    "accessors",
+    "animations",
+    "bufferViews",
+    "buffers",
+    "cameras",
+    "images",
+    "materials",
+    "meshes",
+    "nodes",
+    "samplers",
+    "scenes",
+    "skins",
+    "textures",
+    "techniques",
+];
+
 /// The version of a glTF 1.x file (`asset.version` "1.0", or a binary
 /// glTF with container version 1), None for anything else.
 fn version_1(bytes: &[u8]) -> Option<String> {
@@ -106,9 +125,15 @@ fn version_1(bytes: &[u8]) -> Option<String> {
     let v = json.get("asset").and_then(|a| a.get("version"));
     match v {
         Some(serde_json::Value::String(s)) if s.starts_with("1.") => Some(s.clone()),
-        // 1.0 files may lack asset.version; their meshes, accessors and
-        // materials are objects keyed by id, not arrays.
-        None if json.get("meshes").is_some_and(|m| m.is_object()) => Some("1.0".into()),
+        // 1.0 files may lack asset.version; their top-level collections
+        // (meshes, accessors, nodes, ...) are objects keyed by id, not
+        // arrays.
+        None if COLLECTIONS
+            .iter()
+            .any(|k| json.get(k).is_some_and(|m| m.is_object())) =>
+        {
+            Some("1.0".into())
+        }
         _ => None,
     }
 }
@@ -118,6 +143,13 @@ fn version_1(bytes: &[u8]) -> Option<String> {
 pub fn load(path: &Path, input: &Input) -> Result<GltfModel, Error> {
     let bytes = input.read(path, None, None)?;
     let err = |msg: String| Error::asset(path, None, msg);
+    // A 1.0 file is named as one before its container is checked (a 1.0
+    // binary's header differs after the version).
+    if let Some(v) = version_1(&bytes) {
+        return Err(err(format!(
+            "glTF {v} is not supported; convert it to glTF 2.0 (e.g. with the Khronos glTF-Sample-Viewer's converter, `npx gltf-pipeline` from Cesium, or Blender's importer and exporter)"
+        )));
+    }
     if bytes.starts_with(b"glTF") && bytes.len() < 12 {
         return Err(err(format!(
             "truncated .glb: {} bytes, less than its 12-byte header",
@@ -138,11 +170,6 @@ pub fn load(path: &Path, input: &Input) -> Result<GltfModel, Error> {
                 bytes.len()
             )));
         }
-    }
-    if let Some(v) = version_1(&bytes) {
-        return Err(err(format!(
-            "glTF {v} is not supported; convert it to glTF 2.0 (e.g. with the Khronos glTF-Sample-Viewer's converter, `npx gltf-pipeline` from Cesium, or Blender's importer and exporter)"
-        )));
     }
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| err(format!("malformed glTF: {e}")))?;

@@ -93,7 +93,8 @@ pub struct ObjModel {
 pub fn load(path: &Path, input: &Input) -> Result<ObjModel, Error> {
     let text = input.read_text(path, None)?;
     let mut warnings = Vec::new();
-    let file = parse::parse(path, &text, &mut warnings)?;
+    let mut file = parse::parse(path, &text, &mut warnings)?;
+    points_of_bare_vertices(&mut file);
     let mut mats = libraries(&file, path, input, &mut warnings)?;
     let mut mesh = build_mesh(&file, &mut mats, path, &mut warnings);
     if mesh.triangles.is_empty() && mesh.lines.is_empty() && mesh.points.is_empty() {
@@ -275,6 +276,30 @@ fn build_mesh(
         }
     }
     b.mesh
+}
+
+/// A file of vertices alone (a scan's point cloud, `v x y z [r g b]`
+/// lines with no face, line or point) is drawn as its points: one `p`
+/// element naming every vertex.
+fn points_of_bare_vertices(f: &mut parse::ObjFile) {
+    if !(f.faces.is_empty() && f.lines.is_empty() && f.points.is_empty()) {
+        return;
+    }
+    let n = f.positions.len() as u32;
+    if n == 0 {
+        return;
+    }
+    let start = f.corners.len() as u32;
+    f.corners.extend((0..n).map(|v| parse::Corner {
+        v,
+        t: None,
+        n: None,
+    }));
+    f.points.push(parse::Face {
+        start,
+        len: n,
+        material: None,
+    });
 }
 
 /// Vertices of the mesh, one per distinct (position, uv, normal) corner.
