@@ -1,8 +1,8 @@
-//! What a light delivers to a shaded point: direction and irradiance (the
-//! inverse square law, KHR_lights_punctual's range window and spot cone),
-//! the loop over the lights that both shading models use, and which lights
-//! can reach a region at all (`may_reach`, `LightSet`: a band's tiles skip
-//! the lights that cannot reach them).
+//! What a light delivers to a point: direction and irradiance (the
+//! inverse square law, KHR_lights_punctual's range window and spot cone;
+//! the shading code's lane-wide form is `lanes::incidence`), and which
+//! lights can reach a region at all (`may_reach`, `LightSet`: a band's
+//! tiles skip the lights that cannot reach them).
 
 use glam::Vec3;
 
@@ -213,39 +213,6 @@ pub fn may_reach(light: &Light, lo: Vec3, hi: Vec3) -> bool {
         }
     }
     true
-}
-
-/// Calls `f(l, e)` for each light that reaches a point with unit normal `n`
-/// from its front side: the unit direction to it and the irradiance
-/// E * (n.l) times `shadow(i, l)`, the fraction of light `i` that is not
-/// blocked (asked only of lights with `shadows = true`). (A callback rather
-/// than an iterator: the iterator version did not inline and cost 12% of a
-/// frame.)
-#[inline(always)]
-pub fn for_each_lit(
-    lights: LightSet,
-    shadow: &impl Fn(usize, Vec3) -> f32,
-    p: Vec3,
-    n: Vec3,
-    mut f: impl FnMut(Vec3, Vec3),
-) {
-    lights.for_each(|i, light| {
-        let Some(inc) = incidence(light, p) else {
-            return;
-        };
-        let ndl = n.dot(inc.l);
-        if ndl > 0.0 {
-            let s = if light.shadows { shadow(i, inc.l) } else { 1.0 };
-            if s > 0.0 {
-                f(inc.l, inc.e * (ndl * s));
-            }
-        }
-    });
-}
-
-/// The `shadow` argument of `for_each_lit` when nothing casts shadows.
-pub fn unshadowed(_: usize, _: Vec3) -> f32 {
-    1.0
 }
 
 /// KHR_lights_punctual: t = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1),
