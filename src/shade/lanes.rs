@@ -19,7 +19,7 @@
 // Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::light::{LightMask, LightSet};
@@ -471,16 +471,21 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     fn rgba(&mut self, t: &TextureRef) -> Option<(V3<L>, L)> {
         let i = self.lm.index_of(t)?;
         let map = &self.lm.maps[i];
-        let c = self.lookups.coords;
-        let mut texels = [Vec4::ZERO; MAX_LANES];
-        for (k, o) in texels.iter_mut().enumerate().take(L::WIDTH) {
-            let uv = Vec2::new(c.u.lane(k), c.v.lane(k));
-            *o = map
+        let f = self.lookups.coords;
+        let mut rgba = [[Vec4::ZERO; 4]; 2];
+        for (q, out) in rgba.iter_mut().enumerate().take(L::QUADS) {
+            let fps = f.footprints4(map.slot, q);
+            *out = map
                 .chain
-                .sample1(uv, c.footprints[map.slot][c.first + k], map.mode);
+                .sample4_rgba(f.u.quad(q), f.v.quad(q), &fps, map.mode);
         }
-        let rgb = V3::from_fn(|k| texels[k].truncate());
-        Some((rgb, L::from_fn(|k| texels[k].w)))
+        let channel = |c: usize| L::from_quads(|q| rgba[q][c]);
+        let rgb = V3 {
+            x: channel(0),
+            y: channel(1),
+            z: channel(2),
+        };
+        Some((rgb, channel(3)))
     }
 
     #[inline(always)]

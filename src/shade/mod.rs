@@ -291,7 +291,7 @@ impl ShadeContext<'_> {
                 }
             };
             let mode = t.address.unwrap_or(self.address.into());
-            return Some(tex.sample_footprint(uv, fp, mode, f.mips));
+            return Some(tex.chain(f.mips).sample1(uv, fp, mode));
         }
         Some(t.sample_grad(uv, tc.grads[set], self.address, f))
     }

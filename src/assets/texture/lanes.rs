@@ -19,7 +19,7 @@
 
 use glam::{Vec2, Vec4};
 
-use super::{Footprint, Level, Texture, Wrap};
+use super::{ALPHA_TABLE, Footprint, Level, Texture, Wrap};
 use smallvec::SmallVec;
 
 use crate::color::srgb_to_linear_table;
@@ -27,6 +27,9 @@ use crate::simd::{block_steps4, lanes4, unit_bytes4, whole4};
 
 /// Red, green and blue of four lookups, one lane each.
 pub type Rgb4 = [Vec4; 3];
+
+/// Red, green, blue and alpha of four lookups, one lane each.
+pub type Rgba4 = [Vec4; 4];
 
 /// Where four trilinear lookups fall in any texture of one size and mip
 /// chain (`Texture::taps4`).
@@ -85,26 +88,16 @@ impl Texture {
             texels,
         }
     }
-
-    /// `sample_footprint(uv_k, fps[k], mode, mips)` for the four lanes k
-    /// of (`u`, `v`), red, green and blue.
-    pub fn sample_footprint4(
-        &self,
-        u: Vec4,
-        v: Vec4,
-        fps: &[Footprint; 4],
-        mode: Wrap,
-        mips: Option<&[Level]>,
-    ) -> Rgb4 {
-        self.chain(mips).sample4(u, v, fps, mode)
-    }
 }
 
 impl<'t> Chain<'t> {
-    /// `Texture::sample_footprint` (red, green, blue and alpha) of one
-    /// lookup in this chain.
+    /// One lookup at `uv` over `fp` in this chain (red, green, blue and
+    /// alpha): the four-lane lookup with every lane the same, its first
+    /// lane.
     pub fn sample1(&self, uv: Vec2, fp: Footprint, mode: Wrap) -> Vec4 {
-        self.texture.sample_footprint(uv, fp, mode, self.mips)
+        let (u, v) = (Vec4::splat(uv.x), Vec4::splat(uv.y));
+        let c = self.sample::<4>(u, v, &[fp; 4], mode);
+        Vec4::new(c[0].x, c[1].x, c[2].x, c[3].x)
     }
 
     /// The texture's size and number of levels: taps found in one chain
@@ -113,11 +106,29 @@ impl<'t> Chain<'t> {
         (self.texture.width, self.texture.height, self.texels.len())
     }
 
-    /// `Texture::sample_footprint4` in this chain.
+    /// Four lookups in this chain, lane k at (`u`, `v`) over `fps[k]`:
+    /// red, green and blue.
     pub fn sample4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgb4 {
+        self.sample::<3>(u, v, fps, mode)
+    }
+
+    /// `sample4` with alpha.
+    pub fn sample4_rgba(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgba4 {
+        self.sample::<4>(u, v, fps, mode)
+    }
+
+    /// The first `N` channels of four lookups.
+    #[inline]
+    fn sample<const N: usize>(
+        &self,
+        u: Vec4,
+        v: Vec4,
+        fps: &[Footprint; 4],
+        mode: Wrap,
+    ) -> [Vec4; N] {
         match self.taps4(u, v, fps) {
-            Some(taps) => self.read4(&taps, mode),
-            None => self.probes4(u, v, fps, mode),
+            Some(taps) => self.read(&taps, mode),
+            None => self.probes(u, v, fps, mode),
         }
     }
 
@@ -211,9 +222,15 @@ impl<'t> Chain<'t> {
     /// this texture: red, green and blue.
     #[inline]
     pub fn read4(&self, taps: &Taps4, mode: Wrap) -> Rgb4 {
+        self.read::<3>(taps, mode)
+    }
+
+    /// `read4` of the first `N` channels.
+    #[inline]
+    fn read<const N: usize>(&self, taps: &Taps4, mode: Wrap) -> [Vec4; N] {
         if taps.shape != self.shape() {
             // Taps of another shape: found again here.
-            return self.read4(&self.lod_taps4(taps.u, taps.v, taps.lod), mode);
+            return self.read(&self.lod_taps4(taps.u, taps.v, taps.lod), mode);
         }
         let a = self.bilinear4(&taps.near, taps.u, taps.v, mode);
         match &taps.far {
@@ -247,15 +264,11 @@ impl<'t> Chain<'t> {
         }
     }
 
-    /// `sample_lod(mips, uv_k, mode, lod[k])` for the four lanes.
-    fn sample_lod4(&self, u: Vec4, v: Vec4, lod: [f32; 4], mode: Wrap) -> Rgb4 {
-        self.read4(&self.lod_taps4(u, v, lod), mode)
-    }
-
-    /// `bilinear(level, uv_k, mode)` for the four lanes, each in its level
-    /// of `place`.
+    /// Bilinear lookups at (`u`, `v`) for the four lanes, each in its
+    /// level of `place`: the first `N` channels. The four texels are
+    /// decoded, then blended along x and then along y, a (1 - f) + b f.
     #[inline(always)]
-    fn bilinear4(&self, place: &Place4, u: Vec4, v: Vec4, mode: Wrap) -> Rgb4 {
+    fn bilinear4<const N: usize>(&self, place: &Place4, u: Vec4, v: Vec4, mode: Wrap) -> [Vec4; N] {
         // Corner j (top-left, top-right, bottom-left, bottom-right) of
         // lane k, as stored.
         let mut texels = [[0u32; 4]; 4];
@@ -283,12 +296,17 @@ impl<'t> Chain<'t> {
         }
         let (fx, fy) = (place.fx, place.fy);
         let (gx, gy) = (Vec4::ONE - fx, Vec4::ONE - fy);
-        let mut out = [Vec4::ZERO; 3];
-        // Channel by channel: its four corners decoded, then blended as
-        // `bilinear` blends them.
+        let mut out = [Vec4::ZERO; N];
+        // Channel by channel: its four corners decoded (`Texture::decode`),
+        // then blended.
         if self.texture.srgb {
-            let lut = srgb_to_linear_table();
             for (ch, o) in out.iter_mut().enumerate() {
+                // Color through the sRGB table, alpha as it is stored.
+                let lut = if ch < 3 {
+                    srgb_to_linear_table()
+                } else {
+                    &ALPHA_TABLE
+                };
                 let shift = 8 * ch as u32;
                 let a = srgb_channel4(lut, &texels[0], shift);
                 let b = srgb_channel4(lut, &texels[1], shift);
@@ -316,20 +334,27 @@ impl<'t> Chain<'t> {
                     let level = self.level(place.level[k]);
                     let uv = Vec2::new(u[k], v[k]);
                     let r = self.texture.bilinear_wrapped(level, uv, mode);
-                    out[0][k] = r.x;
-                    out[1][k] = r.y;
-                    out[2][k] = r.z;
+                    for (c, o) in out.iter_mut().enumerate() {
+                        o[k] = r[c];
+                    }
                 }
             }
         }
         out
     }
 
-    /// `sample_footprint` of four lanes of which some take anisotropic
-    /// probes: the probes' sum over their count per lane, a lane with
-    /// fewer probes adding nothing after its last (x + 0 = x); a `Lod`
-    /// lane is one probe at the point itself ((0 + x) / 1 = x).
-    fn probes4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgb4 {
+    /// Four lanes of which some take anisotropic probes: per lane, `n`
+    /// trilinear probes spread along the footprint's longer axis (at
+    /// (k + 1/2) / n - 1/2 of it), their sum over their count, a lane
+    /// with fewer probes adding nothing after its last (x + 0 = x); a
+    /// `Lod` lane is one probe at the point itself ((0 + x) / 1 = x).
+    fn probes<const N: usize>(
+        &self,
+        u: Vec4,
+        v: Vec4,
+        fps: &[Footprint; 4],
+        mode: Wrap,
+    ) -> [Vec4; N] {
         let mut n = [1u32; 4];
         let mut nf = [1.0f32; 4];
         let mut lod = [0.0f32; 4];
@@ -350,7 +375,7 @@ impl<'t> Chain<'t> {
             }
         }
         let probes = n.iter().copied().max().unwrap_or(1);
-        let mut sum = [Vec4::ZERO; 3];
+        let mut sum = [Vec4::ZERO; N];
         for p in 0..probes {
             let (mut pu, mut pv) = (u, v);
             let mut live = [0.0f32; 4];
@@ -365,14 +390,14 @@ impl<'t> Chain<'t> {
                     }
                 }
             }
-            let r = self.sample_lod4(pu, pv, lod, mode);
+            let r: [Vec4; N] = self.read(&self.lod_taps4(pu, pv, lod), mode);
             let live = Vec4::from(live).cmpgt(Vec4::ZERO);
-            for c in 0..3 {
+            for c in 0..N {
                 sum[c] += Vec4::select(live, r[c], Vec4::ZERO);
             }
         }
         let nf = Vec4::from(nf);
-        [sum[0] / nf, sum[1] / nf, sum[2] / nf]
+        sum.map(|s| s / nf)
     }
 }
 
@@ -472,13 +497,9 @@ fn prefetch_texel(t: &[u32], i: usize) {
 
 /// a (1 - f) + b f per channel, as `Vec4::lerp`.
 #[inline(always)]
-fn blend(a: Rgb4, b: Rgb4, f: Vec4) -> Rgb4 {
+fn blend<const N: usize>(a: [Vec4; N], b: [Vec4; N], f: Vec4) -> [Vec4; N] {
     let g = Vec4::ONE - f;
-    [
-        a[0] * g + b[0] * f,
-        a[1] * g + b[1] * f,
-        a[2] * g + b[2] * f,
-    ]
+    std::array::from_fn(|c| a[c] * g + b[c] * f)
 }
 
 /// Channel `shift / 8` of four stored sRGB texels (one per lane),
@@ -512,11 +533,62 @@ mod tests {
         Texture::from_rgba8(w, h, texels, srgb)
     }
 
-    /// Every lane equals the one-lookup function's answer bit for bit,
-    /// inside the image, across its edges (address modes), between
-    /// levels and with anisotropic probes of different counts per lane.
+    /// Bilinear filtering as the GL specification states it, texel by
+    /// texel: inside the image the four texels around `uv` blended along
+    /// x, then y; across an edge the address mode's general path.
+    fn bilinear(t: &Texture, l: &Level, uv: Vec2, mode: Wrap) -> Vec4 {
+        let x = uv.x * l.width as f32 - 0.5;
+        let y = uv.y * l.height as f32 - 0.5;
+        if !(x >= 0.0 && y >= 0.0 && x < (l.width - 1) as f32 && y < (l.height - 1) as f32) {
+            return t.bilinear_wrapped(l, uv, mode);
+        }
+        let (x0, y0) = (x as u32, y as u32);
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let at = |dx: u32, dy: u32| t.decode(l.texel(x0 + dx, y0 + dy));
+        let top = at(0, 0).lerp(at(1, 0), fx);
+        let bottom = at(0, 1).lerp(at(1, 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// Trilinear filtering: level floor(lod), blended with the next by
+    /// lod's fraction; level 0 for lod <= 0 or without a chain.
+    fn trilinear(t: &Texture, mips: Option<&[Level]>, uv: Vec2, mode: Wrap, lod: f32) -> Vec4 {
+        let Some(mips) = mips.filter(|_| lod > 0.0) else {
+            return bilinear(t, &t.base, uv, mode);
+        };
+        let lod = lod.min(mips.len() as f32);
+        let i = lod.floor() as usize;
+        let f = lod - i as f32;
+        let level = |k: usize| if k == 0 { &t.base } else { &mips[k - 1] };
+        let a = bilinear(t, level(i), uv, mode);
+        if f <= 0.0 || i + 1 > mips.len() {
+            return a;
+        }
+        a.lerp(bilinear(t, level(i + 1), uv, mode), f)
+    }
+
+    /// A footprint's lookup: one trilinear probe, or the mean of `n`
+    /// spread along its axis.
+    fn reference(t: &Texture, mips: Option<&[Level]>, uv: Vec2, fp: Footprint, mode: Wrap) -> Vec4 {
+        match fp {
+            Footprint::Lod(lod) => trilinear(t, mips, uv, mode, lod),
+            Footprint::Probes { n, lod, axis } => {
+                let mut sum = Vec4::ZERO;
+                for k in 0..n as u32 {
+                    let s = (k as f32 + 0.5) / n - 0.5;
+                    sum += trilinear(t, mips, uv + axis * s, mode, lod);
+                }
+                sum / n
+            }
+        }
+    }
+
+    /// Every lane, and every lone lookup, equals the texel-by-texel
+    /// reference bit for bit in all four channels: inside the image,
+    /// across its edges (address modes), between levels and with
+    /// anisotropic probes of different counts per lane.
     #[test]
-    fn four_lanes_equal_four_single_lookups() {
+    fn lanes_equal_texel_by_texel_filtering() {
         for srgb in [false, true] {
             let t = noise(37, 20, srgb);
             let chain = build_chain(&t);
@@ -572,19 +644,22 @@ mod tests {
                         } else {
                             Some(&chain[..])
                         };
+                        let mode = Wrap::from(mode);
+                        let lanes = t.chain(mips);
                         let u = Vec4::from(uv.map(|p| p.x));
                         let v = Vec4::from(uv.map(|p| p.y));
-                        let got = t.sample_footprint4(u, v, &fps, mode.into(), mips);
+                        let got = lanes.sample4_rgba(u, v, &fps, mode);
+                        let rgb = lanes.sample4(u, v, &fps, mode);
                         for k in 0..4 {
-                            let want = t.sample_footprint(uv[k], fps[k], mode.into(), mips);
-                            for c in 0..3 {
-                                assert_eq!(
-                                    got[c][k].to_bits(),
-                                    want[c].to_bits(),
-                                    "lane {k} channel {c}: {:?} {:?} {mode:?} {filter:?}",
-                                    uv[k],
-                                    fps[k]
-                                );
+                            let want = reference(&t, mips, uv[k], fps[k], mode);
+                            let one = lanes.sample1(uv[k], fps[k], mode);
+                            for c in 0..4 {
+                                let why = format!("lane {k} channel {c}: {:?} {:?}", uv[k], fps[k]);
+                                assert_eq!(got[c][k].to_bits(), want[c].to_bits(), "{why}");
+                                assert_eq!(one[c].to_bits(), want[c].to_bits(), "{why}");
+                                if c < 3 {
+                                    assert_eq!(rgb[c][k].to_bits(), want[c].to_bits(), "{why}");
+                                }
                             }
                         }
                     }

@@ -103,38 +103,6 @@ fn decode_data(t: [u8; 4]) -> Vec4 {
     }
 }
 
-/// Four data texels as `decode_data` gives them, widened together.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn decode_data4(t: [[u8; 4]; 4]) -> [Vec4; 4] {
-    use std::arch::x86_64::*;
-    // SAFETY: as in `decode_data` (SSE2 only, no memory access).
-    unsafe {
-        let zero = _mm_setzero_si128();
-        let v = _mm_set_epi32(
-            i32::from_le_bytes(t[3]),
-            i32::from_le_bytes(t[2]),
-            i32::from_le_bytes(t[1]),
-            i32::from_le_bytes(t[0]),
-        );
-        let (lo, hi) = (_mm_unpacklo_epi8(v, zero), _mm_unpackhi_epi8(v, zero));
-        let k = _mm_set1_ps(1.0 / 255.0);
-        let f = |w: __m128i| Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(w), k));
-        [
-            f(_mm_unpacklo_epi16(lo, zero)),
-            f(_mm_unpackhi_epi16(lo, zero)),
-            f(_mm_unpacklo_epi16(hi, zero)),
-            f(_mm_unpackhi_epi16(hi, zero)),
-        ]
-    }
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-fn decode_data4(t: [[u8; 4]; 4]) -> [Vec4; 4] {
-    t.map(decode_data)
-}
-
 #[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
 fn decode_data(t: [u8; 4]) -> Vec4 {
@@ -142,7 +110,7 @@ fn decode_data(t: [u8; 4]) -> Vec4 {
 }
 
 /// Byte -> byte / 255 as `b as f32 / 255.0` (the alpha of color maps).
-static ALPHA_TABLE: [f32; 256] = {
+pub(crate) static ALPHA_TABLE: [f32; 256] = {
     let mut t = [0.0f32; 256];
     let mut i = 0;
     while i < 256 {
@@ -263,26 +231,6 @@ impl Level {
     pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
         let i = self.index(x, y);
         self.blocks[i >> 4].0[i & 15]
-    }
-
-    /// Texels (x, y), (x + 1, y), (x, y + 1) and (x + 1, y + 1), for
-    /// x + 1 < width and y + 1 < height: one address, then the steps to
-    /// the neighbours (within a block, or across to the next one).
-    #[inline(always)]
-    fn footprint(&self, x: u32, y: u32) -> [[u8; 4]; 4] {
-        let i = self.index(x, y);
-        // Along x: the next texel of the row, or the first of the block
-        // to the right (16 texels on, 3 back).
-        let dx = if x & 3 == 3 { 13 } else { 1 };
-        // Along y: the next row of the block, or the first row of the
-        // block below (a row of blocks on, 12 back).
-        let dy = if y & 3 == 3 {
-            (self.blocks_x as usize) * 16 - 12
-        } else {
-            4
-        };
-        let t = |i: usize| self.blocks[i >> 4].0[i & 15];
-        [t(i), t(i + dx), t(i + dy), t(i + dx + dy)]
     }
 }
 
@@ -564,56 +512,8 @@ impl Texture {
     /// Bilinear lookup in level 0.
     #[inline]
     pub fn sample_bilinear(&self, uv: Vec2, mode: impl Into<Wrap>) -> Vec4 {
-        self.bilinear(&self.base, uv, mode.into())
-    }
-
-    /// Bilinear lookup: the four texels around `uv`, weighted in linear space.
-    /// Always inlined: its callers (trilinear's two levels, anisotropic
-    /// probes) then schedule the levels' loads together (9% of a
-    /// diablo3-matched frame; the same arithmetic, frames byte-identical).
-    #[inline(always)]
-    pub fn bilinear(&self, l: &Level, uv: Vec2, mode: Wrap) -> Vec4 {
-        // Fast path: all four texels inside the image, so no address mode
-        // applies (the case for almost every lookup of a model's own UVs).
-        let x = uv.x * l.width as f32 - 0.5;
-        let y = uv.y * l.height as f32 - 0.5;
-        if x >= 0.0 && y >= 0.0 && x < (l.width - 1) as f32 && y < (l.height - 1) as f32 {
-            let (x0, y0) = (x as u32, y as u32);
-            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-            let [a, b, c, d] = self.decode4(l.footprint(x0, y0));
-            let top = a.lerp(b, fx);
-            let bottom = c.lerp(d, fx);
-            return top.lerp(bottom, fy);
-        }
-        self.bilinear_wrapped(l, uv, mode)
-    }
-
-    /// Trilinear lookup at level of detail `lod` in the chain whose levels
-    /// 1.. are `mips` (clamped to the chain; level 0 only without one).
-    pub fn sample_lod(
-        &self,
-        mips: Option<&[Level]>,
-        uv: Vec2,
-        mode: impl Into<Wrap>,
-        lod: f32,
-    ) -> Vec4 {
-        let mode = mode.into();
-        let Some(mips) = mips.filter(|_| lod > 0.0) else {
-            return self.bilinear(&self.base, uv, mode);
-        };
-        let top = mips.len() as f32;
-        let lod = lod.min(top);
-        // lod is in (0, top] here: truncation is floor (and needs no
-        // library call).
-        let i = lod as u32 as f32;
-        let f = lod - i;
-        let i = i as usize;
-        let level = |k: usize| if k == 0 { &self.base } else { &mips[k - 1] };
-        let a = self.bilinear(level(i), uv, mode);
-        if f <= 0.0 || i + 1 > mips.len() {
-            return a;
-        }
-        a.lerp(self.bilinear(level(i + 1), uv, mode), f)
+        self.chain(None)
+            .sample1(uv, Footprint::Lod(0.0), mode.into())
     }
 
     /// Filtered lookup with screen-space derivatives: nearest and bilinear
@@ -626,7 +526,7 @@ impl Texture {
             TextureFilter::Nearest => self.sample_nearest(uv, mode),
             TextureFilter::Bilinear => self.sample_bilinear(uv, mode),
             _ if f.mips.is_none() => self.sample_bilinear(uv, mode),
-            _ => self.sample_footprint(uv, self.footprint(g, &f), mode, f.mips),
+            _ => self.chain(f.mips).sample1(uv, self.footprint(g, &f), mode),
         }
     }
 
@@ -665,44 +565,6 @@ impl Texture {
             n,
             lod: lod_of(major / n),
             axis,
-        }
-    }
-
-    /// A lookup at `uv` over `footprint` in the chain whose levels 1..
-    /// are `mips`.
-    #[inline]
-    pub fn sample_footprint(
-        &self,
-        uv: Vec2,
-        footprint: Footprint,
-        mode: Wrap,
-        mips: Option<&[Level]>,
-    ) -> Vec4 {
-        match footprint {
-            Footprint::Lod(lod) => self.sample_lod(mips, uv, mode, lod),
-            Footprint::Probes { n, lod, axis } => {
-                let mut sum = Vec4::ZERO;
-                for k in 0..n as u32 {
-                    let t = (k as f32 + 0.5) / n - 0.5;
-                    sum += self.sample_lod(mips, uv + axis * t, mode, lod);
-                }
-                sum / n
-            }
-        }
-    }
-
-    /// Four texels as `decode` gives them.
-    #[inline(always)]
-    fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
-        if self.srgb {
-            [
-                self.decode(t[0]),
-                self.decode(t[1]),
-                self.decode(t[2]),
-                self.decode(t[3]),
-            ]
-        } else {
-            decode_data4(t)
         }
     }
 
