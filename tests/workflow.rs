@@ -472,3 +472,189 @@ fn review_report_lists_failures_first_and_update_blesses_them() {
     let (code, out, err) = args(&[]);
     assert_eq!(code, 0, "{out}{err}");
 }
+
+/// `softraster render` with `args`, outside any Slurm array unless `env`
+/// says so: (exit status, stdout, stderr).
+fn render_many(args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_softraster"));
+    c.arg("render").args(args);
+    for v in [
+        "SLURM_ARRAY_TASK_ID",
+        "SLURM_ARRAY_TASK_MIN",
+        "SLURM_ARRAY_TASK_COUNT",
+    ] {
+        c.env_remove(v);
+    }
+    c.envs(env.iter().copied());
+    let out = c.output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The JSON lines of `stdout` whose event is `event`.
+fn events(stdout: &str, event: &str) -> Vec<serde_json::Value> {
+    stdout
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|v| v["event"] == event)
+        .collect()
+}
+
+/// A folder of two good models, a bad one and a file that is no model,
+/// rendered in one run: each good input's frame in its folder (the same
+/// bytes as rendering it alone), the bad one reported without stopping
+/// the others, a summary, exit 1; then resumed, sharded (by flag and by
+/// Slurm's variables) and listed.
+#[test]
+fn a_folder_of_models_in_one_run() {
+    let dir = common::scratch("many_inputs");
+    let lib = dir.join("lib");
+    std::fs::create_dir_all(lib.join("sub")).unwrap();
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(lib.join("a.obj"), tri).unwrap();
+    std::fs::write(lib.join("sub/b.obj"), format!("{tri}v 1 1 0\nf 2 4 3\n")).unwrap();
+    std::fs::write(lib.join("sub/bad.obj"), "v 0 0 0\nf 1 2 9\n").unwrap();
+    std::fs::write(lib.join("notes.txt"), "not a model").unwrap();
+    let out = dir.join("out");
+    let small = ["--set", "output.width=40", "--set", "output.height=30"];
+    let (lib_s, out_s) = (lib.to_str().unwrap(), out.to_str().unwrap());
+    let args = |extra: &[&str]| -> Vec<String> {
+        [lib_s, "--out", out_s, "--progress", "json"]
+            .iter()
+            .chain(&small)
+            .chain(extra)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let run = |extra: &[&str], env: &[(&str, &str)]| {
+        let a = args(extra);
+        render_many(&a.iter().map(String::as_str).collect::<Vec<_>>(), env)
+    };
+    let (code, stdout, stderr) = run(&[], &[]);
+    assert_eq!(code, 1, "{stderr}");
+    let inputs = events(&stdout, "input");
+    let status: Vec<_> = inputs
+        .iter()
+        .map(|v| (v["path"].as_str().unwrap().to_string(), v["status"].clone()))
+        .collect();
+    let at = |p: &str| lib.join(p).to_string_lossy().into_owned();
+    assert_eq!(
+        status,
+        [
+            (at("a.obj"), "rendered".into()),
+            (at("sub/b.obj"), "rendered".into()),
+            (at("sub/bad.obj"), "failed".into()),
+        ]
+    );
+    assert!(inputs[2]["message"].as_str().unwrap().contains("bad.obj:2"));
+    assert_eq!(inputs[0]["frames"], 1);
+    let summary = events(&stdout, "summary");
+    assert_eq!(
+        (&summary[0]["rendered"], &summary[0]["failed"]),
+        (&2.into(), &1.into())
+    );
+    assert!(stderr.contains("bad.obj:2"), "{stderr}");
+    assert!(out.join("a/camera_0000.png").is_file());
+    assert!(!out.join("sub/bad").join("camera_0000.png").exists());
+    // The second input (its studio lighting found, not made) is the same
+    // bytes as when rendered alone.
+    let alone = dir.join("alone");
+    let b = lib.join("sub/b.obj");
+    let one = [
+        b.to_str().unwrap(),
+        "--out",
+        alone.to_str().unwrap(),
+        "--quiet",
+    ];
+    let (code, _, stderr) = render_many(&[&one[..], &small[..]].concat(), &[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(
+        std::fs::read(alone.join("camera_0000.png")).unwrap(),
+        std::fs::read(out.join("sub/b/camera_0000.png")).unwrap()
+    );
+    // Resumed: nothing rendered again.
+    let (_, stdout, _) = run(&["--skip-existing"], &[]);
+    assert!(
+        events(&stdout, "frame")
+            .iter()
+            .all(|f| f["skipped"] == true)
+    );
+    // Shards: by flag, and from a Slurm array task's variables.
+    let paths = |stdout: &str| -> Vec<String> {
+        events(stdout, "input")
+            .iter()
+            .map(|v| v["path"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let (code, stdout, _) = run(&["--shard", "1/2"], &[]);
+    assert_eq!((code, paths(&stdout)), (0, vec![at("sub/b.obj")]));
+    let slurm = [
+        ("SLURM_ARRAY_TASK_ID", "7"),
+        ("SLURM_ARRAY_TASK_MIN", "5"),
+        ("SLURM_ARRAY_TASK_COUNT", "3"),
+    ];
+    let (code, stdout, _) = run(&[], &slurm);
+    assert_eq!((code, paths(&stdout)), (1, vec![at("sub/bad.obj")]));
+    // A list: files named by it go to OUT/<stem>/.
+    let list = dir.join("list.txt");
+    std::fs::write(
+        &list,
+        format!("# two models\n{}\n\n{}\n", at("a.obj"), at("sub/b.obj")),
+    )
+    .unwrap();
+    let listed = dir.join("listed");
+    let (code, _, stderr) = render_many(
+        &[
+            &[
+                "--list",
+                list.to_str().unwrap(),
+                "--out",
+                listed.to_str().unwrap(),
+            ][..],
+            &small[..],
+        ]
+        .concat(),
+        &[],
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        listed.join("a/camera_0000.png").is_file() && listed.join("b/camera_0000.png").is_file()
+    );
+}
+
+/// Inputs that cannot be rendered at all are bad arguments: exit 2 with
+/// a message, before anything renders.
+#[test]
+fn bad_input_lists_are_refused() {
+    let dir = common::scratch("many_inputs_bad");
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(empty.join("deeper")).unwrap();
+    std::fs::write(empty.join("deeper/readme.txt"), "").unwrap();
+    let model = dir.join("m.obj");
+    std::fs::write(&model, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let list = dir.join("list.txt");
+    std::fs::write(
+        &list,
+        format!("{}\n{}\n", model.display(), dir.join("gone.obj").display()),
+    )
+    .unwrap();
+    let m = model.to_str().unwrap();
+    for (args, says) in [
+        (vec![empty.to_str().unwrap()], "no file softraster reads"),
+        (vec!["--list", list.to_str().unwrap()], "list.txt:2"),
+        (vec![m, "--shard", "3/2"], "--shard"),
+        (vec![m, "--shard", "0/0"], "--shard"),
+        (
+            vec![dir.join("nothing").to_str().unwrap()],
+            "no such file or folder",
+        ),
+        (vec![], "no input"),
+    ] {
+        let (code, _, stderr) = render_many(&args, &[]);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}

@@ -79,7 +79,17 @@ impl EnvImage {
     /// model, above (2), and a top light (0.75): a white Lambertian
     /// surface facing the key reflects about 0.9. Soft edges everywhere: no
     /// texel-sharp step for the prefilter to ring on.
-    pub fn studio() -> EnvImage {
+    ///
+    /// Made once per process: every scene of the default look shares it.
+    pub fn studio() -> std::sync::Arc<EnvImage> {
+        static STUDIO: std::sync::OnceLock<std::sync::Arc<EnvImage>> = std::sync::OnceLock::new();
+        STUDIO
+            .get_or_init(|| std::sync::Arc::new(EnvImage::make_studio()))
+            .clone()
+    }
+
+    /// `studio`, made.
+    fn make_studio() -> EnvImage {
         let (w, h) = (512u32, 256u32);
         // (toward the panel, angular radius, softness, radiance); the
         // camera looks down -Z from +Z, so "front" is +Z.

@@ -26,6 +26,7 @@ mod ao_pass;
 mod backdrop;
 mod band;
 pub mod display;
+mod env_cache;
 mod exposure;
 mod fragment;
 mod frame;
@@ -90,7 +91,7 @@ pub struct Renderer {
     /// The environment's intensity and rotation its lighting is built with.
     /// The environment's intensity, rotation and prefilter size.
     env_params: Option<(f32, f32, u32)>,
-    env: OnceLock<Option<EnvLight>>,
+    env: OnceLock<Option<Arc<EnvLight>>>,
     /// `method = "sampled"`: the environment's sampling tables.
     env_sampler: OnceLock<Option<EnvSampler>>,
     /// The last frame's shadow maps (reused while nothing they depend on
@@ -306,8 +307,9 @@ impl Renderer {
                 .all(|(a, b)| Arc::ptr_eq(a, b))
     }
 
-    /// The environment's lighting, prefiltered once per scene (its
-    /// intensity and rotation are taken from the first frame's scene).
+    /// The environment's lighting, prefiltered once per process
+    /// (`env_cache`; its intensity and rotation are taken from the first
+    /// frame's scene).
     fn env_light(&self, scene: &Scene) -> Option<&EnvLight> {
         self.env
             .get_or_init(|| {
@@ -320,12 +322,10 @@ impl Renderer {
                     .flat_map(|m| &m.materials)
                     .filter(|m| (all || m.native == Native::BlinnPhong) && m.illum > 0)
                     .map(|m| roughness_from_ns(m.ns));
-                Some(
-                    EnvLight::with_size(&e.image, e.intensity, e.rotation, e.prefilter_size)
-                        .with_phong_roughness(phong),
-                )
+                let params = (e.intensity, e.rotation, e.prefilter_size);
+                Some(env_cache::env_light(&e.image, params, phong.collect()))
             })
-            .as_ref()
+            .as_deref()
     }
 
     /// `method = "sampled"`: the sampling tables (built once) and the

@@ -260,7 +260,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         }
         None if default_look => Some(Environment {
             method: EnvMethod::Prefiltered,
-            image: Arc::new(EnvImage::studio()),
+            image: EnvImage::studio(),
             intensity: 1.0,
             rotation: 0.0,
             prefilter_size: DEFAULT_PREFILTER_SIZE,
@@ -451,9 +451,9 @@ fn environment(
                     ),
                 ));
             }
-            EnvImage::load(&path, input)?
+            Arc::new(EnvImage::load(&path, input)?)
         }
-        (None, Some(desc::EnvPreset::Neutral)) => EnvImage::uniform(glam::Vec3::ONE),
+        (None, Some(desc::EnvPreset::Neutral)) => Arc::new(EnvImage::uniform(glam::Vec3::ONE)),
         // Validation leaves only the studio here.
         (None, _) => EnvImage::studio(),
     };
@@ -467,27 +467,29 @@ fn environment(
     // `sun = true`: the brightest region becomes a shadow-casting light
     // (turned and scaled like the image), and leaves the image.
     let sun = if get(&e.sun, false) {
-        image.extract_sun().map(|(direction, irradiance)| {
-            let world = glam::Mat3::from_rotation_y(rotation.to_radians()) * direction;
-            let e = irradiance * intensity;
-            let peak = e.max_element().max(1e-12);
-            super::Light {
-                kind: super::light::LightKind::Directional {
-                    direction: world.normalize(),
-                    irradiance: peak,
-                },
-                color: e / peak,
-                shadows: true,
-                range: None,
-            }
-        })
+        Arc::make_mut(&mut image)
+            .extract_sun()
+            .map(|(direction, irradiance)| {
+                let world = glam::Mat3::from_rotation_y(rotation.to_radians()) * direction;
+                let e = irradiance * intensity;
+                let peak = e.max_element().max(1e-12);
+                super::Light {
+                    kind: super::light::LightKind::Directional {
+                        direction: world.normalize(),
+                        irradiance: peak,
+                    },
+                    color: e / peak,
+                    shadows: true,
+                    range: None,
+                }
+            })
     } else {
         None
     };
     Ok((
         Environment {
             method,
-            image: Arc::new(image),
+            image,
             intensity,
             rotation,
             prefilter_size: get(&e.prefilter_size, DEFAULT_PREFILTER_SIZE as i64) as u32,

@@ -4,14 +4,14 @@
 //! binary and the tools (`bench`'s arguments) know about clap; the
 //! renderer library does not depend on it.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use softraster::batch::{
-    FrameDone, FramePlan, JobSummary, RenderJob, thread_pool, with_auto_exposure,
-};
+mod inputs;
+mod render;
+
+use softraster::batch::thread_pool;
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::build::LoadOptions;
@@ -53,10 +53,23 @@ enum Command {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// The scene file (TOML), or a model file to render as the one-line
-    /// scene that names it: .gltf, .glb, .obj, .stl or .ply.
-    scene: PathBuf,
-    /// Output directory; wins over `output.dir`.
+    /// Scene files (TOML), model files to render as the one-line scene
+    /// that names them (.gltf, .glb, .obj, .stl, .ply), or folders, read
+    /// recursively for those. One file: its frames go to `--out` (or
+    /// `output.dir`). Several inputs: each file's to `OUT/<stem>/`, each
+    /// found in a folder to `OUT/<path in the folder, no extension>/`.
+    inputs: Vec<PathBuf>,
+    /// A file of inputs, one path a line (`-`: stdin).
+    #[arg(long, value_name = "FILE")]
+    list: Option<PathBuf>,
+    /// Render only inputs I, I + N, I + 2N... of the sorted inputs (I
+    /// from 0 to N - 1). Without it, a Slurm array task takes its share
+    /// of several inputs (SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN of
+    /// SLURM_ARRAY_TASK_COUNT).
+    #[arg(long, value_name = "I/N")]
+    shard: Option<inputs::Shard>,
+    /// Output directory; wins over `output.dir`. With several inputs, the
+    /// root of their folders (default `out`).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Frames to render: `a..b` (half-open), `a-b` (inclusive), `n`, or a
@@ -216,7 +229,7 @@ pub fn main() -> i32 {
         }
     };
     let result = match cli.command {
-        Command::Render(args) => render(args),
+        Command::Render(args) => return render::run(args),
         Command::Gif(args) => gif(args),
         Command::Video(args) => video(args),
         Command::Chart(args) => chart(args),
@@ -227,14 +240,19 @@ pub fn main() -> i32 {
     match result {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {e}");
-            let mut source = std::error::Error::source(&e);
-            while let Some(s) = source {
-                eprintln!("  caused by: {s}");
-                source = s.source();
-            }
+            print_error(&e);
             e.exit_code()
         }
+    }
+}
+
+/// `error: ...` and its causes, on stderr.
+fn print_error(e: &Error) {
+    eprintln!("error: {e}");
+    let mut source = std::error::Error::source(e);
+    while let Some(s) = source {
+        eprintln!("  caused by: {s}");
+        source = s.source();
     }
 }
 
@@ -479,41 +497,6 @@ fn video(args: VideoArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// `--max-memory` (or `render.max_memory`, or by default what the
-/// machine has: the smaller of the memory available and the address-space
-/// limit, less headroom): the estimate against the limit, before the
-/// first frame.
-fn check_memory(scene: &Scene, flag: Option<u64>, args: &RenderArgs) -> Result<(), Error> {
-    let estimate = softraster::render::memory::estimate(scene, rayon::current_num_threads());
-    let (limit, what) = match (flag, scene.settings.max_memory) {
-        (Some(f), _) => (f, "--max-memory"),
-        (None, Some(s)) => (s, "render.max_memory"),
-        (None, None) => (
-            softraster::assets::input::default_budget(),
-            "the default budget (the memory available, or the address-space limit, less headroom; --max-memory sets it):",
-        ),
-    };
-    let chosen = flag.is_some() || scene.settings.max_memory.is_some();
-    if estimate.total() > limit {
-        return Err(Error::Argument(format!(
-            "{}: the render needs about {estimate}, more than {what} {}",
-            args.scene.display(),
-            softraster::render::memory::human(limit)
-        )));
-    }
-    if !chosen {
-        // Within the default: nothing to say.
-        return Ok(());
-    }
-    if !args.quiet {
-        eprintln!(
-            "memory: about {estimate}, within {what} {}",
-            softraster::render::memory::human(limit)
-        );
-    }
-    Ok(())
-}
-
 /// `--set` overrides (parsed) and `--out`, for loading a scene.
 fn load_options(
     sets: &[String],
@@ -534,168 +517,4 @@ fn load_options(
         max_memory: None,
         sandbox: false,
     })
-}
-
-fn render(args: RenderArgs) -> Result<(), Error> {
-    // --turntable N: two overrides before the user's own.
-    let sets: Vec<String> = args
-        .turntable
-        .map(|n| {
-            vec![
-                format!("animation.frames={n}"),
-                "animation.turntable.degrees=360".to_string(),
-            ]
-        })
-        .unwrap_or_default()
-        .into_iter()
-        .chain(args.sets.iter().cloned())
-        .collect();
-    let mut opts = load_options(&sets, args.out.clone(), args.strict, args.cache.clone())?;
-    opts.max_memory = args.max_memory;
-    opts.sandbox = args.sandbox;
-    let pool = thread_pool(args.threads)?;
-    pool.install(|| {
-        let t0 = std::time::Instant::now();
-        let scene = Scene::load(&args.scene, &opts)?;
-        let auto = scene.settings.auto_exposure;
-        let scene = with_auto_exposure(scene);
-        let load_s = t0.elapsed().as_secs_f64();
-        if auto && args.progress == Progress::Json {
-            let stops = scene.settings.exposure;
-            println!("{}", serde_json::json!({ "event": "exposure", "stops": stops }));
-        } else if auto && !args.quiet {
-            eprintln!("exposure: auto, {:+.2} stops", scene.settings.exposure);
-        }
-        // Warnings are shown with --quiet too: it silences progress only.
-        for w in &scene.warnings {
-            eprintln!("warning: {w}");
-        }
-        check_memory(&scene, args.max_memory, &args)?;
-        let plan = FramePlan::select(&scene, args.frames.as_deref(), args.camera.as_deref())?;
-        let job = RenderJob {
-            scene,
-            plan,
-            skip_existing: args.skip_existing,
-        };
-        if !args.quiet {
-            eprintln!(
-                "{}: {} triangles, {} frame(s) x {} camera(s) at {}x{}, loaded in {:.2} s, writing to {}",
-                args.scene.display(),
-                job.scene.triangle_count(),
-                job.plan.frames.len(),
-                job.plan.cameras.len(),
-                job.scene.settings.width,
-                job.scene.settings.height,
-                load_s,
-                job.scene.output.dir.display()
-            );
-        }
-        let t0 = std::time::Instant::now();
-        let report = Reporter::new(&args, job.plan.total());
-        let summary = job.run(|d| report.frame(d))?;
-        report.finish(&summary);
-        if !args.quiet {
-            eprintln!(
-                "done: {} frame(s) in {:.2} s",
-                job.plan.total(),
-                t0.elapsed().as_secs_f64()
-            );
-        }
-        Ok(())
-    })
-}
-
-/// How `render` reports progress: JSON lines on stdout, a bar on a
-/// terminal, a line per frame otherwise, or nothing (`--quiet`).
-struct Reporter {
-    json: bool,
-    quiet: bool,
-    bar: Option<indicatif::ProgressBar>,
-}
-
-impl Reporter {
-    fn new(args: &RenderArgs, total: usize) -> Reporter {
-        let json = args.progress == Progress::Json;
-        let bar = (!args.quiet && !json && std::io::stderr().is_terminal()).then(|| {
-            let b = indicatif::ProgressBar::new(total as u64);
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} frames  {elapsed_precise} (eta {eta})  {msg}",
-                )
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            b
-        });
-        Reporter {
-            json,
-            quiet: args.quiet,
-            bar,
-        }
-    }
-
-    fn frame(&self, d: &FrameDone) {
-        if self.json {
-            let line = serde_json::json!({
-                "event": "frame",
-                "frame": d.frame,
-                "camera": d.camera,
-                "files": d.files,
-                "seconds": d.render_seconds,
-                "skipped": d.skipped,
-            });
-            println!("{line}");
-        } else if let Some(b) = &self.bar {
-            b.set_message(format!("{:.1} ms/frame", d.render_seconds * 1e3));
-            b.inc(1);
-        } else if !self.quiet {
-            let files: Vec<_> = d.files.iter().map(|f| f.display().to_string()).collect();
-            if d.skipped {
-                eprintln!(
-                    "frame {} camera {}: exists, skipped ({})",
-                    d.frame,
-                    d.camera,
-                    files.join(", ")
-                );
-            } else {
-                eprintln!(
-                    "frame {} camera {}: {:.1} ms -> {}",
-                    d.frame,
-                    d.camera,
-                    d.render_seconds * 1e3,
-                    files.join(", ")
-                );
-            }
-        }
-    }
-
-    fn finish(&self, summary: &JobSummary) {
-        if let Some(b) = &self.bar {
-            b.finish();
-            // indicatif leaves the cursor at the end of the bar's line
-            // (padded to the terminal's width): end it, so the next line
-            // starts on its own.
-            eprintln!();
-        }
-        for g in &summary.gifs {
-            if self.json {
-                println!("{}", serde_json::json!({ "event": "gif", "file": g }));
-            } else if !self.quiet {
-                eprintln!("gif: {}", g.display());
-            }
-        }
-        for v in &summary.videos {
-            if self.json {
-                println!("{}", serde_json::json!({ "event": "video", "file": v }));
-            } else if !self.quiet {
-                eprintln!("video: {}", v.display());
-            }
-        }
-        // Why a GIF or video was not written: shown with --quiet too.
-        for why in [&summary.gif_skipped, &summary.video_skipped]
-            .into_iter()
-            .flatten()
-        {
-            eprintln!("note: {why}");
-        }
-    }
 }
