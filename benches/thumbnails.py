@@ -153,12 +153,22 @@ def run_softraster(bin, lib, out, size, rss):
 
 
 def run_f3d(files, out, size):
+    """f3d 4's Python module (`pip install f3d`; its wheel has no command
+    line): one offscreen engine for every file, each file cleared, loaded,
+    rendered and saved; per-file seconds."""
+    import f3d
+
+    engine = f3d.Engine.create(True)
+    engine.window.size = (size, size)
     times = []
     for k, f in enumerate(files):
         t0 = time.time()
-        subprocess.run(["f3d", f, "--output", os.path.join(out, "%05d.png" % k),
-                        "--resolution", "%d,%d" % (size, size)],
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            engine.scene.clear()
+            engine.scene.add(f)
+            engine.window.render_to_image().save(os.path.join(out, "%05d.png" % k))
+        except Exception as e:  # f3d refuses some files; count its time
+            print("f3d: %s: %s" % (f, e), file=sys.stderr)
         times.append(time.time() - t0)
     return times
 
@@ -172,6 +182,7 @@ def main():
     ap.add_argument("--f3d", action="store_true", help="also time f3d, one process per file")
     ap.add_argument("--rss", action="store_true", help="sample resident memory every second")
     ap.add_argument("--bin", default=os.path.join(ROOT, "target", "release", "softraster"))
+    ap.add_argument("--keep", metavar="DIR", help="write the thumbnails to DIR and keep them")
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="thumbs-")
     try:
@@ -179,7 +190,8 @@ def main():
         os.makedirs(lib)
         make_library(lib, a.count, not a.no_repo, a.shared)
         files = model_files(lib)
-        wall, inputs, samples, code = run_softraster(a.bin, lib, os.path.join(work, "out"), a.size, a.rss)
+        out = a.keep or os.path.join(work, "out")
+        wall, inputs, samples, code = run_softraster(a.bin, lib, out, a.size, a.rss)
         secs = [i["seconds"] for i in inputs]
         status = {}
         for i in inputs:
@@ -196,7 +208,9 @@ def main():
             step = max(1, len(samples) // 12)
             print("  resident memory (s: MiB): " + ", ".join("%.0f: %.0f" % s for s in samples[::step] + samples[-1:]))
         if a.f3d:
-            if shutil.which("f3d") is None:
+            try:
+                import f3d  # noqa: F401
+            except ImportError:
                 print("f3d: not installed (pip install f3d)")
             else:
                 out = os.path.join(work, "f3d")

@@ -1,5 +1,5 @@
 //! Fitted cameras (version 2): cameras without eye and target fill the
-//! frame with the models (a 5% margin), centred, over every frame of a
+//! frame with the models (85% of it), centred, over every frame of a
 //! turntable, and see a flat scene from above.
 
 mod common;
@@ -67,12 +67,18 @@ fn fitted_cameras_fill_the_frame_with_a_margin_over_a_turntable() {
             );
             widest = (widest.0.max(x1 - x0 + 1), widest.1.max(y1 - y0 + 1));
         }
-        // At least 65% of the width or height is covered (the fit's 95%
+        // At least 60% of the width or height is covered (the fit's 85%
         // on the binding axis, less the perspective of a turning model).
         let fill = (widest.0 as f32 / 160.0).max(widest.1 as f32 / 120.0);
-        assert!(fill >= 0.65, "{name} ({frames} frames): {fill}");
+        assert!(fill >= 0.6, "{name} ({frames} frames): {fill}");
         if frames == 1 {
-            assert!(fill >= 0.9, "{name}: {fill}");
+            // One view: 80-90% of the frame in the larger direction, and
+            // room below for the contact shadow (at least 3% of the
+            // height).
+            let (_, _, _, y1) = covered(&render_frame(&s, 0, 0));
+            let below = (119 - y1) as f32 / 120.0;
+            assert!((0.8..=0.9).contains(&fill), "{name}: {fill}");
+            assert!(below >= 0.03, "{name}: {below} below");
         }
     }
 }
@@ -96,7 +102,8 @@ fn a_flat_scene_is_seen_from_above() {
     assert!((down - 20f32.to_radians().cos()).abs() < 1e-3, "{down}");
     let f = render_frame(&s, 0, 0);
     let (x0, y0, x1, y1) = covered(&f);
-    assert!((x1 - x0 + 1).max(y1 - y0 + 1) >= 90, "{x0} {y0} {x1} {y1}");
+    let span = (x1 - x0 + 1).max(y1 - y0 + 1);
+    assert!((80..=90).contains(&span), "{x0} {y0} {x1} {y1}");
     // Elevation and azimuth are keys of a fitted camera.
     let s = scene_in(
         &dir,

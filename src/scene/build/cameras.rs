@@ -6,7 +6,7 @@
 //! A camera without `eye` and `target` (and the default camera) fits the
 //! models tightly (version 2): seen from `elevation` degrees above the
 //! horizon (default 20) and `azimuth` degrees about +Y (0: from +Z), the
-//! models' vertices, as every frame of a turntable places them, fill 95%
+//! models' vertices, as every frame of a turntable places them, fill 85%
 //! of the frame's width or height, centred. A model thin along one axis
 //! (under a tenth of its largest extent) is seen along that axis, tilted by
 //! the elevation, never edge-on.
@@ -26,7 +26,7 @@ use crate::scene::desc::{self, Ctx, S, SceneDesc};
 /// The default elevation of fitted cameras, degrees above the horizon.
 const ELEVATION: f32 = 20.0;
 /// The share of the frame's width or height the fitted models fill.
-const FILL: f32 = 0.95;
+const FILL: f32 = 0.85;
 /// Vertices a fit projects at most, per turntable angle.
 const FIT_POINTS: usize = 20_000;
 /// Turntable angles a fit covers at most.
