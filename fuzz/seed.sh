@@ -5,7 +5,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 corpus="$root/fuzz/corpus"
-mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture,output_names}
+mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture,output_names,fbx}
 
 # obj_mtl: OBJ bytes, a NUL, MTL bytes (the first .mtl in the same folder).
 n=0
@@ -23,6 +23,11 @@ while IFS= read -r -d '' g; do
   [ "$size" -gt 200000 ] && continue
   cp "$g" "$corpus/gltf/$(basename "$g")"
 done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.gltf' -o -name '*.glb' \) -print0)
+
+# fbx: the FBX files.
+while IFS= read -r -d '' f; do
+  cp "$f" "$corpus/fbx/$(basename "$f")"
+done < <(find "$root/tests/wild" -name '*.fbx' -print0)
 
 # scene_toml: every scene, its model paths pointed at the fuzz assets.
 while IFS= read -r -d '' s; do

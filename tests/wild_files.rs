@@ -242,3 +242,50 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
     };
     assert!(err.contains("cannot decode texture"), "{err}");
 }
+
+/// FBX through ufbx: Blender's 2-unit cube, turned 30 degrees about its up
+/// axis and standing on the ground, arrives in Y-up metres, and its
+/// checker (embedded in one file, beside the other) shows red and white.
+#[test]
+fn fbx_cubes_arrive_upright_in_metres_with_their_checker() {
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    for file in ["cube_embedded.fbx", "cube_external.fbx"] {
+        let opts = LoadOptions {
+            sets: ["output.width=96", "output.height=96"]
+                .iter()
+                .map(|s| s.parse().unwrap())
+                .collect(),
+            ..Default::default()
+        };
+        let scene = Scene::load(&dir.join(file), &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+        let (lo, hi) = scene.models[0].mesh.bounds();
+        // Up is +Y, from 0 to 2; across, cos 30 + sin 30 on either side.
+        let across = 30f32.to_radians().cos() + 30f32.to_radians().sin();
+        for (got, want) in [
+            (lo.y, 0.0),
+            (hi.y, 2.0),
+            (hi.x, across),
+            (-lo.x, across),
+            (hi.z, across),
+        ] {
+            assert!((got - want).abs() < 1e-3, "{file}: {lo} {hi}");
+        }
+        let f = common::render_frame(&scene, 0, 0);
+        let (mut red, mut white, mut covered) = (0, 0, 0);
+        for (i, c) in f.color.iter().enumerate() {
+            if !f.depth[i].is_finite() {
+                continue;
+            }
+            covered += 1;
+            red += (c.x > 2.0 * c.y.max(c.z) && c.x > 0.2) as usize;
+            white += (c.min_element() > 0.3 && c.y > 0.7 * c.x) as usize;
+        }
+        assert!(
+            red * 5 > covered && white * 5 > covered,
+            "{file}: {red} red, {white} white of {covered}"
+        );
+    }
+}

@@ -6,6 +6,7 @@ pub mod clip;
 pub mod dds;
 pub mod draco;
 pub mod environment;
+pub mod fbx;
 pub mod gltf;
 pub mod gltf_pose;
 pub mod input;

@@ -14,7 +14,7 @@ use softraster::error::Error;
 
 /// The extensions a folder is searched for (case-insensitive): scenes and
 /// every model format softraster reads.
-pub const EXTENSIONS: [&str; 6] = ["toml", "gltf", "glb", "obj", "stl", "ply"];
+pub const EXTENSIONS: [&str; 7] = ["toml", "gltf", "glb", "obj", "stl", "ply", "fbx"];
 
 /// One input to render.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -127,7 +127,7 @@ pub struct GltfSpecular {
 
 impl GltfMaterial {
     /// The material of primitives without one (glTF's default).
-    pub(super) fn default_material() -> GltfMaterial {
+    pub(crate) fn default_material() -> GltfMaterial {
         GltfMaterial {
             name: "default".into(),
             base_color: Vec4::ONE,

@@ -94,7 +94,7 @@ impl Scene {
             return Err(Error::asset(
                 path,
                 None,
-                "neither a scene (TOML) nor a model file softraster reads (.gltf, .glb, .obj, .stl, .ply)",
+                "neither a scene (TOML) nor a model file softraster reads (.gltf, .glb, .obj, .stl, .ply, .fbx)",
             ));
         }
         let edited = overrides::apply(path, &text, &opts.sets)?;
@@ -154,7 +154,7 @@ fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<String, Error> {
         path,
         None,
         format!(
-            "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl or .ply",
+            "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl, .ply or .fbx",
             e.utf8_error().valid_up_to()
         ),
         )
@@ -165,7 +165,7 @@ fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<String, Error> {
 /// The one-line scene of a model file, or None for other files.
 fn model_as_scene(path: &Path) -> Option<String> {
     let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
-    if !matches!(ext.as_str(), "gltf" | "glb" | "obj" | "stl" | "ply") {
+    if !matches!(ext.as_str(), "gltf" | "glb" | "obj" | "stl" | "ply" | "fbx") {
         return None;
     }
     let name = path.file_name()?.to_string_lossy().into_owned();

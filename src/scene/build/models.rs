@@ -550,6 +550,18 @@ impl SourceModel {
                 warnings: std::mem::take(&mut g.warnings),
                 gltf: Some(g),
             })
+        } else if ext == "fbx" {
+            let f = crate::assets::fbx::load(path, input)?;
+            Ok(SourceModel {
+                mesh: f.mesh,
+                materials: f
+                    .materials
+                    .into_iter()
+                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                    .collect(),
+                gltf: None,
+                warnings: f.warnings,
+            })
         } else if ext == "stl" || ext == "ply" {
             let mesh = if ext == "stl" {
                 crate::assets::stl::load(path, input)?
