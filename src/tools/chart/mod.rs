@@ -208,18 +208,29 @@ fn ao_rmse(got: &Frame, reference: &Frame) -> f64 {
     crate::tools::accuracy::ao_error([(got, reference)]).0
 }
 
-/// Marks the Pareto front of each knob and reference.
+/// Marks the Pareto front of each knob and reference, by the time and
+/// error as `csv` writes them (so a reader of the CSV finds the same
+/// front: two times equal to the written microsecond tie).
 fn mark_pareto(rows: &mut [Row]) {
+    let written = |x: f64, places: usize| -> f64 { format!("{x:.places$}").parse().unwrap_or(x) };
+    let key: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (written(r.time.median_ms, 3), written(r.error, 6)))
+        .collect();
     for i in 0..rows.len() {
-        let r = &rows[i];
-        let dominated = rows.iter().enumerate().any(|(j, o)| {
-            j != i
-                && o.knob == r.knob
-                && o.against == r.against
-                && o.time.median_ms <= r.time.median_ms
-                && o.error <= r.error
-                && (o.time.median_ms < r.time.median_ms || o.error < r.error)
-        });
+        let (r, (t, e)) = (&rows[i], key[i]);
+        let dominated = rows
+            .iter()
+            .zip(&key)
+            .enumerate()
+            .any(|(j, (o, &(ot, oe)))| {
+                j != i
+                    && o.knob == r.knob
+                    && o.against == r.against
+                    && ot <= t
+                    && oe <= e
+                    && (ot < t || oe < e)
+            });
         rows[i].pareto = !dominated;
     }
 }
