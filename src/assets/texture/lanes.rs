@@ -62,6 +62,9 @@ struct Place4 {
     /// Lanes whose footprint lies inside the level (bit k: lane k); the
     /// others go through the address mode.
     inside: u32,
+    /// Lanes whose result is used (bit k: lane k): a lone lookup reads and
+    /// decodes one lane's texels, not four.
+    live: u32,
 }
 
 /// A texture's levels as the four-lane lookups read them: the image and
@@ -96,7 +99,7 @@ impl<'t> Chain<'t> {
     /// lane.
     pub fn sample1(&self, uv: Vec2, fp: Footprint, mode: Wrap) -> Vec4 {
         let (u, v) = (Vec4::splat(uv.x), Vec4::splat(uv.y));
-        let c = self.sample::<4>(u, v, &[fp; 4], mode);
+        let c = self.sample::<4>(u, v, &[fp; 4], mode, 0b0001);
         Vec4::new(c[0].x, c[1].x, c[2].x, c[3].x)
     }
 
@@ -109,15 +112,16 @@ impl<'t> Chain<'t> {
     /// Four lookups in this chain, lane k at (`u`, `v`) over `fps[k]`:
     /// red, green and blue.
     pub fn sample4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgb4 {
-        self.sample::<3>(u, v, fps, mode)
+        self.sample::<3>(u, v, fps, mode, 0b1111)
     }
 
     /// `sample4` with alpha.
     pub fn sample4_rgba(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], mode: Wrap) -> Rgba4 {
-        self.sample::<4>(u, v, fps, mode)
+        self.sample::<4>(u, v, fps, mode, 0b1111)
     }
 
-    /// The first `N` channels of four lookups.
+    /// The first `N` channels of four lookups, in the lanes `live` (the
+    /// others unspecified).
     #[inline]
     fn sample<const N: usize>(
         &self,
@@ -125,10 +129,11 @@ impl<'t> Chain<'t> {
         v: Vec4,
         fps: &[Footprint; 4],
         mode: Wrap,
+        live: u32,
     ) -> [Vec4; N] {
         match self.taps4(u, v, fps) {
-            Some(taps) => self.read(&taps, mode),
-            None => self.probes(u, v, fps, mode),
+            Some(taps) => self.read(&taps.only(live), mode),
+            None => self.probes(u, v, fps, mode, live),
         }
     }
 
@@ -230,7 +235,8 @@ impl<'t> Chain<'t> {
     fn read<const N: usize>(&self, taps: &Taps4, mode: Wrap) -> [Vec4; N] {
         if taps.shape != self.shape() {
             // Taps of another shape: found again here.
-            return self.read(&self.lod_taps4(taps.u, taps.v, taps.lod), mode);
+            let again = self.lod_taps4(taps.u, taps.v, taps.lod);
+            return self.read(&again.only(taps.near.live), mode);
         }
         let a = self.bilinear4(&taps.near, taps.u, taps.v, mode);
         match &taps.far {
@@ -272,8 +278,9 @@ impl<'t> Chain<'t> {
         // Corner j (top-left, top-right, bottom-left, bottom-right) of
         // lane k, as stored.
         let mut texels = [[0u32; 4]; 4];
+        let read = place.inside & place.live;
         for k in 0..4 {
-            if place.inside & (1 << k) != 0 {
+            if read & (1 << k) != 0 {
                 let t = self.texels[place.level[k]];
                 let (i, dx, dy) = (
                     place.at[k] as usize,
@@ -308,10 +315,10 @@ impl<'t> Chain<'t> {
                     &ALPHA_TABLE
                 };
                 let shift = 8 * ch as u32;
-                let a = srgb_channel4(lut, &texels[0], shift);
-                let b = srgb_channel4(lut, &texels[1], shift);
-                let c = srgb_channel4(lut, &texels[2], shift);
-                let d = srgb_channel4(lut, &texels[3], shift);
+                let a = srgb_channel4(lut, &texels[0], shift, place.live);
+                let b = srgb_channel4(lut, &texels[1], shift, place.live);
+                let c = srgb_channel4(lut, &texels[2], shift, place.live);
+                let d = srgb_channel4(lut, &texels[3], shift, place.live);
                 let top = a * gx + b * fx;
                 let bottom = c * gx + d * fx;
                 *o = top * gy + bottom * fy;
@@ -328,9 +335,10 @@ impl<'t> Chain<'t> {
                 *o = top * gy + bottom * fy;
             }
         }
-        if place.inside != 0b1111 {
+        let wrapped = place.live & !place.inside;
+        if wrapped != 0 {
             for k in 0..4 {
-                if place.inside & (1 << k) == 0 {
+                if wrapped & (1 << k) != 0 {
                     let level = self.level(place.level[k]);
                     let uv = Vec2::new(u[k], v[k]);
                     let r = self.texture.bilinear_wrapped(level, uv, mode);
@@ -354,6 +362,7 @@ impl<'t> Chain<'t> {
         v: Vec4,
         fps: &[Footprint; 4],
         mode: Wrap,
+        used: u32,
     ) -> [Vec4; N] {
         let mut n = [1u32; 4];
         let mut nf = [1.0f32; 4];
@@ -390,7 +399,7 @@ impl<'t> Chain<'t> {
                     }
                 }
             }
-            let r: [Vec4; N] = self.read(&self.lod_taps4(pu, pv, lod), mode);
+            let r: [Vec4; N] = self.read(&self.lod_taps4(pu, pv, lod).only(used), mode);
             let live = Vec4::from(live).cmpgt(Vec4::ZERO);
             for c in 0..N {
                 sum[c] += Vec4::select(live, r[c], Vec4::ZERO);
@@ -409,6 +418,18 @@ fn level_of<'a>(base: &'a Level, mips: Option<&'a [Level]>, i: usize) -> &'a Lev
     match (i, mips) {
         (0, _) | (_, None) => base,
         (i, Some(m)) => m.get(i - 1).unwrap_or(base),
+    }
+}
+
+impl Taps4 {
+    /// These taps with only the lanes `live` read.
+    #[inline(always)]
+    fn only(mut self, live: u32) -> Taps4 {
+        self.near.live = live;
+        if let Some((far, _)) = &mut self.far {
+            far.live = live;
+        }
+        self
     }
 }
 
@@ -473,6 +494,7 @@ impl Place4 {
             fx: x - x0,
             fy: y - y0,
             inside,
+            live: 0b1111,
         }
     }
 }
@@ -505,8 +527,11 @@ fn blend<const N: usize>(a: [Vec4; N], b: [Vec4; N], f: Vec4) -> [Vec4; N] {
 /// Channel `shift / 8` of four stored sRGB texels (one per lane),
 /// linear: the decoding table's values.
 #[inline(always)]
-fn srgb_channel4(lut: &[f32; 256], t: &[u32; 4], shift: u32) -> Vec4 {
+fn srgb_channel4(lut: &[f32; 256], t: &[u32; 4], shift: u32, live: u32) -> Vec4 {
     let at = |k: usize| lut[((t[k] >> shift) & 0xff) as usize];
+    if live == 0b0001 {
+        return Vec4::splat(at(0));
+    }
     lanes4(at(0), at(1), at(2), at(3))
 }
 
