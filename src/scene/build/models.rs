@@ -184,9 +184,10 @@ fn playback(
     };
     let err = |m: String| Err(ctx.err(want.span(), m));
     let Some(g) = &src.gltf else {
-        return err(
-            "model.animation: only glTF models carry animations; this one is not glTF".into(),
-        );
+        return err(format!(
+            "model.animation: only glTF models' animations are read; this one is {}",
+            format_name(md.path.get_ref())
+        ));
     };
     let rig = match &g.rig {
         None => {
@@ -487,7 +488,10 @@ fn import_lights_and_cameras(
         {
             return Err(ctx.err(
                 v.span(),
-                format!("{key} = true: only glTF models carry {what}; this one is OBJ"),
+                format!(
+                    "{key} = true: only glTF models' {what} are read; this one is {}",
+                    format_name(md.path.get_ref())
+                ),
             ));
         }
     }
@@ -719,4 +723,12 @@ fn displace(
     }
     crate::assets::mesh::smooth_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals, &used);
     Ok(())
+}
+
+/// The format of a model file, as messages name it (by its extension).
+fn format_name(path: &str) -> String {
+    Path::new(path)
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_uppercase())
+        .unwrap_or_else(|| "not glTF".into())
 }
