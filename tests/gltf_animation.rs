@@ -469,7 +469,11 @@ fn bad_animation_keys_are_errors_naming_the_key() {
             "no animation 7; it has: 0 \"Bend\", 1 \"Idle\"",
         ),
         ("bar.gltf", "-1", "an animation's name"),
-        ("tri.obj", "\"Walk\"", "only glTF models carry animations"),
+        (
+            "tri.obj",
+            "\"Walk\"",
+            "only glTF models' animations are read; this one is OBJ",
+        ),
         ("still.gltf", "0", "has no animations"),
         (
             "typo.gltf",
