@@ -5,7 +5,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 corpus="$root/fuzz/corpus"
-mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture,output_names,fbx}
+mkdir -p "$corpus"/{obj_mtl,gltf,scene_toml,render,texture,output_names,fbx,usd}
 
 # obj_mtl: OBJ bytes, a NUL, MTL bytes (the first .mtl in the same folder).
 n=0
@@ -28,6 +28,16 @@ done < <(find "$root/tests/wild" "$root/assets" "$root/tests/data" \( -name '*.g
 while IFS= read -r -d '' f; do
   cp "$f" "$corpus/fbx/$(basename "$f")"
 done < <(find "$root/tests/wild" -name '*.fbx' -print0)
+
+# usd: the USD files, each behind the byte that picks its extension.
+while IFS= read -r -d '' f; do
+  case "$f" in
+    *.usda) pick='\000' ;;
+    *.usdc) pick='\001' ;;
+    *) pick='\002' ;;
+  esac
+  { printf "$pick"; cat "$f"; } > "$corpus/usd/$(basename "$f")"
+done < <(find "$root/tests/wild" \( -name '*.usda' -o -name '*.usdc' -o -name '*.usdz' \) -print0)
 
 # scene_toml: every scene, its model paths pointed at the fuzz assets.
 while IFS= read -r -d '' s; do

@@ -472,7 +472,7 @@ fn bad_animation_keys_are_errors_naming_the_key() {
         (
             "tri.obj",
             "\"Walk\"",
-            "only glTF models' animations are read; this one is OBJ",
+            "only glTF and FBX models' animations are read; this one is OBJ",
         ),
         ("still.gltf", "0", "has no animations"),
         (

@@ -4,6 +4,7 @@
 
 mod common;
 
+use glam::Vec4;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug)]
@@ -102,8 +103,9 @@ fn every_file_in_the_corpus_has_its_outcome() {
     // read through the models that name them).
     for e in std::fs::read_dir(&dir).unwrap().flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let model = ["obj", "stl", "ply", "gltf", "glb", "toml"]
+        let model = softraster::assets::MODEL_EXTENSIONS
             .iter()
+            .chain(&["toml"])
             .any(|x| name.ends_with(&format!(".{x}")));
         assert!(
             !model || cases.iter().any(|c| c.file == name),
@@ -241,6 +243,205 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
         Err(e) => e.to_string(),
     };
     assert!(err.contains("cannot decode texture"), "{err}");
+}
+
+/// USD through openusd: Blender's cube as text, binary and package
+/// arrives as the FBX one does (Z up and metres converted), its checker
+/// beside the file or inside the package.
+#[test]
+fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    for file in ["cube.usda", "cube.usdc", "cube.usdz"] {
+        let opts = LoadOptions {
+            sets: ["output.width=96", "output.height=96"]
+                .iter()
+                .map(|s| s.parse().unwrap())
+                .collect(),
+            ..Default::default()
+        };
+        let scene = Scene::load(&dir.join(file), &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+        let (lo, hi) = scene.models[0].mesh.bounds();
+        let across = 30f32.to_radians().cos() + 30f32.to_radians().sin();
+        for (got, want) in [
+            (lo.y, 0.0),
+            (hi.y, 2.0),
+            (hi.x, across),
+            (-lo.x, across),
+            (hi.z, across),
+        ] {
+            assert!((got - want).abs() < 1e-3, "{file}: {lo} {hi}");
+        }
+        let f = common::render_frame(&scene, 0, 0);
+        let (mut red, mut white, mut covered) = (0, 0, 0);
+        for (i, c) in f.color.iter().enumerate() {
+            if !f.depth[i].is_finite() {
+                continue;
+            }
+            covered += 1;
+            red += (c.x > 2.0 * c.y.max(c.z) && c.x > 0.2) as usize;
+            white += (c.min_element() > 0.3 && c.y > 0.7 * c.x) as usize;
+        }
+        assert!(
+            red * 5 > covered && white * 5 > covered,
+            "{file}: {red} red, {white} white of {covered}"
+        );
+    }
+}
+
+/// A hand-written USD file: no `metersPerUnit` is centimetres, a
+/// left-handed plate faces up once its winding is reversed, a GeomSubset
+/// binds its own material to one face, `displayColor` colours a mesh with
+/// no material, and an invisible mesh is left out.
+#[test]
+fn usd_units_winding_subsets_and_display_colour() {
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/usd_subsets.usda");
+    let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let model = &scene.models[0];
+    let mesh = &model.mesh;
+    // The plate spans 2 m by 1 m, 1 m up; the marker reaches 1.3 m; the
+    // hidden triangle (10 m) is not there.
+    let (lo, hi) = mesh.bounds();
+    for (got, want) in [
+        (lo.x, -1.0),
+        (hi.x, 1.0),
+        (lo.y, 1.0),
+        (hi.y, 1.3),
+        (hi.z, 0.5),
+    ] {
+        assert!((got - want).abs() < 1e-4, "{lo} {hi}");
+    }
+    assert_eq!(mesh.triangles.len(), 5);
+    let plate: Vec<_> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| mesh.positions[i as usize]))
+        .filter(|[a, b, c]| a.y == 1.0 && b.y == 1.0 && c.y == 1.0)
+        .collect();
+    assert_eq!(plate.len(), 4);
+    for [a, b, c] in &plate {
+        assert!(
+            (*b - *a).cross(*c - *a).y > 0.0,
+            "a plate triangle faces down"
+        );
+    }
+    let colour_of = |x: f32| {
+        let g = mesh
+            .groups
+            .iter()
+            .find(|g| {
+                g.triangles.clone().any(|t| {
+                    let p = mesh.triangles[t as usize].map(|i| mesh.positions[i as usize]);
+                    p.iter().all(|p| p.y == 1.0) && p.iter().map(|p| p.x).sum::<f32>() * x > 0.0
+                })
+            })
+            .expect("a group");
+        model.materials[g.material].pbr.base_color
+    };
+    let (left, right) = (colour_of(-1.0), colour_of(1.0));
+    assert!(left.y > 0.5 && left.z < 0.2, "left face {left}");
+    assert!(right.z > 0.5 && right.y < 0.2, "right face {right}");
+    // The marker's orange is its vertex colour.
+    let orange = mesh
+        .colors
+        .iter()
+        .any(|c| (c.x - 1.0).abs() < 1e-6 && (c.y - 0.5).abs() < 1e-6);
+    assert!(orange, "no displayColor on the marker");
+}
+
+/// 3MF: millimetres and Z up arrive as metres and Y up, build items and
+/// components are placed by their transforms, and colours come from base
+/// materials (per object) and colour groups (per corner).
+#[test]
+fn three_mf_cubes_arrive_in_metres_with_their_colours() {
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/colour_cubes.3mf");
+    let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let mesh = &scene.models[0].mesh;
+    assert_eq!(mesh.triangles.len(), 24);
+    // The red cube spans 0..20 mm; the assembly's 40..60 mm along x and
+    // 10..30 mm up; the file's +y runs away from the viewer (-z).
+    let (lo, hi) = mesh.bounds();
+    for (got, want) in [
+        (lo.x, 0.0),
+        (hi.x, 0.06),
+        (lo.y, 0.0),
+        (hi.y, 0.03),
+        (lo.z, -0.02),
+        (hi.z, 0.0),
+    ] {
+        assert!((got - want).abs() < 1e-6, "{lo} {hi}");
+    }
+    let has = |want: Vec4| {
+        mesh.colors
+            .iter()
+            .any(|c| (*c - want).abs().max_element() < 1e-6)
+    };
+    assert!(has(Vec4::new(1.0, 0.0, 0.0, 1.0)), "no red");
+    assert!(has(Vec4::new(0.0, 1.0, 0.0, 1.0)), "no green corner");
+    assert!(has(Vec4::new(0.0, 0.0, 1.0, 1.0)), "no blue corner");
+    assert!(has(Vec4::ONE), "no white");
+    // Every corner of the red cube is red.
+    for (p, c) in mesh.positions.iter().zip(&mesh.colors) {
+        if p.x < 0.03 {
+            assert_eq!(*c, Vec4::new(1.0, 0.0, 0.0, 1.0), "at {p}");
+        }
+    }
+}
+
+/// FBX skins and animation stacks through the glTF rig and clip code:
+/// Blender's cylinder (0 to 2 up) skinned to two bones, the upper turned
+/// 0.8 rad about Blender's X at the end of its stack. At the start the
+/// pose is the rest mesh; at the end the top ring's centre has swung
+/// about the joint at 1 m: up to 1 + cos 0.8, forward (+Z, Blender's -Y)
+/// by sin 0.8.
+#[test]
+fn fbx_skin_bends_with_its_animation_stack() {
+    use softraster::assets::rig::Parts;
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    let opts = LoadOptions {
+        sets: ["model.0.animation=0"]
+            .iter()
+            .map(|s| s.parse().unwrap())
+            .collect(),
+        ..Default::default()
+    };
+    let scene = Scene::load(&dir.join("rigged.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let model = &scene.models[0];
+    let p = model.playback.as_ref().expect("the stack plays");
+    let rest = p.pose(&model.mesh, 0.0, Parts::All);
+    for (a, b) in rest.positions.iter().zip(&model.mesh.positions) {
+        assert!(
+            (*a - *b).length() < 1e-4,
+            "at the start {a} is not the rest {b}"
+        );
+    }
+    let end = p.pose(&model.mesh, f64::from(p.clip.duration) - 1e-4, Parts::All);
+    // The ring's twelve points, each once (corners repeat them).
+    let mut top: Vec<(glam::Vec3, glam::Vec3)> = Vec::new();
+    for (rest, posed) in model.mesh.positions.iter().zip(&end.positions) {
+        if rest.y > 1.99 && !top.iter().any(|(r, _)| (*r - *rest).length() < 1e-5) {
+            top.push((*rest, *posed));
+        }
+    }
+    assert_eq!(top.len(), 12);
+    let top: Vec<_> = top.into_iter().map(|(_, posed)| posed).collect();
+    assert!(!top.is_empty());
+    let centre = top.iter().copied().sum::<glam::Vec3>() / top.len() as f32;
+    let want = glam::Vec3::new(0.0, 1.0 + 0.8f32.cos(), 0.8f32.sin());
+    assert!(
+        (centre - want).length() < 0.02,
+        "the top's centre is at {centre}, not {want}"
+    );
 }
 
 /// FBX through ufbx: Blender's 2-unit cube, turned 30 degrees about its up

@@ -12,9 +12,11 @@ use std::path::{Path, PathBuf};
 
 use softraster::error::Error;
 
-/// The extensions a folder is searched for (case-insensitive): scenes and
-/// every model format softraster reads.
-pub const EXTENSIONS: [&str; 7] = ["toml", "gltf", "glb", "obj", "stl", "ply", "fbx"];
+/// Whether a folder's file with extension `e` is an input: a scene or a
+/// model of any format softraster reads (case-insensitive).
+fn is_input_extension(e: &str) -> bool {
+    e.eq_ignore_ascii_case("toml") || softraster::assets::is_model_extension(e)
+}
 
 /// One input to render.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -77,10 +79,10 @@ fn add(
     walk(p, &mut HashSet::new(), &mut files);
     if files.is_empty() {
         return Err(Error::Argument(format!(
-            "{}{}: a folder with no file softraster reads below it (.{})",
+            "{}{}: a folder with no file softraster reads below it (.toml, {})",
             whence(),
             p.display(),
-            EXTENSIONS.join(", .")
+            softraster::assets::model_extensions_listed()
         )));
     }
     found.extend(
@@ -91,7 +93,7 @@ fn add(
     Ok(())
 }
 
-/// The files below `dir` with one of `EXTENSIONS`, following links to
+/// The files below `dir` with a scene's or model's extension, following links to
 /// folders but entering each folder once (`seen`: canonical paths), so a
 /// link loop ends. Unreadable entries are passed over.
 fn walk(dir: &Path, seen: &mut HashSet<PathBuf>, out: &mut Vec<PathBuf>) {
@@ -115,11 +117,11 @@ fn walk(dir: &Path, seen: &mut HashSet<PathBuf>, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Whether `p` has an extension of `EXTENSIONS`.
+/// Whether `p` has a scene's or a model's extension.
 fn readable(p: &Path) -> bool {
     p.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)))
+        .is_some_and(is_input_extension)
 }
 
 /// The paths of list `list` with their line numbers (from 1).

@@ -54,7 +54,8 @@ enum Command {
 #[derive(clap::Args)]
 struct RenderArgs {
     /// Scene files (TOML), model files to render as the one-line scene
-    /// that names them (.gltf, .glb, .obj, .stl, .ply, .fbx), or folders, read
+    /// that names them (.gltf, .glb, .obj, .stl, .ply, .fbx, .usd/.usda/.usdc/.usdz,
+    /// .3mf), or folders, read
     /// recursively for those. One file: its frames go to `--out` (or
     /// `output.dir`). Several inputs: each file's to `OUT/<stem>/`, each
     /// found in a folder to `OUT/<path in the folder, no extension>/`.

@@ -94,7 +94,10 @@ impl Scene {
             return Err(Error::asset(
                 path,
                 None,
-                "neither a scene (TOML) nor a model file softraster reads (.gltf, .glb, .obj, .stl, .ply, .fbx)",
+                format!(
+                    "neither a scene (TOML) nor a model file softraster reads ({})",
+                    crate::assets::model_extensions_listed()
+                ),
             ));
         }
         let edited = overrides::apply(path, &text, &opts.sets)?;
@@ -151,12 +154,13 @@ fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<String, Error> {
     let bytes = input.read(path, None, None)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         Error::asset(
-        path,
-        None,
-        format!(
-            "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are .gltf, .glb, .obj, .stl, .ply or .fbx",
-            e.utf8_error().valid_up_to()
-        ),
+            path,
+            None,
+            format!(
+                "the scene file is not UTF-8 text (byte {}): a scene is TOML; models are {}",
+                e.utf8_error().valid_up_to(),
+                crate::assets::model_extensions_listed()
+            ),
         )
     })?;
     Ok(text)
@@ -165,7 +169,7 @@ fn read_scene_file(path: &Path, opts: &LoadOptions) -> Result<String, Error> {
 /// The one-line scene of a model file, or None for other files.
 fn model_as_scene(path: &Path) -> Option<String> {
     let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
-    if !matches!(ext.as_str(), "gltf" | "glb" | "obj" | "stl" | "ply" | "fbx") {
+    if !crate::assets::is_model_extension(&ext) {
         return None;
     }
     let name = path.file_name()?.to_string_lossy().into_owned();

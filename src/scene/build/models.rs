@@ -18,7 +18,7 @@ use crate::assets::gltf::{GltfCamera, GltfModel, ImageSource};
 use crate::assets::input::Input;
 use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
-use crate::assets::rig::Parts;
+use crate::assets::rig::{Parts, Rig};
 use crate::assets::texture::{AddressMode, Texture};
 use crate::assets::texture_cache::TextureCache;
 use crate::error::Error;
@@ -47,6 +47,9 @@ struct SourceModel {
     materials: Vec<SourceMaterial>,
     /// glTF only: lights, cameras.
     gltf: Option<GltfModel>,
+    /// glTF and FBX files with animation: their rig and clips, or why
+    /// they cannot be played.
+    rig: Option<Result<Arc<Rig>, String>>,
     warnings: Vec<String>,
 }
 
@@ -171,8 +174,8 @@ fn model_name(md: &desc::ModelDesc, before: &[Model]) -> String {
     name
 }
 
-/// `model.animation`: the clip it names in the model's glTF file, ready to
-/// play (an error lists the clips the file has).
+/// `model.animation`: the clip it names in the model's glTF or FBX file,
+/// ready to play (an error lists the clips the file has).
 fn playback(
     md: &desc::ModelDesc,
     ctx: &Ctx,
@@ -183,13 +186,13 @@ fn playback(
         return Ok(None);
     };
     let err = |m: String| Err(ctx.err(want.span(), m));
-    let Some(g) = &src.gltf else {
+    let format = format_name(md.path.get_ref());
+    if src.gltf.is_none() && format != "FBX" {
         return err(format!(
-            "model.animation: only glTF models' animations are read; this one is {}",
-            format_name(md.path.get_ref())
+            "model.animation: only glTF and FBX models' animations are read; this one is {format}"
         ));
-    };
-    let rig = match &g.rig {
+    }
+    let rig = match &src.rig {
         None => {
             return err(format!(
                 "model.animation: {} has no animations",
@@ -552,6 +555,7 @@ impl SourceModel {
                     .map(|m| SourceMaterial::Gltf(Box::new(m)))
                     .collect(),
                 warnings: std::mem::take(&mut g.warnings),
+                rig: g.rig.clone(),
                 gltf: Some(g),
             })
         } else if ext == "fbx" {
@@ -564,7 +568,34 @@ impl SourceModel {
                     .map(|m| SourceMaterial::Gltf(Box::new(m)))
                     .collect(),
                 gltf: None,
+                rig: f.rig,
                 warnings: f.warnings,
+            })
+        } else if matches!(ext.as_str(), "usd" | "usda" | "usdc" | "usdz") {
+            let u = crate::assets::usd::load(path, input)?;
+            Ok(SourceModel {
+                mesh: u.mesh,
+                materials: u
+                    .materials
+                    .into_iter()
+                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                    .collect(),
+                gltf: None,
+                rig: None,
+                warnings: u.warnings,
+            })
+        } else if ext == "3mf" {
+            let t = crate::assets::threemf::load(path, input)?;
+            Ok(SourceModel {
+                mesh: t.mesh,
+                materials: t
+                    .materials
+                    .into_iter()
+                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                    .collect(),
+                gltf: None,
+                rig: None,
+                warnings: t.warnings,
             })
         } else if ext == "stl" || ext == "ply" {
             let mesh = if ext == "stl" {
@@ -582,6 +613,7 @@ impl SourceModel {
                     },
                 )))],
                 gltf: None,
+                rig: None,
                 warnings: Vec::new(),
             })
         } else {
@@ -594,6 +626,7 @@ impl SourceModel {
                     .map(|m| SourceMaterial::Mtl(Box::new(MtlSource::new(m))))
                     .collect(),
                 gltf: None,
+                rig: None,
                 warnings: o.warnings,
             })
         }

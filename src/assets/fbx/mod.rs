@@ -15,13 +15,20 @@
 //! - textures embedded in the file, or external (relative to the FBX file,
 //!   then by name beside it); a missing one is a warning, as for glTF.
 //!
-//! Not read yet: skins, blend shapes and animation stacks (the model is
-//! drawn in its bind pose, with a warning), cameras and lights.
+//! - skins and animation stacks (`rig`), played as glTF animation is:
+//!   `model.animation` names a stack or gives its index.
+//!
+//! Not read yet: blend shapes (drawn without them, with a warning),
+//! cameras and lights.
+
+mod rig;
 
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use super::rig::Rig;
 
 use super::gltf::{GltfAlphaMode, GltfMaterial, ImageSource, TexInfo};
 use super::input::Input;
@@ -36,6 +43,9 @@ pub struct FbxModel {
     /// Indexed by `Group::material`.
     pub materials: Vec<GltfMaterial>,
     pub warnings: Vec<String>,
+    /// Files with skins or animation stacks: what posing the mesh at
+    /// other times takes, or why it cannot be done.
+    pub rig: Option<Result<Arc<Rig>, String>>,
 }
 
 /// Reads the FBX file at `path` through `input` (bounded reads, the
@@ -77,24 +87,37 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
         mesh: Mesh::default(),
         materials: Vec::new(),
         warnings: Vec::new(),
+        rig: None,
     };
     let mut materials: Vec<(u32, usize)> = Vec::new();
+    let mut instances = Vec::new();
     for node in scene.nodes.iter() {
         let Some(mesh) = &node.mesh else { continue };
         let world = matrix(&node.geometry_to_world);
         let list = &mut model.materials;
-        add_mesh(&mut model.mesh, mesh, node, world, &mut |m: Option<
-            &ufbx::Material,
-        >| {
-            // Materials by element id, each converted once.
-            let id = m.map_or(u32::MAX, |m| m.element.element_id);
-            if let Some(&(_, k)) = materials.iter().find(|(i, _)| *i == id) {
-                return k;
-            }
-            let k = model_material(list, m, dir);
-            materials.push((id, k));
-            k
-        });
+        let first = model.mesh.positions.len() as u32;
+        let mut instance = rig::Instance {
+            node: node.element.typed_id as usize,
+            first,
+            vertices: Vec::new(),
+            corners: Vec::new(),
+        };
+        add_mesh(
+            &mut model.mesh,
+            (mesh, node, world),
+            &mut instance,
+            &mut |m: Option<&ufbx::Material>| {
+                // Materials by element id, each converted once.
+                let id = m.map_or(u32::MAX, |m| m.element.element_id);
+                if let Some(&(_, k)) = materials.iter().find(|(i, _)| *i == id) {
+                    return k;
+                }
+                let k = model_material(list, m, dir);
+                materials.push((id, k));
+                k
+            },
+        );
+        instances.push(instance);
     }
     if model.mesh.triangles.is_empty() {
         return Err(Error::asset(
@@ -103,11 +126,14 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
             "the FBX file has no mesh with faces",
         ));
     }
-    if !scene.skin_deformers.is_empty() || !scene.anim_stacks.is_empty() {
+    if !scene.blend_deformers.is_empty() {
         model.warnings.push(format!(
-            "{}: skins and animation in FBX files are not read yet; the model is drawn in its bind pose",
+            "{}: blend shapes in FBX files are not read yet; the model is drawn without them",
             path.display()
         ));
+    }
+    if !scene.skin_deformers.is_empty() || !scene.anim_stacks.is_empty() {
+        model.rig = Some(rig::rig(&scene, &instances).map(Arc::new));
     }
     for m in &model.materials {
         for (t, _) in m.textures() {
@@ -126,12 +152,12 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
 }
 
 /// Appends the triangles of `mesh` as `node` places it (`world`), with
-/// `material` giving the model's material index of each of its materials.
+/// `material` giving the model's material index of each of its materials;
+/// records where each vertex came from in `instance`.
 fn add_mesh(
     out: &mut Mesh,
-    mesh: &ufbx::Mesh,
-    node: &ufbx::Node,
-    world: Mat4,
+    (mesh, node, world): (&ufbx::Mesh, &ufbx::Node, Mat4),
+    instance: &mut rig::Instance,
     material: &mut dyn FnMut(Option<&ufbx::Material>) -> usize,
 ) {
     let normal_world = Mat4::from_mat3(glam::Mat3::from_mat4(world).inverse().transpose());
@@ -157,6 +183,8 @@ fn add_mesh(
             for tri in corners[..3 * n].chunks_exact(3) {
                 let base = out.positions.len() as u32;
                 for &ix in tri {
+                    instance.corners.push(ix);
+                    instance.vertices.push(mesh.vertex_indices[ix as usize]);
                     let ix = ix as usize;
                     let p = vec3(&mesh.vertex_position[ix]);
                     out.positions.push(world.transform_point3(p));
