@@ -29,15 +29,17 @@ while IFS= read -r -d '' f; do
   cp "$f" "$corpus/fbx/$(basename "$f")"
 done < <(find "$root/tests/wild" -name '*.fbx' -print0)
 
-# usd: the USD files, each behind the byte that picks its extension.
+# usd: the USD and 3MF files, each behind the byte that picks its
+# extension.
 while IFS= read -r -d '' f; do
   case "$f" in
     *.usda) pick='\000' ;;
     *.usdc) pick='\001' ;;
-    *) pick='\002' ;;
+    *.usdz) pick='\002' ;;
+    *) pick='\003' ;;
   esac
   { printf "$pick"; cat "$f"; } > "$corpus/usd/$(basename "$f")"
-done < <(find "$root/tests/wild" \( -name '*.usda' -o -name '*.usdc' -o -name '*.usdz' \) -print0)
+done < <(find "$root/tests/wild" \( -name '*.usda' -o -name '*.usdc' -o -name '*.usdz' -o -name '*.3mf' \) -print0)
 
 # scene_toml: every scene, its model paths pointed at the fuzz assets.
 while IFS= read -r -d '' s; do

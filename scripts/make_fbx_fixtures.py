@@ -8,7 +8,8 @@ exporter (pip install bpy==5.0.1; Python 3.11):
 - cube_external.fbx: the same without vertex colours, the checker as
   fbx_checker.png beside it;
 - rigged.fbx: a cylinder skinned to a two-bone armature with a 10-frame
-  bend (softraster draws it in its bind pose and says so).
+  bend;
+- lit_camera.fbx: a cube with a camera, a point, a sun and a spot light.
 
     python3 scripts/make_fbx_fixtures.py tests/wild
 """
@@ -92,3 +93,25 @@ for f, angle in [(1, 0.0), (10, 0.8)]:
 bpy.ops.object.mode_set(mode="OBJECT")
 bpy.ops.export_scene.fbx(filepath=os.path.join(out, "rigged.fbx"), bake_anim=True)
 print("wrote", sorted(os.listdir(out)))
+
+# lit_camera.fbx: a 2-unit cube at the origin, a camera 10 units in front
+# of it (Blender -Y, 45-degree vertical field of view) looking at it, a
+# 1000 W point light 4 units above it, a sun pointing straight down and a
+# spot light at +X pointing at the cube (cone 60 degrees, blend 0.25).
+reset()
+bpy.ops.mesh.primitive_cube_add(size=2.0)
+bpy.ops.object.camera_add(location=(0, -10, 0), rotation=(1.5707963, 0, 0))
+cam = bpy.context.active_object
+cam.data.sensor_fit = "VERTICAL"
+cam.data.angle = 0.7853982
+bpy.ops.object.light_add(type="POINT", location=(0, 0, 4))
+bpy.context.active_object.data.energy = 1000.0
+bpy.ops.object.light_add(type="SUN", location=(0, 0, 6), rotation=(0, 0, 0))
+bpy.context.active_object.data.energy = 3.0
+bpy.ops.object.light_add(type="SPOT", location=(6, 0, 0), rotation=(0, 1.5707963, 0))
+spot = bpy.context.active_object
+spot.data.energy = 500.0
+spot.data.spot_size = 1.0471976
+spot.data.spot_blend = 0.25
+bpy.ops.export_scene.fbx(filepath=os.path.join(out, "lit_camera.fbx"))
+print("wrote lit_camera.fbx")

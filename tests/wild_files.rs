@@ -444,6 +444,75 @@ fn fbx_skin_bends_with_its_animation_stack() {
     );
 }
 
+/// FBX lights and cameras on request: Blender's camera 10 m in front of
+/// the cube looking at it (its exporter writes the lens as a 63.7-degree
+/// horizontal field at 16:9, 38.5 degrees vertically), a point light
+/// 4 m above, a sun shining down and a 60-degree spot at +X pointing at
+/// the cube, all in Y-up metres.
+#[test]
+fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    use softraster::scene::camera::Projection;
+    use softraster::scene::light::LightKind;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    let opts = LoadOptions {
+        sets: ["model.0.lights=true", "model.0.cameras=true"]
+            .iter()
+            .map(|s| s.parse().unwrap())
+            .collect(),
+        ..Default::default()
+    };
+    let scene = Scene::load(&dir.join("lit_camera.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let close = |a: glam::Vec3, b: glam::Vec3| (a - b).length() < 1e-3;
+    let cam = &scene.cameras[0];
+    assert!(
+        close(cam.eye, glam::Vec3::new(0.0, 0.0, 10.0)),
+        "{:?}",
+        cam.eye
+    );
+    assert!(
+        close((cam.target - cam.eye).normalize(), glam::Vec3::NEG_Z),
+        "{cam:?}"
+    );
+    assert!(close(cam.up, glam::Vec3::Y), "{cam:?}");
+    match cam.projection {
+        Projection::Perspective { fov_y } => assert!((fov_y - 38.53).abs() < 0.01, "{fov_y}"),
+        ref other => panic!("{other:?}"),
+    }
+    let (mut point, mut sun, mut spot) = (false, false, false);
+    for l in &scene.lights {
+        match l.kind {
+            LightKind::Point {
+                position,
+                intensity,
+            } => {
+                point |= close(position, glam::Vec3::new(0.0, 4.0, 0.0)) && intensity > 0.0;
+            }
+            LightKind::Directional {
+                direction,
+                irradiance,
+            } => {
+                sun |= close(direction, glam::Vec3::NEG_Y) && irradiance > 0.0;
+            }
+            LightKind::Spot {
+                position,
+                direction,
+                cos_outer,
+                cos_inner,
+                ..
+            } => {
+                spot |= close(position, glam::Vec3::new(6.0, 0.0, 0.0))
+                    && close(direction, glam::Vec3::NEG_X)
+                    && (cos_outer - 30f32.to_radians().cos()).abs() < 1e-3
+                    && cos_inner > cos_outer;
+            }
+        }
+    }
+    assert!(point && sun && spot, "{point} {sun} {spot}");
+}
+
 /// FBX through ufbx: Blender's 2-unit cube, turned 30 degrees about its up
 /// axis and standing on the ground, arrives in Y-up metres, and its
 /// checker (embedded in one file, beside the other) shows red and white.

@@ -18,9 +18,12 @@
 //! - skins and animation stacks (`rig`), played as glTF animation is:
 //!   `model.animation` names a stack or gives its index.
 //!
-//! Not read yet: blend shapes (drawn without them, with a warning),
-//! cameras and lights.
+//! - lights and cameras (`lights`), for `model.lights` and
+//!   `model.cameras`.
+//!
+//! Not read yet: blend shapes (drawn without them, with a warning).
 
+mod lights;
 mod rig;
 
 use std::path::Path;
@@ -30,7 +33,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::rig::Rig;
 
-use super::gltf::{GltfAlphaMode, GltfMaterial, ImageSource, TexInfo};
+use super::gltf::{GltfAlphaMode, GltfCamera, GltfLight, GltfMaterial, ImageSource, TexInfo};
 use super::input::Input;
 use super::mesh::{Group, Mesh};
 use super::texture::{AddressMode, Wrap};
@@ -46,6 +49,9 @@ pub struct FbxModel {
     /// Files with skins or animation stacks: what posing the mesh at
     /// other times takes, or why it cannot be done.
     pub rig: Option<Result<Arc<Rig>, String>>,
+    /// Placed in the file's (converted) space.
+    pub lights: Vec<GltfLight>,
+    pub cameras: Vec<GltfCamera>,
 }
 
 /// Reads the FBX file at `path` through `input` (bounded reads, the
@@ -88,6 +94,8 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
         materials: Vec::new(),
         warnings: Vec::new(),
         rig: None,
+        lights: Vec::new(),
+        cameras: Vec::new(),
     };
     let mut materials: Vec<(u32, usize)> = Vec::new();
     let mut instances = Vec::new();
@@ -135,6 +143,8 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
     if !scene.skin_deformers.is_empty() || !scene.anim_stacks.is_empty() {
         model.rig = Some(rig::rig(&scene, &instances).map(Arc::new));
     }
+    model.lights = lights::lights(&scene, &mut model.warnings);
+    model.cameras = lights::cameras(&scene);
     for m in &model.materials {
         for (t, _) in m.textures() {
             if let ImageSource::File(p) = &t.image

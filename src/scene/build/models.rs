@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::cameras::Bounds;
 use super::materials::{self, MtlSource, SourceMaterial};
 use super::{get, lights};
-use crate::assets::gltf::{GltfCamera, GltfModel, ImageSource};
+use crate::assets::gltf::{GltfCamera, GltfLight, GltfModel, ImageSource};
 use crate::assets::input::Input;
 use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
@@ -50,6 +50,9 @@ struct SourceModel {
     /// glTF and FBX files with animation: their rig and clips, or why
     /// they cannot be played.
     rig: Option<Result<Arc<Rig>, String>>,
+    /// glTF and FBX files: their lights and cameras, placed in the file's
+    /// space (None: the format has none).
+    imported: Option<(Vec<GltfLight>, Vec<GltfCamera>)>,
     warnings: Vec<String>,
 }
 
@@ -471,8 +474,8 @@ fn tangent_set(materials: &[Material]) -> Option<usize> {
         .map(|map| map.texcoord as usize)
 }
 
-/// `model.lights` and `model.cameras`: glTF files only; an import that
-/// finds nothing is a warning.
+/// `model.lights` and `model.cameras`: glTF and FBX files only; an import
+/// that finds nothing is a warning.
 fn import_lights_and_cameras(
     md: &desc::ModelDesc,
     ctx: &Ctx,
@@ -487,37 +490,44 @@ fn import_lights_and_cameras(
     ] {
         if let Some(v) = v
             && *v.get_ref()
-            && src.gltf.is_none()
+            && src.imported.is_none()
         {
             return Err(ctx.err(
                 v.span(),
                 format!(
-                    "{key} = true: only glTF models' {what} are read; this one is {}",
+                    "{key} = true: only glTF and FBX models' {what} are read; this one is {}",
                     format_name(md.path.get_ref())
                 ),
             ));
         }
     }
-    let Some(g) = &src.gltf else { return Ok(()) };
+    let Some((file_lights, file_cameras)) = &src.imported else {
+        return Ok(());
+    };
     if get(&md.lights, false) {
-        if g.lights.is_empty() {
+        if file_lights.is_empty() {
+            let what = if src.gltf.is_some() {
+                "KHR_lights_punctual lights"
+            } else {
+                "lights"
+            };
             warnings.push(format!(
-                "{}: model.lights = true, but the file has no KHR_lights_punctual lights",
+                "{}: model.lights = true, but the file has no {what}",
                 md.path.get_ref()
             ));
         }
         out.lights
-            .extend(g.lights.iter().map(|l| lights::from_gltf(l, world)));
+            .extend(file_lights.iter().map(|l| lights::from_gltf(l, world)));
     }
     if get(&md.cameras, false) {
-        if g.cameras.is_empty() {
+        if file_cameras.is_empty() {
             warnings.push(format!(
                 "{}: model.cameras = true, but the file has no cameras",
                 md.path.get_ref()
             ));
         }
         out.cameras
-            .extend(g.cameras.iter().map(|c| (c.clone(), world)));
+            .extend(file_cameras.iter().map(|c| (c.clone(), world)));
     }
     Ok(())
 }
@@ -556,6 +566,7 @@ impl SourceModel {
                     .collect(),
                 warnings: std::mem::take(&mut g.warnings),
                 rig: g.rig.clone(),
+                imported: Some((g.lights.clone(), g.cameras.clone())),
                 gltf: Some(g),
             })
         } else if ext == "fbx" {
@@ -569,6 +580,7 @@ impl SourceModel {
                     .collect(),
                 gltf: None,
                 rig: f.rig,
+                imported: Some((f.lights, f.cameras)),
                 warnings: f.warnings,
             })
         } else if matches!(ext.as_str(), "usd" | "usda" | "usdc" | "usdz") {
@@ -582,6 +594,7 @@ impl SourceModel {
                     .collect(),
                 gltf: None,
                 rig: None,
+                imported: None,
                 warnings: u.warnings,
             })
         } else if ext == "3mf" {
@@ -595,6 +608,7 @@ impl SourceModel {
                     .collect(),
                 gltf: None,
                 rig: None,
+                imported: None,
                 warnings: t.warnings,
             })
         } else if ext == "stl" || ext == "ply" {
@@ -614,6 +628,7 @@ impl SourceModel {
                 )))],
                 gltf: None,
                 rig: None,
+                imported: None,
                 warnings: Vec::new(),
             })
         } else {
@@ -627,6 +642,7 @@ impl SourceModel {
                     .collect(),
                 gltf: None,
                 rig: None,
+                imported: None,
                 warnings: o.warnings,
             })
         }
