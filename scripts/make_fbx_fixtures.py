@@ -9,7 +9,8 @@ exporter (pip install bpy==5.0.1; Python 3.11):
   fbx_checker.png beside it;
 - rigged.fbx: a cylinder skinned to a two-bone armature with a 10-frame
   bend;
-- lit_camera.fbx: a cube with a camera, a point, a sun and a spot light.
+- lit_camera.fbx: a cube with a camera, a point, a sun and a spot light;
+- shape_keys.fbx: a cube whose keyed shape key raises its top.
 
     python3 scripts/make_fbx_fixtures.py tests/wild
 """
@@ -115,3 +116,25 @@ spot.data.spot_size = 1.0471976
 spot.data.spot_blend = 0.25
 bpy.ops.export_scene.fbx(filepath=os.path.join(out, "lit_camera.fbx"))
 print("wrote lit_camera.fbx")
+
+# shape_keys.fbx: a 2-unit cube whose shape key "Up" raises its top four
+# vertices by 1 unit (Blender Z), its value keyed from 0 at frame 1 to 1 at
+# frame 11.
+reset()
+bpy.ops.mesh.primitive_cube_add(size=2.0)
+box = bpy.context.active_object
+box.shape_key_add(name="Basis")
+up = box.shape_key_add(name="Up")
+for v in up.data:
+    if v.co.z > 0:
+        v.co.z += 1.0
+up.value = 0.0
+up.keyframe_insert("value", frame=1)
+up.value = 1.0
+up.keyframe_insert("value", frame=11)
+up.value = 0.0
+# The exporter writes a stack for objects with keys of their own.
+box.keyframe_insert("location", frame=1)
+box.keyframe_insert("location", frame=11)
+bpy.ops.export_scene.fbx(filepath=os.path.join(out, "shape_keys.fbx"), bake_anim=True)
+print("wrote shape_keys.fbx")

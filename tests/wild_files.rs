@@ -444,6 +444,40 @@ fn fbx_skin_bends_with_its_animation_stack() {
     );
 }
 
+/// FBX blend shapes as morph targets: Blender's cube whose shape key
+/// raises its top by 1 m, keyed from 0 to 1 over the stack. The top is at
+/// 1 m at the start, 1.5 m halfway and 2 m at the end; the bottom stays.
+#[test]
+fn fbx_blend_shape_follows_its_keys() {
+    use softraster::assets::rig::Parts;
+    use softraster::scene::Scene;
+    use softraster::scene::build::LoadOptions;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    let opts = LoadOptions {
+        sets: ["model.0.animation=0"]
+            .iter()
+            .map(|s| s.parse().unwrap())
+            .collect(),
+        ..Default::default()
+    };
+    let scene = Scene::load(&dir.join("shape_keys.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let model = &scene.models[0];
+    let p = model.playback.as_ref().expect("the stack plays");
+    let d = f64::from(p.clip.duration);
+    for (t, top) in [(0.0, 1.0), (0.5 * d, 1.5), (d - 1e-5, 2.0)] {
+        let posed = p.pose(&model.mesh, t, Parts::All);
+        let (lo, hi) = posed
+            .positions
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), q| {
+                (lo.min(q.y), hi.max(q.y))
+            });
+        assert!((lo + 1.0).abs() < 1e-3, "at {t}: bottom {lo}");
+        assert!((hi - top).abs() < 0.02, "at {t}: top {hi}, not {top}");
+    }
+}
+
 /// FBX lights and cameras on request: Blender's camera 10 m in front of
 /// the cube looking at it (its exporter writes the lens as a 63.7-degree
 /// horizontal field at 16:9, 38.5 degrees vertically), a point light

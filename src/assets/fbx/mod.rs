@@ -15,13 +15,11 @@
 //! - textures embedded in the file, or external (relative to the FBX file,
 //!   then by name beside it); a missing one is a warning, as for glTF.
 //!
-//! - skins and animation stacks (`rig`), played as glTF animation is:
-//!   `model.animation` names a stack or gives its index.
+//! - skins, blend shapes and animation stacks (`rig`), played as glTF
+//!   animation is: `model.animation` names a stack or gives its index.
 //!
 //! - lights and cameras (`lights`), for `model.lights` and
 //!   `model.cameras`.
-//!
-//! Not read yet: blend shapes (drawn without them, with a warning).
 
 mod lights;
 mod rig;
@@ -134,13 +132,8 @@ pub fn load(path: &Path, input: &Input) -> Result<FbxModel, Error> {
             "the FBX file has no mesh with faces",
         ));
     }
-    if !scene.blend_deformers.is_empty() {
-        model.warnings.push(format!(
-            "{}: blend shapes in FBX files are not read yet; the model is drawn without them",
-            path.display()
-        ));
-    }
-    if !scene.skin_deformers.is_empty() || !scene.anim_stacks.is_empty() {
+    let rigged = !scene.skin_deformers.is_empty() || !scene.blend_deformers.is_empty();
+    if rigged || !scene.anim_stacks.is_empty() {
         model.rig = Some(rig::rig(&scene, &instances).map(Arc::new));
     }
     model.lights = lights::lights(&scene, &mut model.warnings);

@@ -6,14 +6,15 @@
 //! node space for the others), and each animation stack baked by ufbx
 //! into linear keys of translation, rotation and scale per node.
 //!
-//! Blend shapes are not read: a file with them is drawn without them,
-//! with a warning.
+//! Blend shapes are morph targets: each blend channel's full-weight shape
+//! (in-between shapes are not read), its weight the node's default, and
+//! its `DeformPercent` keys a weights channel of the stack's clip.
 
 use glam::{Mat4, Quat, Vec3};
 
 use super::{matrix, vec3};
 use crate::assets::clip::{Channel, ChannelPath, Clip, Interpolation};
-use crate::assets::gltf_pose::Influences;
+use crate::assets::gltf_pose::{Influences, Target};
 use crate::assets::rig::{Rig, RigNode, RigSkin, Segment, SegmentNormals};
 
 /// The loaded mesh's vertices of one mesh instance: where they start and,
@@ -40,6 +41,15 @@ pub(super) fn rig(scene: &ufbx::Scene, instances: &[Instance]) -> Result<Rig, St
             }
         })
         .collect();
+    let mut nodes = nodes;
+    for inst in instances {
+        if let Some(mesh) = &scene.nodes[inst.node].mesh {
+            nodes[inst.node].weights = blend_channels(mesh)
+                .iter()
+                .map(|c| finite(c.weight))
+                .collect();
+        }
+    }
     let order = parents_first(&nodes)?;
     let skins: Vec<RigSkin> = scene
         .skin_deformers
@@ -68,7 +78,7 @@ pub(super) fn rig(scene: &ufbx::Scene, instances: &[Instance]) -> Result<Rig, St
     let clips = scene
         .anim_stacks
         .iter()
-        .map(|s| (s.element.name.to_string(), clip(scene, s)))
+        .map(|s| (s.element.name.to_string(), clip(scene, s, instances)))
         .collect();
     Ok(Rig {
         nodes,
@@ -148,6 +158,11 @@ fn segment(scene: &ufbx::Scene, inst: &Instance) -> Result<Segment, String> {
         ),
         None => (None, Vec::new()),
     };
+    let linear = glam::Mat3::from_mat4(to_node);
+    let targets = blend_channels(mesh)
+        .iter()
+        .map(|c| target(mesh, c, inst, linear))
+        .collect();
     Ok(Segment {
         first: inst.first,
         order: None,
@@ -155,9 +170,58 @@ fn segment(scene: &ufbx::Scene, inst: &Instance) -> Result<Segment, String> {
         skin: skin_index,
         positions,
         normals: SegmentNormals::Vertex(normals),
-        targets: Vec::new(),
+        targets,
         influences,
     })
+}
+
+/// The blend channels of `mesh`'s blend deformers, in order.
+fn blend_channels(mesh: &ufbx::Mesh) -> Vec<&ufbx::BlendChannel> {
+    mesh.blend_deformers
+        .iter()
+        .flat_map(|d| d.channels.iter().map(|c| &**c))
+        .collect()
+}
+
+/// `v` as f32, 0 where not finite.
+fn finite(v: f64) -> f32 {
+    if v.is_finite() { v as f32 } else { 0.0 }
+}
+
+/// Channel `c`'s full-weight shape as a morph target of `inst`'s
+/// vertices (offsets turned by `linear`, the segment's placement).
+fn target(
+    mesh: &ufbx::Mesh,
+    c: &ufbx::BlendChannel,
+    inst: &Instance,
+    linear: glam::Mat3,
+) -> Target {
+    let shape = c
+        .target_shape
+        .as_ref()
+        .or_else(|| c.keyframes.iter().last().map(|k| &k.shape));
+    let mut offsets = vec![Vec3::ZERO; mesh.num_vertices];
+    if let Some(shape) = shape {
+        for (v, d) in shape
+            .offset_vertices
+            .iter()
+            .zip(shape.position_offsets.iter())
+        {
+            if let Some(o) = offsets.get_mut(*v as usize) {
+                let d = vec3(d);
+                *o = if d.is_finite() {
+                    linear * d
+                } else {
+                    Vec3::ZERO
+                };
+            }
+        }
+    }
+    Target {
+        positions: Some(inst.vertices.iter().map(|&v| offsets[v as usize]).collect()),
+        normals: None,
+        tangents: None,
+    }
 }
 
 /// Vertex `v`'s eight heaviest bone weights in skin `s`.
@@ -192,8 +256,13 @@ fn influences(s: &ufbx::SkinDeformer, v: u32) -> Influences {
     out
 }
 
-/// Animation stack `stack` baked into linear keys per node.
-fn clip(scene: &ufbx::Scene, stack: &ufbx::AnimStack) -> Result<Clip, String> {
+/// Animation stack `stack` baked into linear keys per node, and the blend
+/// channels' weights of `instances`.
+fn clip(
+    scene: &ufbx::Scene,
+    stack: &ufbx::AnimStack,
+    instances: &[Instance],
+) -> Result<Clip, String> {
     let opts = ufbx::BakeOpts {
         trim_start_time: true,
         ..Default::default()
@@ -244,6 +313,13 @@ fn clip(scene: &ufbx::Scene, stack: &ufbx::AnimStack) -> Result<Clip, String> {
             });
         }
     }
+    for inst in instances {
+        if let Some(mesh) = &scene.nodes[inst.node].mesh
+            && let Some(c) = weights(&baked, &blend_channels(mesh), inst.node)
+        {
+            channels.push(c);
+        }
+    }
     for (k, c) in channels.iter().enumerate() {
         c.check().map_err(|e| format!("channel {k}: {e}"))?;
     }
@@ -256,4 +332,68 @@ fn clip(scene: &ufbx::Scene, stack: &ufbx::AnimStack) -> Result<Clip, String> {
         channels,
         duration,
     })
+}
+
+/// The weights channel of node `node` whose blend channels are `blend`,
+/// from their baked `DeformPercent` keys (None when none is animated):
+/// every channel sampled at every key time of any.
+fn weights(baked: &ufbx::BakedAnim, blend: &[&ufbx::BlendChannel], node: usize) -> Option<Channel> {
+    let keys: Vec<Option<&[ufbx::BakedVec3]>> = blend
+        .iter()
+        .map(|c| {
+            let e = baked
+                .elements
+                .iter()
+                .find(|e| e.element_id == c.element.element_id)?;
+            let p = e.props.iter().find(|p| &*p.name == "DeformPercent")?;
+            Some(p.keys.as_ref())
+        })
+        .collect();
+    let mut times: Vec<f64> = keys
+        .iter()
+        .flatten()
+        .flat_map(|k| k.iter().map(|k| k.time))
+        .collect();
+    if times.is_empty() {
+        return None;
+    }
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let mut values = Vec::with_capacity(times.len() * blend.len());
+    for &t in &times {
+        for (c, k) in blend.iter().zip(&keys) {
+            values.push(match k {
+                Some(k) => finite(sample(k, t) / 100.0),
+                None => finite(c.weight),
+            });
+        }
+    }
+    Some(Channel {
+        node,
+        path: ChannelPath::Weights,
+        interpolation: Interpolation::Linear,
+        times: times.iter().map(|&t| t as f32).collect(),
+        values,
+        width: blend.len(),
+    })
+}
+
+/// Keys `k` (x) at time `t`, linearly; the first before, the last after.
+fn sample(k: &[ufbx::BakedVec3], t: f64) -> f64 {
+    let Some(first) = k.first() else { return 0.0 };
+    if t <= first.time {
+        return first.value.x;
+    }
+    for w in k.windows(2) {
+        if t <= w[1].time {
+            let span = w[1].time - w[0].time;
+            let f = if span > 0.0 {
+                (t - w[0].time) / span
+            } else {
+                1.0
+            };
+            return w[0].value.x + (w[1].value.x - w[0].value.x) * f;
+        }
+    }
+    k.last().map_or(0.0, |l| l.value.x)
 }

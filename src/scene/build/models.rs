@@ -196,6 +196,12 @@ fn playback(
         ));
     }
     let rig = match &src.rig {
+        Some(Ok(r)) if r.clips.is_empty() => {
+            return err(format!(
+                "model.animation: {} has no animations",
+                md.path.get_ref()
+            ));
+        }
         None => {
             return err(format!(
                 "model.animation: {} has no animations",
