@@ -26,7 +26,7 @@ import threading
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-EXTS = (".gltf", ".glb", ".obj", ".stl", ".ply")
+EXTS = (".gltf", ".glb", ".obj", ".stl", ".ply", ".fbx", ".usd", ".usda", ".usdc", ".usdz", ".3mf")
 
 
 def sphere(n_lat, n_lon, r):
