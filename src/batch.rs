@@ -719,7 +719,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
         let text = format!("[[model]]\npath = \"t.obj\"\n[animation]\nframes = 12\n{extra}");
-        let opts = crate::scene::build::LoadOptions::default();
+        let opts = crate::scene::assemble::LoadOptions::default();
         Scene::from_text(&dir.join("shot.toml"), &text, &opts).unwrap()
     }
 

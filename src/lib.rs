@@ -1,7 +1,7 @@
 //! softraster: a data-driven CPU batch renderer.
 //!
 //! Data flows one way: scene file ([`scene::desc`]) -> loaded
-//! [`scene::Scene`] ([`scene::build`]) -> per-frame draw list
+//! [`scene::Scene`] ([`scene::assemble`]) -> per-frame draw list
 //! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
 //! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 
 /// The showcase's models and lights, small, with `cameras` and `animation`.
 fn scene(dir: &Path, cameras: &str, animation: &str) -> Scene {

@@ -10,7 +10,7 @@ use glam::Vec3;
 use serde_json::{Value, json};
 use softraster::render::FrameSetup;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 use softraster::scene::light::LightKind;
 
 /// A glTF file being written: one embedded buffer, accessors appended.

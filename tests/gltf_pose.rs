@@ -166,7 +166,7 @@ fn a_skinned_bar_takes_its_joints_default_pose() {
     std::fs::write(dir.join("s.toml"), text).unwrap();
     let scene = softraster::scene::Scene::load(
         &dir.join("s.toml"),
-        &softraster::scene::build::LoadOptions::default(),
+        &softraster::scene::assemble::LoadOptions::default(),
     )
     .unwrap();
     let f = common::render_frame(&scene, 0, 0);

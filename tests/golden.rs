@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use common::render_frame;
 use softraster::output::{Image8, png, resolve};
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 use softraster::scene::overrides::SetOverride;
 use softraster::tools::compare::{Metric, score};
 

@@ -13,7 +13,7 @@ use softraster::output::exr::read_channel;
 use softraster::procedural::{self, Builder};
 use softraster::render::Frame;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 
 /// A procedural mesh as OBJ text without a material library.
 fn obj(b: Builder) -> String {

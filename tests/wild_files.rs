@@ -251,7 +251,7 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
 #[test]
 fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     for file in ["cube.usda", "cube.usdc", "cube.usdz"] {
         let opts = LoadOptions {
@@ -298,7 +298,7 @@ fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
 #[test]
 fn usd_units_winding_subsets_and_display_colour() {
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/usd_subsets.usda");
     let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let model = &scene.models[0];
@@ -359,7 +359,7 @@ fn usd_units_winding_subsets_and_display_colour() {
 #[test]
 fn three_mf_cubes_arrive_in_metres_with_their_colours() {
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/colour_cubes.3mf");
     let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
@@ -405,7 +405,7 @@ fn three_mf_cubes_arrive_in_metres_with_their_colours() {
 fn fbx_skin_bends_with_its_animation_stack() {
     use softraster::assets::rig::Parts;
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     let opts = LoadOptions {
         sets: ["model.0.animation=0"]
@@ -451,7 +451,7 @@ fn fbx_skin_bends_with_its_animation_stack() {
 fn fbx_blend_shape_follows_its_keys() {
     use softraster::assets::rig::Parts;
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     let opts = LoadOptions {
         sets: ["model.0.animation=0"]
@@ -486,7 +486,7 @@ fn fbx_blend_shape_follows_its_keys() {
 #[test]
 fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     use softraster::scene::camera::Projection;
     use softraster::scene::light::LightKind;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
@@ -553,7 +553,7 @@ fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
 #[test]
 fn fbx_cubes_arrive_upright_in_metres_with_their_checker() {
     use softraster::scene::Scene;
-    use softraster::scene::build::LoadOptions;
+    use softraster::scene::assemble::LoadOptions;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     for file in ["cube_embedded.fbx", "cube_external.fbx"] {
         let opts = LoadOptions {

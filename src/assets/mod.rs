@@ -2,14 +2,13 @@
 //! USD and 3MF, textures from images.
 
 pub mod accessor;
-pub mod clip;
 pub mod dds;
 pub mod draco;
 pub mod environment;
 pub mod fbx;
 pub mod gltf;
-pub mod gltf_pose;
 pub mod input;
+pub mod keyframes;
 pub mod ktx2;
 pub mod mesh;
 pub mod meshopt;
@@ -20,7 +19,6 @@ pub mod rig;
 pub mod stl;
 pub mod text;
 pub mod texture;
-pub mod texture_cache;
 pub mod threemf;
 pub mod usd;
 

@@ -16,8 +16,8 @@
 use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::clip::{ChannelPath, Clip};
-use super::gltf_pose::{Influences, Target, joint_matrices, morph_vertex};
+use super::gltf::pose::{Influences, Target, joint_matrices, morph_vertex};
+use super::keyframes::{ChannelPath, Clip};
 use super::mesh::Mesh;
 
 #[derive(Debug, Clone)]

@@ -14,7 +14,7 @@ mod render;
 use softraster::batch::thread_pool;
 use softraster::error::Error;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 use softraster::scene::overrides::SetOverride;
 
 #[derive(Parser)]

@@ -12,7 +12,7 @@ use softraster::batch::{
 };
 use softraster::error::Error;
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 
 use super::inputs::{self, Input, Shard};
 use super::{Progress, RenderArgs, load_options, print_error};

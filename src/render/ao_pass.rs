@@ -3,7 +3,7 @@
 //! BVHs. It runs between visibility and shading, which multiplies the
 //! ambient term by it.
 
-use super::setup::FrameSetup;
+use super::frame_setup::FrameSetup;
 use crate::raytrace::Tracer;
 use crate::scene::settings::AoMethod;
 use crate::shade::ao::{self, AoView, GPixel};

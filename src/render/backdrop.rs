@@ -15,8 +15,8 @@ use std::sync::{Arc, Mutex};
 use glam::Vec4;
 use rayon::prelude::*;
 
+use super::frame_setup::FrameSetup;
 use super::rays::CameraRays;
-use super::setup::FrameSetup;
 use crate::scene::settings::Background;
 use crate::shade::env::EnvLight;
 

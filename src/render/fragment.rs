@@ -8,10 +8,10 @@
 use glam::{Vec3, Vec4};
 
 use super::backdrop::EnvBackground;
+use super::frame_setup::FrameSetup;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
 use super::light_tiles::Culling;
-use super::setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::setup::Tri;
 use crate::raytrace::Tracer;

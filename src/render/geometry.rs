@@ -8,7 +8,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::setup::FrameSetup;
+use super::frame_setup::FrameSetup;
 use super::vertex::{self, ModelVertices};
 use crate::assets::mesh::Mesh;
 use crate::raster::CullMode;
@@ -393,7 +393,7 @@ mod tests {
 
     /// The scene `text` loaded as if from a file in `dir`.
     fn scene_in(dir: &std::path::Path, text: &str) -> Scene {
-        let opts = crate::scene::build::LoadOptions::default();
+        let opts = crate::scene::assemble::LoadOptions::default();
         Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap()
     }
 

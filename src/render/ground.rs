@@ -19,8 +19,8 @@ use std::sync::OnceLock;
 
 use glam::{Vec3, Vec4};
 
+use super::frame_setup::FrameSetup;
 use super::rays::CameraRays;
-use super::setup::FrameSetup;
 use crate::raytrace::Tracer;
 use crate::scene::Light;
 use crate::scene::settings::Background;

@@ -11,7 +11,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::frame::Frame;
-use super::setup::FrameSetup;
+use super::frame_setup::FrameSetup;
 use super::vertex::ModelVertices;
 
 /// A projected end of a segment (or a point): screen position, 1/w and

@@ -24,7 +24,7 @@ use std::sync::{Arc, Mutex};
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::setup::FrameSetup;
+use super::frame_setup::FrameSetup;
 use super::vertex::ModelVertices;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};

@@ -5,7 +5,7 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::setup::FrameSetup;
+use super::frame_setup::FrameSetup;
 
 /// Vertices of one model after the vertex pass.
 pub(super) struct ModelVertices {

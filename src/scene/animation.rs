@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 
-use crate::assets::clip::Clip;
+use crate::assets::keyframes::Clip;
 use crate::assets::mesh::Mesh;
 use crate::assets::rig::{NodePose, Parts, Posed, Rig};
 use crate::scene::light::Light;

@@ -7,7 +7,7 @@
 //! rendered, and the renderer never writes into a `Scene`.
 
 pub mod animation;
-pub mod build;
+pub mod assemble;
 pub mod camera;
 pub mod desc;
 pub mod environment;
@@ -23,7 +23,7 @@ use glam::{Mat4, Vec3};
 
 use crate::assets::mesh::Mesh;
 pub use animation::Animation;
-pub use build::LoadOptions;
+pub use assemble::LoadOptions;
 pub use camera::Camera;
 pub use light::Light;
 pub use material::Material;

@@ -1,4 +1,4 @@
-//! The renderer's settings, as `scene::build` makes them from the file
+//! The renderer's settings, as `scene::assemble` makes them from the file
 //! (`scene::desc`) and its defaults: the types every stage reads. The file's
 //! spelling of a value is `desc`'s business; a change to the file format
 //! stops at `build`.

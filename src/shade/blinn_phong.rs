@@ -16,7 +16,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::env::dominant_direction_lanes;
-use super::env_sampled::{self, Lobes};
+use super::env::sampled::{self as env_sampled, Lobes};
 use super::lanes::{Lanes, Lit};
 use super::{Fetch, ShadeContext};
 use crate::scene::Material;

@@ -4,7 +4,6 @@
 pub mod ao;
 pub mod blinn_phong;
 pub mod env;
-pub mod env_sampled;
 pub mod gouraud;
 pub mod iridescence;
 pub mod lanes;
@@ -53,7 +52,7 @@ pub struct ShadeContext<'a> {
     /// `method = "sampled"`: the environment's sampler, the frame's rays and
     /// the sample count; replaces the prefiltered light of `env`.
     pub env_sampled: Option<(
-        &'a env_sampled::EnvSampler,
+        &'a env::sampled::EnvSampler,
         &'a crate::raytrace::Tracer<'a>,
         u32,
     )>,

@@ -10,7 +10,7 @@ use crate::error::Error;
 use crate::output;
 use crate::render::{Frame, Renderer};
 use crate::scene::Scene;
-use crate::scene::build::LoadOptions;
+use crate::scene::assemble::LoadOptions;
 
 /// One method's row of an accuracy table.
 #[derive(Debug, Clone)]

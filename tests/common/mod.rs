@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use softraster::render::{Frame, Renderer};
 use softraster::scene::Scene;
-use softraster::scene::build::LoadOptions;
+use softraster::scene::assemble::LoadOptions;
 
 /// One frame of one camera, through the library's one entry for a frame.
 pub fn render_frame(scene: &Scene, camera: usize, frame: u32) -> Frame {

@@ -13,8 +13,8 @@
 use glam::{Mat4, Quat, Vec3};
 
 use super::{matrix, vec3};
-use crate::assets::clip::{Channel, ChannelPath, Clip, Interpolation};
-use crate::assets::gltf_pose::{Influences, Target};
+use crate::assets::gltf::pose::{Influences, Target};
+use crate::assets::keyframes::{Channel, ChannelPath, Clip, Interpolation};
 use crate::assets::rig::{Rig, RigNode, RigSkin, Segment, SegmentNormals};
 
 /// The loaded mesh's vertices of one mesh instance: where they start and,

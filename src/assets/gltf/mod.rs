@@ -32,6 +32,7 @@ mod accessors;
 mod buffers;
 mod lights;
 mod materials;
+pub mod pose;
 
 use accessors::*;
 use buffers::*;
@@ -272,7 +273,7 @@ fn rig(
     let skins = doc
         .skins()
         .map(|s| {
-            let (joints, inverse_bind) = super::gltf_pose::read_skin(&s, buffers)?;
+            let (joints, inverse_bind) = pose::read_skin(&s, buffers)?;
             Ok(RigSkin {
                 joints,
                 inverse_bind,
@@ -285,7 +286,7 @@ fn rig(
         skins,
         segments,
         light_nodes,
-        clips: super::gltf_pose::read_clips(doc, buffers),
+        clips: pose::read_clips(doc, buffers),
     })
 }
 
@@ -359,7 +360,7 @@ fn walk_nodes(
     let mut seen = vec![false; doc.nodes().count()];
     // Every node's default world transform, for skins' joints.
     let worlds = if doc.skins().next().is_some() {
-        super::gltf_pose::node_worlds(doc)?
+        pose::node_worlds(doc)?
     } else {
         Vec::new()
     };
@@ -684,7 +685,7 @@ impl Builder {
             .segments
             .is_some()
             .then(|| (attributes.positions.clone(), attributes.normals.clone()));
-        super::gltf_pose::apply_morph(prim, pose.weights, buffers, &mut attributes)?;
+        pose::apply_morph(prim, pose.weights, buffers, &mut attributes)?;
         let Attributes {
             positions,
             normals,
@@ -697,9 +698,7 @@ impl Builder {
         // A skinned primitive: each vertex placed by its joints (the node's
         // own transform does not apply).
         let skinned = match pose.skin {
-            Some((skin, worlds)) => Some(super::gltf_pose::skin_matrices(
-                prim, skin, worlds, buffers, n,
-            )?),
+            Some((skin, worlds)) => Some(pose::skin_matrices(prim, skin, worlds, buffers, n)?),
             None => None,
         };
         let place = |s: usize| skinned.as_ref().map_or(world, |k| k[s]);
@@ -803,12 +802,11 @@ impl Builder {
                 pose.node
             )
         };
-        let targets = super::gltf_pose::read_targets(prim, buffers, n).map_err(context)?;
+        let targets = pose::read_targets(prim, buffers, n).map_err(context)?;
         let (skin, influences) = match pose.skin {
             Some((skin, _)) => {
                 let count = skin.joints().count();
-                let inf =
-                    super::gltf_pose::read_influences(prim, buffers, n, count).map_err(context)?;
+                let inf = pose::read_influences(prim, buffers, n, count).map_err(context)?;
                 (Some(skin.index()), inf)
             }
             None => (None, Vec::new()),

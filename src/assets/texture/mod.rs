@@ -13,6 +13,7 @@
 //! both directions. Textures are cache-bound on minified models, so this is
 //! worth a few shifts per fetch.
 
+pub mod cache;
 mod lanes;
 
 use std::path::Path;

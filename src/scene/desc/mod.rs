@@ -157,7 +157,7 @@ impl<'de> Deserialize<'de> for VideoQualityDesc {
     }
 }
 
-/// `[render]`. The defaults are `scene::build::settings`'s (and the
+/// `[render]`. The defaults are `scene::assemble::settings`'s (and the
 /// format's documentation).
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]

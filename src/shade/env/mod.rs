@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use crate::assets::environment::EnvImage;
 
 mod octahedral;
+pub mod sampled;
 
 use octahedral::Octahedral;
 

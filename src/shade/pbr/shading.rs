@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::{COAT_F0, Coat, Films, PbrColor, Sheens, brdf, env_brdf, environment, f_cos, splat3};
 use crate::scene::Material;
-use crate::shade::env_sampled::{self, Lobes};
+use crate::shade::env::sampled::{self as env_sampled, Lobes};
 use crate::shade::lanes::{Lanes, Lit};
 use crate::shade::{Fetch, ShadeContext};
 use crate::simd::{Lane, Mask, V3, clamp01};

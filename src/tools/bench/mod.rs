@@ -17,7 +17,7 @@ use crate::error::Error;
 use crate::output;
 use crate::render::{Frame, FrameSequence, Renderer};
 use crate::scene::Scene;
-use crate::scene::build::LoadOptions;
+use crate::scene::assemble::LoadOptions;
 use crate::scene::light::{Light, LightKind};
 use models::{floor_disc, obj_bounds, resampled_diablo3, spherical_uv_model, subdivided};
 

@@ -644,7 +644,7 @@ fn depth_scene(dir: &Path, mode: &str) -> Result<Scene, Error> {
     Scene::from_text(
         &dir.join("depth.toml"),
         &text,
-        &crate::scene::build::LoadOptions::plain(),
+        &crate::scene::assemble::LoadOptions::plain(),
     )
 }
 

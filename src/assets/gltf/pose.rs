@@ -9,8 +9,8 @@
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 
-use super::accessor::{Attributes, read_floats};
-use super::clip::{Channel, ChannelPath, Clip, Interpolation};
+use crate::assets::accessor::{Attributes, read_floats};
+use crate::assets::keyframes::{Channel, ChannelPath, Clip, Interpolation};
 
 /// World matrix of every node at its default transform, following its
 /// parents (a node without a parent is a root). A cycle is an error.

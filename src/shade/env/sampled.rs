@@ -15,10 +15,10 @@ use std::f32::consts::PI;
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::env::{direction_to_uv, uv_to_direction};
-use super::pbr::{self, PbrColor};
+use super::{direction_to_uv, uv_to_direction};
 use crate::assets::environment::EnvImage;
 use crate::raytrace::Tracer;
+use crate::shade::pbr::{self, PbrColor};
 
 /// Luminance-proportional sampling of an environment image.
 #[derive(Debug, Clone)]

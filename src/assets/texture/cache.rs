@@ -13,7 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::texture::Texture;
+use super::Texture;
 use crate::error::Error;
 
 /// A cache directory.
@@ -71,7 +71,7 @@ impl TextureCache {
             return Ok((t, Lookup::Hit, None));
         }
         let t = decode()?;
-        let chain = super::mip::build_chain(&t);
+        let chain = crate::assets::mip::build_chain(&t);
         let warning = write_atomically(&path, &t.to_cache_bytes(&chain))
             .err()
             .map(|e| {

@@ -42,7 +42,7 @@ pub struct LoadOptions {
     /// an unknown MTL key, a setting without effect) is an error.
     pub strict: bool,
     /// `--cache DIR`: decoded textures and their mip chains kept between
-    /// runs (`assets::texture_cache`).
+    /// runs (`assets::texture::cache`).
     pub cache: Option<PathBuf>,
     /// `--max-memory`: the memory budget (wins over `render.max_memory`;
     /// neither: `assets::input::default_budget`). Sizes read from asset
@@ -207,7 +207,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     )?;
     let mut warnings = settings::no_effect_warnings(d, ctx, &settings);
     let cache = match &opts.cache {
-        Some(dir) => Some(crate::assets::texture_cache::TextureCache::new(dir)?),
+        Some(dir) => Some(crate::assets::texture::cache::TextureCache::new(dir)?),
         None => None,
     };
     let input = opts.input(&settings, &scene_dir);
