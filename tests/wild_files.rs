@@ -250,44 +250,8 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
 /// beside the file or inside the package.
 #[test]
 fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
     for file in ["cube.usda", "cube.usdc", "cube.usdz"] {
-        let opts = LoadOptions {
-            sets: ["output.width=96", "output.height=96"]
-                .iter()
-                .map(|s| s.parse().unwrap())
-                .collect(),
-            ..Default::default()
-        };
-        let scene = Scene::load(&dir.join(file), &opts).unwrap_or_else(|e| panic!("{e}"));
-        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
-        let (lo, hi) = scene.models[0].mesh.bounds();
-        let across = 30f32.to_radians().cos() + 30f32.to_radians().sin();
-        for (got, want) in [
-            (lo.y, 0.0),
-            (hi.y, 2.0),
-            (hi.x, across),
-            (-lo.x, across),
-            (hi.z, across),
-        ] {
-            assert!((got - want).abs() < 1e-3, "{file}: {lo} {hi}");
-        }
-        let f = common::render_frame(&scene, 0, 0);
-        let (mut red, mut white, mut covered) = (0, 0, 0);
-        for (i, c) in f.color.iter().enumerate() {
-            if !f.depth[i].is_finite() {
-                continue;
-            }
-            covered += 1;
-            red += (c.x > 2.0 * c.y.max(c.z) && c.x > 0.2) as usize;
-            white += (c.min_element() > 0.3 && c.y > 0.7 * c.x) as usize;
-        }
-        assert!(
-            red * 5 > covered && white * 5 > covered,
-            "{file}: {red} red, {white} white of {covered}"
-        );
+        check_blender_cube(file);
     }
 }
 
@@ -297,10 +261,7 @@ fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
 /// no material, and an invisible mesh is left out.
 #[test]
 fn usd_units_winding_subsets_and_display_colour() {
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/usd_subsets.usda");
-    let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_wild("usd_subsets.usda", &[]);
     let model = &scene.models[0];
     let mesh = &model.mesh;
     // The plate spans 2 m by 1 m, 1 m up; the marker reaches 1.3 m; the
@@ -358,10 +319,7 @@ fn usd_units_winding_subsets_and_display_colour() {
 /// materials (per object) and colour groups (per corner).
 #[test]
 fn three_mf_cubes_arrive_in_metres_with_their_colours() {
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild/colour_cubes.3mf");
-    let scene = Scene::load(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_wild("colour_cubes.3mf", &[]);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let mesh = &scene.models[0].mesh;
     assert_eq!(mesh.triangles.len(), 24);
@@ -404,17 +362,7 @@ fn three_mf_cubes_arrive_in_metres_with_their_colours() {
 #[test]
 fn fbx_skin_bends_with_its_animation_stack() {
     use softraster::assets::rig::Parts;
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
-    let opts = LoadOptions {
-        sets: ["model.0.animation=0"]
-            .iter()
-            .map(|s| s.parse().unwrap())
-            .collect(),
-        ..Default::default()
-    };
-    let scene = Scene::load(&dir.join("rigged.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_wild("rigged.fbx", &["model.0.animation=0"]);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let model = &scene.models[0];
     let p = model.playback.as_ref().expect("the stack plays");
@@ -450,17 +398,7 @@ fn fbx_skin_bends_with_its_animation_stack() {
 #[test]
 fn fbx_blend_shape_follows_its_keys() {
     use softraster::assets::rig::Parts;
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
-    let opts = LoadOptions {
-        sets: ["model.0.animation=0"]
-            .iter()
-            .map(|s| s.parse().unwrap())
-            .collect(),
-        ..Default::default()
-    };
-    let scene = Scene::load(&dir.join("shape_keys.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_wild("shape_keys.fbx", &["model.0.animation=0"]);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let model = &scene.models[0];
     let p = model.playback.as_ref().expect("the stack plays");
@@ -485,19 +423,12 @@ fn fbx_blend_shape_follows_its_keys() {
 /// the cube, all in Y-up metres.
 #[test]
 fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
-    use softraster::scene::Scene;
-    use softraster::scene::assemble::LoadOptions;
     use softraster::scene::camera::Projection;
     use softraster::scene::light::LightKind;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
-    let opts = LoadOptions {
-        sets: ["model.0.lights=true", "model.0.cameras=true"]
-            .iter()
-            .map(|s| s.parse().unwrap())
-            .collect(),
-        ..Default::default()
-    };
-    let scene = Scene::load(&dir.join("lit_camera.fbx"), &opts).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_wild(
+        "lit_camera.fbx",
+        &["model.0.lights=true", "model.0.cameras=true"],
+    );
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let close = |a: glam::Vec3, b: glam::Vec3| (a - b).length() < 1e-3;
     let cam = &scene.cameras[0];
@@ -552,44 +483,53 @@ fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
 /// checker (embedded in one file, beside the other) shows red and white.
 #[test]
 fn fbx_cubes_arrive_upright_in_metres_with_their_checker() {
-    use softraster::scene::Scene;
+    for file in ["cube_embedded.fbx", "cube_external.fbx"] {
+        check_blender_cube(file);
+    }
+}
+
+/// Scene `file` of tests/wild (a model file: its one-line scene) with
+/// `sets` applied as `--set` does.
+fn load_wild(file: &str, sets: &[&str]) -> softraster::scene::Scene {
     use softraster::scene::assemble::LoadOptions;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
-    for file in ["cube_embedded.fbx", "cube_external.fbx"] {
-        let opts = LoadOptions {
-            sets: ["output.width=96", "output.height=96"]
-                .iter()
-                .map(|s| s.parse().unwrap())
-                .collect(),
-            ..Default::default()
-        };
-        let scene = Scene::load(&dir.join(file), &opts).unwrap_or_else(|e| panic!("{e}"));
-        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
-        let (lo, hi) = scene.models[0].mesh.bounds();
-        // Up is +Y, from 0 to 2; across, cos 30 + sin 30 on either side.
-        let across = 30f32.to_radians().cos() + 30f32.to_radians().sin();
-        for (got, want) in [
-            (lo.y, 0.0),
-            (hi.y, 2.0),
-            (hi.x, across),
-            (-lo.x, across),
-            (hi.z, across),
-        ] {
-            assert!((got - want).abs() < 1e-3, "{file}: {lo} {hi}");
-        }
-        let f = common::render_frame(&scene, 0, 0);
-        let (mut red, mut white, mut covered) = (0, 0, 0);
-        for (i, c) in f.color.iter().enumerate() {
-            if !f.depth[i].is_finite() {
-                continue;
-            }
-            covered += 1;
-            red += (c.x > 2.0 * c.y.max(c.z) && c.x > 0.2) as usize;
-            white += (c.min_element() > 0.3 && c.y > 0.7 * c.x) as usize;
-        }
-        assert!(
-            red * 5 > covered && white * 5 > covered,
-            "{file}: {red} red, {white} white of {covered}"
-        );
+    let opts = LoadOptions {
+        sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
+        ..Default::default()
+    };
+    softraster::scene::Scene::load(&dir.join(file), &opts).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+/// Blender's 2-unit cube of tests/wild `file` (turned 30 degrees about its
+/// up axis, standing on the ground, a red and white checker): upright in
+/// metres, red and white in a 96x96 frame, without a warning.
+fn check_blender_cube(file: &str) {
+    let scene = load_wild(file, &["output.width=96", "output.height=96"]);
+    assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+    let (lo, hi) = scene.models[0].mesh.bounds();
+    // Up is +Y, from 0 to 2; across, cos 30 + sin 30 on either side.
+    let across = 30f32.to_radians().cos() + 30f32.to_radians().sin();
+    for (got, want) in [
+        (lo.y, 0.0),
+        (hi.y, 2.0),
+        (hi.x, across),
+        (-lo.x, across),
+        (hi.z, across),
+    ] {
+        assert!((got - want).abs() < 1e-3, "{file}: {lo} {hi}");
     }
+    let f = common::render_frame(&scene, 0, 0);
+    let (mut red, mut white, mut covered) = (0, 0, 0);
+    for (i, c) in f.color.iter().enumerate() {
+        if !f.depth[i].is_finite() {
+            continue;
+        }
+        covered += 1;
+        red += (c.x > 2.0 * c.y.max(c.z) && c.x > 0.2) as usize;
+        white += (c.min_element() > 0.3 && c.y > 0.7 * c.x) as usize;
+    }
+    assert!(
+        red * 5 > covered && white * 5 > covered,
+        "{file}: {red} red, {white} white of {covered}"
+    );
 }

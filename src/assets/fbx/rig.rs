@@ -272,46 +272,37 @@ fn clip(
     let mut channels = Vec::new();
     for n in baked.nodes.iter() {
         let node = n.typed_id as usize;
-        let times = |t: &mut dyn Iterator<Item = f64>| t.map(|t| t as f32).collect::<Vec<f32>>();
-        let vec3s = |keys: &[ufbx::BakedVec3]| {
-            keys.iter()
-                .flat_map(|k| [k.value.x as f32, k.value.y as f32, k.value.z as f32])
-                .collect::<Vec<f32>>()
+        let mut push = |path, times: Vec<f32>, values: Vec<f32>, width| {
+            if !times.is_empty() {
+                channels.push(Channel {
+                    node,
+                    path,
+                    interpolation: Interpolation::Linear,
+                    times,
+                    values,
+                    width,
+                });
+            }
         };
-        if !n.translation_keys.is_empty() {
-            channels.push(Channel {
-                node,
-                path: ChannelPath::Translation,
-                interpolation: Interpolation::Linear,
-                times: times(&mut n.translation_keys.iter().map(|k| k.time)),
-                values: vec3s(&n.translation_keys),
-                width: 3,
-            });
-        }
-        if !n.rotation_keys.is_empty() {
-            channels.push(Channel {
-                node,
-                path: ChannelPath::Rotation,
-                interpolation: Interpolation::Linear,
-                times: times(&mut n.rotation_keys.iter().map(|k| k.time)),
-                values: n
-                    .rotation_keys
-                    .iter()
-                    .flat_map(|k| quat(&k.value).to_array())
-                    .collect(),
-                width: 4,
-            });
-        }
-        if !n.scale_keys.is_empty() {
-            channels.push(Channel {
-                node,
-                path: ChannelPath::Scale,
-                interpolation: Interpolation::Linear,
-                times: times(&mut n.scale_keys.iter().map(|k| k.time)),
-                values: vec3s(&n.scale_keys),
-                width: 3,
-            });
-        }
+        let vec3s = |keys: &[ufbx::BakedVec3]| {
+            let times = keys.iter().map(|k| k.time as f32).collect();
+            let values = keys
+                .iter()
+                .flat_map(|k| [k.value.x as f32, k.value.y as f32, k.value.z as f32])
+                .collect();
+            (times, values)
+        };
+        let (t, v) = vec3s(&n.translation_keys);
+        push(ChannelPath::Translation, t, v, 3);
+        let keys = &n.rotation_keys;
+        let t = keys.iter().map(|k| k.time as f32).collect();
+        let v = keys
+            .iter()
+            .flat_map(|k| quat(&k.value).to_array())
+            .collect();
+        push(ChannelPath::Rotation, t, v, 4);
+        let (t, v) = vec3s(&n.scale_keys);
+        push(ChannelPath::Scale, t, v, 3);
     }
     for inst in instances {
         if let Some(mesh) = &scene.nodes[inst.node].mesh

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::cameras::Bounds;
 use super::materials::{self, MtlSource, SourceMaterial};
 use super::{get, lights};
-use crate::assets::gltf::{GltfCamera, GltfLight, GltfModel, ImageSource};
+use crate::assets::gltf::{GltfCamera, GltfLight, GltfMaterial, GltfModel, ImageSource};
 use crate::assets::input::Input;
 use crate::assets::mesh::Mesh;
 use crate::assets::obj::{self, MapSpec};
@@ -556,6 +556,22 @@ pub(super) fn bounds(models: &[Model]) -> Bounds {
 }
 
 impl SourceModel {
+    /// A model of metallic-roughness materials with nothing more to
+    /// import (no rig, lights or cameras).
+    fn pbr(mesh: Mesh, materials: Vec<GltfMaterial>, warnings: Vec<String>) -> SourceModel {
+        SourceModel {
+            mesh,
+            materials: materials
+                .into_iter()
+                .map(|m| SourceMaterial::Gltf(Box::new(m)))
+                .collect(),
+            gltf: None,
+            rig: None,
+            imported: None,
+            warnings,
+        }
+    }
+
     fn load(path: &Path, input: &Input) -> Result<SourceModel, Error> {
         let ext = path
             .extension()
@@ -577,46 +593,16 @@ impl SourceModel {
             })
         } else if ext == "fbx" {
             let f = crate::assets::fbx::load(path, input)?;
-            Ok(SourceModel {
-                mesh: f.mesh,
-                materials: f
-                    .materials
-                    .into_iter()
-                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
-                    .collect(),
-                gltf: None,
-                rig: f.rig,
-                imported: Some((f.lights, f.cameras)),
-                warnings: f.warnings,
-            })
+            let mut m = SourceModel::pbr(f.mesh, f.materials, f.warnings);
+            m.rig = f.rig;
+            m.imported = Some((f.lights, f.cameras));
+            Ok(m)
         } else if matches!(ext.as_str(), "usd" | "usda" | "usdc" | "usdz") {
             let u = crate::assets::usd::load(path, input)?;
-            Ok(SourceModel {
-                mesh: u.mesh,
-                materials: u
-                    .materials
-                    .into_iter()
-                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
-                    .collect(),
-                gltf: None,
-                rig: None,
-                imported: None,
-                warnings: u.warnings,
-            })
+            Ok(SourceModel::pbr(u.mesh, u.materials, u.warnings))
         } else if ext == "3mf" {
             let t = crate::assets::threemf::load(path, input)?;
-            Ok(SourceModel {
-                mesh: t.mesh,
-                materials: t
-                    .materials
-                    .into_iter()
-                    .map(|m| SourceMaterial::Gltf(Box::new(m)))
-                    .collect(),
-                gltf: None,
-                rig: None,
-                imported: None,
-                warnings: t.warnings,
-            })
+            Ok(SourceModel::pbr(t.mesh, t.materials, t.warnings))
         } else if ext == "stl" || ext == "ply" {
             let mesh = if ext == "stl" {
                 crate::assets::stl::load(path, input)?
