@@ -21,6 +21,7 @@
 //! dialects (MDL, MaterialX: such meshes get the default material).
 
 mod material;
+mod trial;
 
 use std::path::Path;
 
@@ -52,6 +53,15 @@ const MAX_PRIMS: usize = 1 << 20;
 /// the crate, and in the sandbox each must lie in the file's folder).
 pub fn load(path: &Path, input: &Input) -> Result<UsdModel, Error> {
     let bytes = input.read(path, None, None)?;
+    trial::survives(input.budget(), || {
+        let _ = read(path, input, &bytes);
+    })
+    .map_err(|m| Error::asset(path, None, m))?;
+    read(path, input, &bytes)
+}
+
+/// `load` of the file at `path`, whose bytes are `bytes`.
+fn read(path: &Path, input: &Input, bytes: &[u8]) -> Result<UsdModel, Error> {
     let fail = |m: String| Error::asset(path, None, m);
     let name = path
         .to_str()
@@ -63,7 +73,7 @@ pub fn load(path: &Path, input: &Input) -> Result<UsdModel, Error> {
             input.confine(Path::new(&layer), Some(path))?;
         }
     }
-    let package = material::Package::of(path, &bytes);
+    let package = material::Package::of(path, bytes);
     let mut reader = Reader {
         stage: &stage,
         dir: path.parent().unwrap_or(Path::new("")),
