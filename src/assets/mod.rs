@@ -7,6 +7,7 @@ pub mod draco;
 pub mod environment;
 pub mod fbx;
 pub mod gltf;
+pub mod guard;
 pub mod input;
 pub mod keyframes;
 pub mod ktx2;

@@ -111,10 +111,10 @@ fn read(path: &Path, input: &Input, bytes: &[u8]) -> Result<UsdModel, Error> {
 /// Runs `f`, turning a panic inside the crate into an error (a file that
 /// trips it is bad input, never a crash).
 fn guarded<T>(f: impl FnOnce() -> anyhow::Result<T>) -> Result<T, String> {
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+    match super::guard::catch(f) {
         Ok(Ok(v)) => Ok(v),
         Ok(Err(e)) => Err(format!("{e:#}")),
-        Err(_) => Err("the USD reader failed on this file".into()),
+        Err(()) => Err("the USD reader failed on this file".into()),
     }
 }
 
