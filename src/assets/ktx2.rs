@@ -229,7 +229,7 @@ fn basis(b: &[u8], width: u32, height: u32) -> Result<Decoded, String> {
         t.transcode(0, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE)
             .map_err(|e| format!("KTX2 Basis Universal data cannot be transcoded ({e:?})"))
     };
-    let rgba = super::guard::catch(run).map_err(|_| {
+    let rgba = super::guard::catch(run).ok_or_else(|| {
         "KTX2 Basis Universal data is damaged (the transcoder failed)".to_string()
     })??;
     let n = width as usize * height as usize;

@@ -112,9 +112,9 @@ fn read(path: &Path, input: &Input, bytes: &[u8]) -> Result<UsdModel, Error> {
 /// trips it is bad input, never a crash).
 fn guarded<T>(f: impl FnOnce() -> anyhow::Result<T>) -> Result<T, String> {
     match super::guard::catch(f) {
-        Ok(Ok(v)) => Ok(v),
-        Ok(Err(e)) => Err(format!("{e:#}")),
-        Err(()) => Err("the USD reader failed on this file".into()),
+        Some(Ok(v)) => Ok(v),
+        Some(Err(e)) => Err(format!("{e:#}")),
+        None => Err("the USD reader failed on this file".into()),
     }
 }
 
