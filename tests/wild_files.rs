@@ -247,18 +247,20 @@ fn fuzz_found_inputs_are_refused_not_panicked_on() {
 
 /// USD through openusd: Blender's cube as text, binary and package
 /// arrives as the FBX one does (Z up and metres converted), its checker
-/// beside the file or inside the package.
+/// beside the file or inside the package; with its coordinates named
+/// `UVMap` instead of `st`, the same.
 #[test]
 fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
-    for file in ["cube.usda", "cube.usdc", "cube.usdz"] {
+    for file in ["cube.usda", "cube.usdc", "cube.usdz", "cube_uvmap.usda"] {
         check_blender_cube(file);
     }
 }
 
 /// A hand-written USD file: no `metersPerUnit` is centimetres, a
 /// left-handed plate faces up once its winding is reversed, a GeomSubset
-/// binds its own material to one face, `displayColor` colours a mesh with
-/// no material, and an invisible mesh is left out.
+/// binds its own material to one face, indexed coordinates are looked up,
+/// `displayColor` colours a mesh with no material, and an invisible mesh
+/// is left out.
 #[test]
 fn usd_units_winding_subsets_and_display_colour() {
     let scene = load_wild("usd_subsets.usda", &[]);
@@ -306,6 +308,18 @@ fn usd_units_winding_subsets_and_display_colour() {
     let (left, right) = (colour_of(-1.0), colour_of(1.0));
     assert!(left.y > 0.5 && left.z < 0.2, "left face {left}");
     assert!(right.z > 0.5 && right.y < 0.2, "right face {right}");
+    // The indexed coordinates: (0, 0) on the left face, (1, 1) on the
+    // right (t flipped to the image's rows: (0, 1) and (1, 0)).
+    for (p, uv) in mesh.positions.iter().zip(&mesh.uvs) {
+        if p.y == 1.0 && p.x != 0.0 {
+            let want = if p.x < 0.0 {
+                glam::Vec2::new(0.0, 1.0)
+            } else {
+                glam::Vec2::new(1.0, 0.0)
+            };
+            assert_eq!(*uv, want, "at {p}");
+        }
+    }
     // The marker's orange is its vertex colour.
     let orange = mesh
         .colors

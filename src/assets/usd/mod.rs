@@ -206,7 +206,7 @@ impl Reader<'_> {
         let left = matches!(prim.attribute("orientation").get::<Value>()?,
             Some(Value::Token(t)) if t.as_str() == "leftHanded");
         let normals = Primvar::read(prim, "normals", "primvars:normals")?;
-        let st = Primvar::read(prim, "primvars:st", "primvars:st")?;
+        let st = texture_coordinates(prim)?;
         let (face_material, bound) = self.face_materials(prim, counts.len())?;
         // displayColor stands in for a material, as USD viewers draw it.
         let colors = if bound {
@@ -360,6 +360,25 @@ impl Reader<'_> {
     }
 }
 
+/// `prim`'s texture coordinates: `primvars:st`, else its first other
+/// 2-vector primvar (exporters name them `UVMap`, `map1`, `st0`, ...).
+fn texture_coordinates(prim: &Prim) -> anyhow::Result<Primvar> {
+    let st = Primvar::read(prim, "primvars:st", "primvars:st")?;
+    if st.present() {
+        return Ok(st);
+    }
+    for name in prim.property_names()? {
+        let name = name.as_str();
+        if name.starts_with("primvars:") && !name.ends_with(":indices") {
+            let p = Primvar::read(prim, name, name)?;
+            if matches!(p.values, Values::V2(_)) {
+                return Ok(p);
+            }
+        }
+    }
+    Ok(st)
+}
+
 /// Whether `prim` is drawn: not `invisible`, and of the default or render
 /// purpose (guides and proxies are not).
 fn shown(prim: &Prim) -> anyhow::Result<bool> {
@@ -492,10 +511,10 @@ enum Interp {
 impl Primvar {
     /// Attribute `name` (else `fallback`) of `prim`.
     fn read(prim: &Prim, name: &str, fallback: &str) -> anyhow::Result<Primvar> {
-        let mut attr = prim.attribute(name);
+        let (mut attr, mut used) = (prim.attribute(name), name);
         let mut value = attr.get::<Value>()?;
         if value.is_none() && fallback != name {
-            attr = prim.attribute(fallback);
+            (attr, used) = (prim.attribute(fallback), fallback);
             value = attr.get::<Value>()?;
         }
         let values = match &value {
@@ -517,7 +536,7 @@ impl Primvar {
             _ => Interp::Vertex,
         };
         let indices = match prim
-            .attribute(format!("{}:indices", attr.path().name().unwrap_or_default()).as_str())
+            .attribute(format!("{used}:indices").as_str())
             .get::<Value>()?
         {
             Some(Value::IntVec(v)) => Some(v),
