@@ -256,6 +256,38 @@ fn usd_cubes_arrive_upright_in_metres_with_their_checker() {
     }
 }
 
+/// In the sandbox a USD file loads with its own layers, and one whose
+/// sublayer lies outside its folder is refused, naming that layer.
+#[test]
+fn usd_layers_stay_in_the_sandbox() {
+    use softraster::scene::Scene;
+    use softraster::scene::assemble::LoadOptions;
+    let opts = LoadOptions {
+        sandbox: true,
+        ..Default::default()
+    };
+    let wild = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/wild");
+    for file in ["cube.usda", "cube.usdz"] {
+        Scene::load(&wild.join(file), &opts).unwrap_or_else(|e| panic!("{file}: {e}"));
+    }
+    let dir = common::scratch("usd_sandbox");
+    std::fs::create_dir_all(dir.join("inner")).unwrap();
+    std::fs::copy(wild.join("usd_subsets.usda"), dir.join("outside.usda")).unwrap();
+    let model = dir.join("inner/model.usda");
+    std::fs::write(
+        &model,
+        "#usda 1.0\n(\n    subLayers = [@../outside.usda@]\n)\n",
+    )
+    .unwrap();
+    // Outside the sandbox the sublayer is read.
+    Scene::load(&model, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let e = Scene::load(&model, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("outside.usda") && e.contains("outside the model's folder"),
+        "{e}"
+    );
+}
+
 /// A hand-written USD file: no `metersPerUnit` is centimetres, a
 /// left-handed plate faces up once its winding is reversed, a GeomSubset
 /// binds its own material to one face, indexed coordinates are looked up,

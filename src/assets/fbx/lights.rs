@@ -1,10 +1,10 @@
 //! An FBX file's lights and cameras as glTF's (`model.lights`,
 //! `model.cameras`), placed by their nodes in Y-up metres.
 //!
-//! FBX lights carry no physical unit: ufbx's intensity (the file's
-//! `Intensity` over 100) is taken as candela for point and spot lights and
-//! as lux for directional ones, which is how glTF viewers that import FBX
-//! treat it. Spot cones: the file's inner and outer angles are full
+//! FBX lights carry no physical unit: the intensity ufbx reports is taken
+//! as candela for point and spot lights and as lux for directional ones.
+//! (Blender's exporter writes a 1000 W point light as 1000; its glTF
+//! exporter writes the same light as 54,351 cd, P / 4 pi x 683.) Spot cones: the file's inner and outer angles are full
 //! angles; glTF's are half. Area and volume lights are left out, with a
 //! warning. Cameras look along their node's +X with +Y up (FBX's
 //! convention), with the file's vertical field of view.

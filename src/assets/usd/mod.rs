@@ -23,7 +23,7 @@
 mod material;
 mod trial;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use openusd::schemas::geom::{Imageable, Xformable};
@@ -69,9 +69,7 @@ fn read(path: &Path, input: &Input, bytes: &[u8]) -> Result<UsdModel, Error> {
     let stage = guarded(|| Stage::open(name))
         .map_err(|e| fail(format!("cannot read the USD file: {e}")))?;
     if input.is_sandboxed() {
-        for layer in stage.layer_identifiers() {
-            input.confine(Path::new(&layer), Some(path))?;
-        }
+        confine_layers(&stage, path)?;
     }
     let package = material::Package::of(path, bytes);
     let mut reader = Reader {
@@ -106,6 +104,46 @@ fn read(path: &Path, input: &Input, bytes: &[u8]) -> Result<UsdModel, Error> {
         }
     }
     Ok(model)
+}
+
+/// In the sandbox: every layer the stage composed lies in the folder of
+/// `path` (the root file, which the sandbox has checked). The crate names
+/// layers by their resolved paths; anonymous layers have no file.
+fn confine_layers(stage: &Stage, path: &Path) -> Result<(), Error> {
+    let folder = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let folder = folder.canonicalize().map_err(|e| {
+        Error::asset(
+            path,
+            None,
+            format!("cannot resolve the model's folder: {e}"),
+        )
+    })?;
+    for layer in stage.layer_identifiers() {
+        if layer.starts_with("anon:") {
+            continue;
+        }
+        // "pkg.usdz[inner.usdc]": the package is the file.
+        let file = match layer.find('[') {
+            Some(k) => &layer[..k],
+            None => layer.as_str(),
+        };
+        let inside = Path::new(file)
+            .canonicalize()
+            .is_ok_and(|real| real.starts_with(&folder));
+        if !inside {
+            return Err(Error::Sandbox {
+                path: PathBuf::from(file),
+                message: format!(
+                    " (a layer of {}): outside the model's folder",
+                    path.display()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Runs `f`, turning a panic inside the crate into an error (a file that
