@@ -231,6 +231,146 @@ fn vertex_colours_illum_and_repeat_are_the_same_at_every_width() {
 }
 
 #[test]
+fn blended_layers_are_the_same_at_every_width() {
+    // Blended surfaces are layers the lanes shade (colour and opacity):
+    // a constant d, a map_d without alpha (its red channel) and a map_Kd
+    // with alpha, over a textured quad, as Blinn-Phong and as pbr, with
+    // one sample and with MSAA 4 (coverage-weighted layers).
+    let dir = scratch("lanes_blended");
+    let obj = "mtllib m.mtl\n\
+        v -1 -1 -0.5\nv 1 -1 -0.5\nv 1 1 -0.5\nv -1 1 -0.5\n\
+        vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nvn 0 0 1\n\
+        usemtl back\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n\
+        v -0.9 -0.9 0\nv 0.2 -0.9 0\nv 0.2 0.9 0\nv -0.9 0.9 0\n\
+        usemtl constant\nf 5/1/1 6/2/1 7/3/1\nf 5/1/1 7/3/1 8/4/1\n\
+        v -0.3 -0.8 0.2\nv 0.9 -0.8 0.2\nv 0.9 0.4 0.2\n\
+        usemtl grey_map\nf 9/1/1 10/2/1 11/3/1\n\
+        v -0.2 0.1 0.3\nv 0.95 0.1 0.3\nv 0.95 0.95 0.3\n\
+        usemtl alpha_map\nf 12/1/1 13/2/1 14/3/1\n";
+    let checker = |name: &str, alpha: bool| {
+        let img = image::RgbaImage::from_fn(16, 16, |x, y| {
+            let on = (x / 4 + y / 4) % 2 == 0;
+            let a = if alpha && on { 60 } else { 255 };
+            if on {
+                image::Rgba([230, 200, 40, a])
+            } else {
+                image::Rgba([20, 60, 200, a])
+            }
+        });
+        img.save(dir.join(name)).unwrap();
+    };
+    checker("checker.png", false);
+    checker("holes.png", true);
+    let grey = image::GrayImage::from_fn(8, 8, |x, _| image::Luma([(x * 30) as u8]));
+    grey.save(dir.join("grey.png")).unwrap();
+    let mtl = "newmtl back\nKd 1 1 1\nKs 0.3 0.3 0.3\nNs 30\nmap_Kd checker.png\n\
+        newmtl constant\nKd 0.2 0.5 0.9\nKs 0.5 0.5 0.5\nNs 60\nd 0.4\n\
+        newmtl grey_map\nKd 0.9 0.3 0.2\nd 0.9\nmap_d grey.png\n\
+        newmtl alpha_map\nKd 1 1 1\nmap_Kd holes.png\nd 0.8\n";
+    let scene = scene_in(&dir, QUAD_SCENE, &[("quad.obj", obj), ("m.mtl", mtl)]);
+    let blended =
+        |m: &softraster::scene::Material| m.alpha == softraster::scene::material::AlphaMode::Blend;
+    assert_eq!(
+        scene.models[0]
+            .materials
+            .iter()
+            .filter(|m| blended(m))
+            .count(),
+        3
+    );
+    for sets in [
+        vec![],
+        vec!["render.msaa=4"],
+        vec!["render.shading=\"pbr\"", "render.msaa=4"],
+        vec![
+            "render.shading=\"pbr\"",
+            "render.texture_filter=\"anisotropic\"",
+        ],
+    ] {
+        let file = dir.join("scene.toml");
+        same_both_ways(
+            &load_with(&file, &sets),
+            &[0],
+            &format!("blended, {sets:?}"),
+        );
+    }
+}
+
+#[test]
+fn texture_transforms_and_set_1_are_the_same_at_every_width() {
+    // A turned glTF cube whose maps read both coordinate sets, with and
+    // without KHR_texture_transform (offset, rotation, scale): base colour
+    // and normal map through one transform of set 0, metallic-roughness
+    // and emission from set 1, occlusion plain; opaque and blended, under
+    // lights with trilinear and anisotropic filtering, and the studio look
+    // with MSAA 4.
+    let dir = scratch("lanes_transforms");
+    layer_texture(&dir.join("t.png"));
+    let mut cube = common::cube();
+    cube.uv1 = cube
+        .uv0
+        .iter()
+        .map(|t| [t[0] * 1.7 + 0.2, t[1] * 0.6])
+        .collect();
+    let moved = r#""extensions": {"KHR_texture_transform": {"offset": [0.3, -0.1], "rotation": 0.4, "scale": [2.0, 1.5]}}"#;
+    let material = format!(
+        r#""pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.6, 0.4, 0.7], "baseColorTexture": {{"index": 0, {moved}}},
+            "metallicRoughnessTexture": {{"index": 0, "texCoord": 1}}, "metallicFactor": 0.6, "roughnessFactor": 0.8}},
+            "normalTexture": {{"index": 0, {moved}}}, "occlusionTexture": {{"index": 0}},
+            "emissiveTexture": {{"index": 0, "texCoord": 1}}, "emissiveFactor": [0.2, 0.1, 0.0]"#
+    );
+    // The opaque cube first, then the one drawn in front of it.
+    for (alpha, file) in [
+        ("OPAQUE", "o.gltf"),
+        ("OPAQUE", "c.gltf"),
+        ("BLEND", "c.gltf"),
+    ] {
+        let (text, _) = common::gltf_text(
+            &cube,
+            r#", "material": 0"#,
+            &format!(
+                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                "extensionsUsed": ["KHR_texture_transform"], "materials": [{{{material}, "alphaMode": "{alpha}"}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join(file), text).unwrap();
+        if file == "o.gltf" {
+            continue;
+        }
+        let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+            [[model]]\npath = \"c.gltf\"\n";
+        let lit = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+            [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+            [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
+        let scene = scene_in(&dir, &format!("{lit}{models}"), &[]);
+        let file = dir.join("scene.toml");
+        same_both_ways(&scene, &[0], &format!("transforms, {alpha}"));
+        let aniso = ["render.texture_filter=\"anisotropic\""];
+        same_both_ways(
+            &load_with(&file, &aniso),
+            &[0],
+            &format!("transforms, {alpha}, anisotropic"),
+        );
+        let studio = dir.join("studio.toml");
+        std::fs::write(
+            &studio,
+            format!(
+                "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 4\n\
+                 [environment]\npreset = \"studio\"\n{models}"
+            ),
+        )
+        .unwrap();
+        same_both_ways(
+            &load_with(&studio, &[]),
+            &[0],
+            &format!("transforms, {alpha}, studio"),
+        );
+    }
+}
+
+#[test]
 fn pbr_models_are_the_same_at_every_width() {
     // The walker: pbr factors without maps under the default look (studio
     // environment, its ground shadow), MSAA 4.

@@ -30,7 +30,7 @@ use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::material::AlphaMode;
 use crate::shade::ao::GPixel;
-use crate::shade::lanes::MAX_SIZES;
+use crate::shade::lanes::{LaneMaterial, MAX_SIZES};
 use crate::shade::light::LightMask;
 use crate::shade::{SizedFootprint, TexCoords};
 
@@ -226,9 +226,11 @@ impl<'a> FrameData<'a> {
 
     /// Blended triangles, farthest first (by mean depth; ties in submission
     /// order), each pixel in front of the opaque surface composited over it.
+    /// With MSAA a triangle is shaded once per pixel over the samples where
+    /// it is in front of the opaque surface, and composited with its
+    /// opacity times the fraction of samples it covers (exact where the
+    /// surface behind is one color).
     fn blend(&self, vis: &Visibility, mut ids: Vec<u32>, color: &mut [Vec4]) {
-        let rect = vis.rect;
-        let tw = rect.width();
         let far_key = |id: &u32| {
             let z = self.tris[*id as usize].z;
             let mean = (z[0] + z[1] + z[2]) / 3.0;
@@ -236,46 +238,93 @@ impl<'a> FrameData<'a> {
             if self.reverse { -mean } else { mean }
         };
         ids.sort_by(|a, b| far_key(b).total_cmp(&far_key(a)).then(a.cmp(b)));
-        let n = vis.samples();
-        if n > 1 {
-            for id in ids {
-                self.blend_msaa(vis, id, color);
-            }
-            return;
-        }
+        let (mut frags, mut layers) = (Vec::new(), Vec::new());
         for id in ids {
             let t = &self.tris[id as usize];
             let it = Interpolator::new(t);
-            raster_triangle(t, rect, |px, py, z| {
-                let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
-                if !in_front(z, vis.depth()[i], self.reverse) {
-                    return;
-                }
-                let g = if self.grads {
-                    self.gradients(t, &it, (px & !1, py & !1))
+            let lane = self.lane_material(t.draw as usize).filter(|lm| lm.layers);
+            frags.clear();
+            self.layer_fragments(vis, (t, &it, id), lane, &mut frags);
+            layers.clear();
+            if lane.is_some() {
+                self.layers(t, &frags, &mut layers);
+            }
+            for (k, f) in frags.iter().enumerate() {
+                let layer = match layers.get(k) {
+                    Some(&(c, a)) => {
+                        let a = a.clamp(0.0, 1.0);
+                        let (add, through) = (c * a, Vec3::splat(1.0 - a));
+                        (add.is_finite() && through.is_finite()).then_some((add, through, a))
+                    }
+                    None => self.layer(vis, (t, &it), f),
+                };
+                let Some((add, through, a)) = layer else {
+                    continue;
+                };
+                let (add, through, a) = if vis.samples() > 1 {
+                    // Over the fraction of samples it covers.
+                    let k = f.count;
+                    (add * k, through * k + Vec3::splat(1.0 - k), a * k)
                 } else {
-                    [Gradients::default(); 2]
+                    (add, through, a)
                 };
-                let frag = it.at_pixel(px, py);
-                let Some((add, through, a)) = self.layer(t, &it, frag, (px, py), g) else {
-                    return;
-                };
+                let i = f.pixel as usize;
                 let dst = color[i];
                 color[i] = (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a));
-            });
+            }
         }
     }
 
-    /// One blended triangle with MSAA: shaded once per pixel over the
-    /// samples where it is in front of the opaque surface, and composited
-    /// with its opacity times the fraction of samples it covers (exact
-    /// where the surface behind is one color).
-    fn blend_msaa(&self, vis: &Visibility, id: u32, color: &mut [Vec4]) {
+    /// The fragments of the blended triangle `t` (id `id`) in front of the
+    /// opaque surface, in raster order: per pixel its shading point, the
+    /// fraction of the pixel's samples it covers there (`count`) and, for
+    /// the lanes (`lane`), its filter footprints.
+    fn layer_fragments(
+        &self,
+        vis: &Visibility,
+        (t, it, id): (&Tri, &Interpolator, u32),
+        lane: Option<&LaneMaterial>,
+        out: &mut Vec<Pending>,
+    ) {
         let rect = vis.rect;
         let tw = rect.width();
         let n = vis.samples();
-        let t = &self.tris[id as usize];
-        let it = Interpolator::new(t);
+        let mut quad: Option<((i32, i32), [Footprint; MAX_SIZES])> = None;
+        let mut push = |px: i32, py: i32, frag: Fragment, count: f32| {
+            let mut footprints = [Footprint::Lod(0.0); MAX_SIZES];
+            if let Some(lm) = lane {
+                let q0 = (px & !1, py & !1);
+                footprints = match quad {
+                    Some((q, f)) if q == q0 => f,
+                    _ => {
+                        let f = lm.footprints(&self.ctx, self.lane_gradients(lm, t, it, q0));
+                        quad = Some((q0, f));
+                        f
+                    }
+                };
+            }
+            out.push(Pending {
+                id,
+                pixel: ((py - rect.y0) as usize * tw + (px - rect.x0) as usize) as u32,
+                count,
+                lambda: frag.lambda,
+                w: frag.w,
+                footprints,
+                ao: 1.0,
+                // Blended fragments may lie in front of the tile's visible
+                // depths: every light.
+                lights: LightMask::ALL,
+            });
+        };
+        if n == 1 {
+            raster_triangle(t, rect, |px, py, z| {
+                let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
+                if in_front(z, vis.depth()[i], self.reverse) {
+                    push(px, py, it.at_pixel(px, py), 1.0);
+                }
+            });
+            return;
+        }
         raster_samples(t, rect, self.pattern, |px, py, mask, z| {
             let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
             let mut m = 0u32;
@@ -284,40 +333,36 @@ impl<'a> FrameData<'a> {
                     m |= 1 << s;
                 }
             }
-            if m == 0 {
-                return;
+            if m != 0 {
+                let frag = self.shading_point(it, px, py, m);
+                push(px, py, frag, m.count_ones() as f32 / n as f32);
             }
-            let g = if self.grads {
-                self.gradients(t, &it, (px & !1, py & !1))
-            } else {
-                [Gradients::default(); 2]
-            };
-            let frag = self.shading_point(&it, px, py, m);
-            let Some((add, through, a)) = self.layer(t, &it, frag, (px, py), g) else {
-                return;
-            };
-            // Over the fraction of samples it covers.
-            let k = m.count_ones() as f32 / n as f32;
-            let (add, through, a) = (add * k, through * k + Vec3::splat(1.0 - k), a * k);
-            let dst = color[i];
-            color[i] = (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a));
         });
     }
 
-    /// A blended fragment as a layer (`ShadeContext::layer`): the light it
-    /// adds, what it lets through and its alpha; None where shading is not
-    /// finite (degenerate input), so the fragment is skipped.
+    /// A blended fragment `f` of `t` as a layer, one fragment at a time
+    /// (`ShadeContext::layer`): the light it adds, what it lets through
+    /// and its alpha; None where shading is not finite (degenerate input),
+    /// so the fragment is skipped.
     fn layer(
         &self,
-        t: &Tri,
-        it: &Interpolator,
-        frag: Fragment,
-        px: (i32, i32),
-        grads: [Gradients; 2],
+        vis: &Visibility,
+        (t, it): (&Tri, &Interpolator),
+        f: &Pending,
     ) -> Option<(Vec3, Vec3, f32)> {
-        // Blended fragments may lie in front of the tile's visible depths:
-        // every light.
-        let surface = self.surface((t, it), frag, px, (grads, [None; 2]), Reach::FULL);
+        let tw = vis.rect.width();
+        let (x, y) = (f.pixel as usize % tw, f.pixel as usize / tw);
+        let (px, py) = (vis.rect.x0 + x as i32, vis.rect.y0 + y as i32);
+        let grads = if self.grads {
+            self.gradients(t, it, (px & !1, py & !1))
+        } else {
+            [Gradients::default(); 2]
+        };
+        let frag = Fragment {
+            lambda: f.lambda,
+            w: f.w,
+        };
+        let surface = self.surface((t, it), frag, (px, py), (grads, [None; 2]), Reach::FULL);
         let (add, through, a) = self.ctx.layer(&surface);
         (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
@@ -626,13 +671,10 @@ impl<'a> FrameData<'a> {
         let k = match quad.iter().position(|q| q.id == id) {
             Some(k) => k,
             None => {
-                let grads = if !self.grads {
-                    [Gradients::default(); 2]
-                } else if lane.is_some() {
-                    // The lanes read set 0 only.
-                    [self.gradients0(t, it, at.q0), Gradients::default()]
-                } else {
-                    self.gradients(t, it, at.q0)
+                let grads = match lane {
+                    Some(lm) => self.lane_gradients(lm, t, it, at.q0),
+                    None if self.grads => self.gradients(t, it, at.q0),
+                    None => [Gradients::default(); 2],
                 };
                 quad.push(QuadEntry {
                     id,
@@ -649,7 +691,7 @@ impl<'a> FrameData<'a> {
             let q = &mut quad[k];
             let footprints = *q
                 .lane_footprints
-                .get_or_insert_with(|| lm.footprints(&self.ctx, q.grads[0]));
+                .get_or_insert_with(|| lm.footprints(&self.ctx, q.grads));
             return Shaded::Later(
                 t.draw,
                 Pending {

@@ -95,7 +95,7 @@ impl<'a> FrameData<'a> {
             .iter()
             .map(|d| {
                 let model = &fs.scene.models[d.model];
-                let uvs = !model.mesh.uvs.is_empty();
+                let uvs = [!model.mesh.uvs.is_empty(), !model.mesh.uvs1.is_empty()];
                 let tangents = !geo.tangents[d.model].is_empty();
                 let m = &model.materials[d.material];
                 paths

@@ -3,9 +3,11 @@
 //! lane width): queued per draw while the band's quads are walked, then
 //! gathered into groups of one draw and shaded together; a quad covered
 //! by one triangle is shaded at once (with eight lanes, two such quads of
-//! one draw together). Each fragment's result is the same bits at every
-//! width, so the band resolves its pixels in the same order with the
-//! same values whatever the width.
+//! one draw together). A blended triangle's fragments are shaded as
+//! layers (colour and opacity), a lane group at a time, before the band
+//! composites them in order. Each fragment's result is the same bits at
+//! every width, so the band resolves its pixels in the same order with
+//! the same values whatever the width.
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -357,6 +359,9 @@ pub(super) struct Prepared {
     ao: [f32; MAX_LANES],
     footprints: [[Footprint; MAX_LANES]; MAX_SIZES],
     lights: LightMask,
+    /// Blended layers (`layer_lanes`): each lane's result is its colour
+    /// and opacity instead of its colour and view depth.
+    layer: bool,
 }
 
 impl Prepared {
@@ -378,7 +383,8 @@ impl Prepared {
 pub(super) struct Corners {
     world: [Vec3; 3],
     normal: [Vec3; 3],
-    uv: [Vec2; 3],
+    /// Texture coordinates of sets 0 and 1 (zero without them).
+    uv: [[Vec2; 3]; 2],
     /// Per corner, with the bitangent sign in w (zero without tangents).
     tangent: [Vec4; 3],
     color: [Vec4; 3],
@@ -391,7 +397,7 @@ impl Corners {
     const NONE: Corners = Corners {
         world: [Vec3::ZERO; 3],
         normal: [Vec3::ZERO; 3],
-        uv: [Vec2::ZERO; 3],
+        uv: [[Vec2::ZERO; 3]; 2],
         tangent: [Vec4::ZERO; 3],
         color: [Vec4::ZERO; 3],
         front: false,
@@ -416,11 +422,13 @@ impl<'a> FrameData<'a> {
         Corners {
             world: idx.map(|i| mv.world[i]),
             normal: idx.map(|i| mv.normal[i]),
-            uv: if mesh.uvs.is_empty() {
-                [Vec2::ZERO; 3]
-            } else {
-                idx.map(|i| mesh.uvs[i])
-            },
+            uv: [&mesh.uvs, &mesh.uvs1].map(|uv| {
+                if uv.is_empty() {
+                    [Vec2::ZERO; 3]
+                } else {
+                    idx.map(|i| uv[i])
+                }
+            }),
             tangent,
             color: if mesh.colors.is_empty() {
                 [Vec4::ONE; 3]
@@ -438,6 +446,7 @@ impl<'a> FrameData<'a> {
     #[inline(always)]
     fn lanes<'p, L: Lane>(
         &self,
+        lm: &LaneMaterial,
         p: &'p Prepared,
         corners: &[&Corners; MAX_LANES],
         at: usize,
@@ -475,8 +484,18 @@ impl<'a> FrameData<'a> {
                 n
             };
         }
-        let uv = |j: usize| (L::from_fn(|k| c(k).uv[j].x), L::from_fn(|k| c(k).uv[j].y));
-        let ((u0, v0), (u1, v1), (u2, v2)) = (uv(0), uv(1), uv(2));
+        let uv = |set: usize| {
+            let at = |j: usize| {
+                let u = L::from_fn(|k| c(k).uv[set][j].x);
+                (u, L::from_fn(|k| c(k).uv[set][j].y))
+            };
+            let ((u0, v0), (u1, v1), (u2, v2)) = (at(0), at(1), at(2));
+            (
+                u0 * l.x + u1 * l.y + u2 * l.z,
+                v0 * l.x + v1 * l.y + v2 * l.z,
+            )
+        };
+        let set1 = if lm.reads_set1() { uv(1) } else { uv(0) };
         let tangent = lerp(|k| k.tangent.map(|t| t.truncate()));
         let color = (!mesh.colors.is_empty()).then(|| lerp(|k| k.color.map(|c| c.truncate())));
         let lanes = Lanes {
@@ -488,8 +507,7 @@ impl<'a> FrameData<'a> {
             lights: p.lights,
         };
         let coords = Coords {
-            u: u0 * l.x + u1 * l.y + u2 * l.z,
-            v: v0 * l.x + v1 * l.y + v2 * l.z,
+            uv: lm.coords([uv(0), set1]),
             tangent,
             sign: L::from_fn(|k| c(k).tangent[0].w),
             footprints: &p.footprints,
@@ -531,11 +549,46 @@ impl<'a> FrameData<'a> {
         at: usize,
         out: &mut [(Vec3, f32); MAX_LANES],
     ) {
-        let (lanes, coords, depth) = self.lanes::<L>(p, corners, at);
+        let (lanes, coords, depth) = self.lanes::<L>(lm, p, corners, at);
+        if p.layer {
+            // The vertex colours' alpha (exactly 1 without them).
+            let mesh = &self.fs.scene.models[self.draws[p.draw].model].mesh;
+            let alpha = if mesh.colors.is_empty() {
+                L::splat(1.0)
+            } else {
+                let l = V3::<L>::from_fn(|k| p.lambda[at + k]);
+                let a = |j: usize| L::from_fn(|k| corners[at + k].color[j].w);
+                a(0) * l.x + a(1) * l.y + a(2) * l.z
+            };
+            let (c, a) = self.ctx.layer_lanes(lm, &lanes, &coords, alpha);
+            for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
+                *o = (c.lane(k), a.lane(k));
+            }
+            return;
+        }
         let c = self.ctx.shade_lanes(lm, &lanes, &coords);
         for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
             let c = c.lane(k);
             *o = (if c.is_finite() { c } else { Vec3::ZERO }, depth.lane(k));
+        }
+    }
+
+    /// The fragments `frags` of the blended triangle `t`, whose material
+    /// the lanes shade as layers (`LaneMaterial::layers`), a lane group
+    /// at a time: per fragment, in order, its colour and opacity
+    /// (`ShadeContext::layer_lanes`) into `out`.
+    pub(super) fn layers(&self, t: &Tri, frags: &[Pending], out: &mut Vec<(Vec3, f32)>) {
+        let draw = t.draw as usize;
+        let c = self.corners(draw, t);
+        let refs = [&c; MAX_LANES];
+        let width = self.lane_width;
+        for chunk in frags.chunks(width) {
+            let mut group = [chunk[chunk.len() - 1]; MAX_LANES];
+            group[..chunk.len()].copy_from_slice(chunk);
+            let mut p = self.prepare_group(&group, width);
+            (p.draw, p.layer) = (draw, true);
+            let res = self.shade_prepared(&p, &refs, width);
+            out.extend_from_slice(&res[..chunk.len()]);
         }
     }
 
@@ -566,20 +619,22 @@ impl<'a> FrameData<'a> {
                 }
             })
         };
-        let uv = |k: usize| {
-            let c = &corners.uv;
-            let l = centers[k].lambda;
-            c[0] * l.x + c[1] * l.y + c[2] * l.z
-        };
-        let grads = if self.grads {
+        let grads = |set: usize| {
+            if !self.grads || (set == 1 && !q.lm.reads_set1()) {
+                return Gradients::default();
+            }
+            let uv = |k: usize| {
+                let c = &corners.uv[set];
+                let l = centers[k].lambda;
+                c[0] * l.x + c[1] * l.y + c[2] * l.z
+            };
             let a = uv(0);
             Gradients {
                 dx: uv(1) - a,
                 dy: uv(2) - a,
             }
-        } else {
-            Gradients::default()
         };
+        let grads = [grads(0), grads(1)];
         let fp = q.lm.footprints(&self.ctx, grads);
         let pick = |k: usize| k.min(3);
         Prepared {
@@ -590,6 +645,7 @@ impl<'a> FrameData<'a> {
             ao: std::array::from_fn(|k| q.ao[pick(k)]),
             footprints: fp.map(|f| [f; MAX_LANES]),
             lights: q.lights,
+            layer: false,
         }
     }
 
@@ -605,6 +661,7 @@ impl<'a> FrameData<'a> {
             ao: [1.0; MAX_LANES],
             footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
             lights: LightMask::NONE,
+            layer: false,
         };
         for (k, f) in frags.iter().enumerate().take(width) {
             p.lambda[k] = f.lambda;

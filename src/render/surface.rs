@@ -12,6 +12,7 @@ use crate::assets::texture::Gradients;
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::settings::ShadingMode;
+use crate::shade::lanes::LaneMaterial;
 use crate::shade::light::LightMask;
 use crate::shade::{SizedFootprint, Surface, TexCoords};
 
@@ -78,6 +79,25 @@ impl<'a> FrameData<'a> {
             },
             _ => Gradients::default(),
         })
+    }
+
+    /// The texture derivatives the footprints of lane material `lm`
+    /// need over the quad at `q0`: none where filtering does not read
+    /// them, set 0 alone unless some map reads set 1.
+    pub(super) fn lane_gradients(
+        &self,
+        lm: &LaneMaterial,
+        t: &Tri,
+        it: &Interpolator,
+        q0: (i32, i32),
+    ) -> [Gradients; 2] {
+        if !self.grads {
+            [Gradients::default(); 2]
+        } else if lm.reads_set1() {
+            self.gradients(t, it, q0)
+        } else {
+            [self.gradients0(t, it, q0), Gradients::default()]
+        }
     }
 
     /// `gradients` of set 0 alone.

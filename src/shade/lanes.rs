@@ -6,12 +6,13 @@
 //!
 //! What differs between the widths is where texels come from (`Fetch`).
 //! A lone fragment reads them through `ShadeContext::sample`, which takes
-//! every map (transforms, samplers of its own, set 1, object-space and
-//! bump maps). The renderer gathers the visible fragments of a band into
+//! every map (samplers with filters of their own, object-space and bump
+//! maps). The renderer gathers the visible fragments of a band into
 //! wider calls wherever `ShadeContext::lane_material` accepts the
-//! material: its maps are plain lookups of set 0, in at most three
-//! texture sizes, and its normal maps are in tangent space. Their
-//! lookups are found four lanes at a time for all maps of one size
+//! material: its maps use the frame's filter (no sampler limits of their
+//! own) and fall in at most three slots (coordinate set, transform,
+//! texture size and chain), and its normal maps are in tangent space.
+//! Their lookups are found four lanes at a time for all maps of one slot
 //! (`Texture::taps4`) and gathered per lane.
 //!
 //! The lanes of one call share a material but not a triangle.
@@ -19,7 +20,7 @@
 // Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Vec3, Vec4};
+use glam::{Affine2, Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::light::{LightMask, LightSet};
@@ -30,14 +31,14 @@ use crate::assets::texture::{
 };
 use crate::scene::Material;
 use crate::scene::light::{Light, LightKind};
-use crate::scene::material::{Native, NormalMap, NormalSpace};
+use crate::scene::material::{AlphaMode, Native, NormalMap, NormalSpace};
 use crate::scene::settings::{ShadingMode, TextureFilter};
 use crate::simd::{Lane, Mask, V3, clamp01};
 
-/// At most this many distinct texture sizes (and mip chains) among a lane
-/// material's maps: each fragment carries one filter footprint per size,
-/// and the maps of one size share where their lookups fall
-/// (`Texture::taps4`).
+/// At most this many slots (coordinate set and transform, texture size
+/// and mip chain) among a lane material's maps: each fragment carries
+/// one filter footprint per slot, and the maps of one slot share where
+/// their lookups fall (`Texture::taps4`).
 pub const MAX_SIZES: usize = 3;
 
 /// The most lanes a call shades (`simd::F8`).
@@ -72,14 +73,33 @@ pub(super) enum Kind {
 pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
     pub(super) kind: Kind,
+    /// Whether its blended surfaces are layers the lanes shade
+    /// (`layer_lanes`): blended, and not transmissive.
+    pub layers: bool,
     /// Every map its shading may read, in the order it reads them.
     maps: Vec<Map<'a>>,
     /// Whether the mesh has tangents (without them a tangent-space
     /// normal map leaves the normal as it is).
     tangents: bool,
-    /// Per slot: the (width, height) of its maps and their number of
-    /// levels.
-    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
+    /// Where its maps are looked up: the slots of `Map::slot`.
+    slots: SmallVec<[Slot; MAX_SIZES]>,
+}
+
+/// Where a lane material's maps of one slot are looked up: the same
+/// coordinates (set and transform) in textures of the same size and
+/// chain, so they share one filter footprint per fragment and where
+/// their lookups fall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Slot {
+    /// Texture-coordinate set (0 or 1).
+    set: usize,
+    /// `TextureRef::transform` (KHR_texture_transform).
+    transform: Affine2,
+    /// Width and height.
+    size: (u32, u32),
+    /// Levels of its chain this frame; 0: level 0 alone, without a chain
+    /// (never minified), looked up bilinearly (`Texture::sample_grad`).
+    levels: usize,
 }
 
 /// The points of the fragments in the lanes: what shading needs of a
@@ -101,15 +121,15 @@ pub struct Lanes<L: Lane = Vec4> {
 
 /// Where the lanes' fragments read a lane material's maps.
 pub struct Coords<'p, L: Lane = Vec4> {
-    /// Texture coordinates (set 0).
-    pub u: L,
-    pub v: L,
+    /// Texture coordinates per slot of the material
+    /// (`LaneMaterial::coords`).
+    pub uv: [(L, L); MAX_SIZES],
     /// Interpolated tangent and its bitangent sign (when the material has
     /// a normal map).
     pub tangent: V3<L>,
     pub sign: L,
-    /// Per texture size of the material (`LaneMaterial::footprints`), per
-    /// lane from lane `first`.
+    /// Per slot of the material (`LaneMaterial::footprints`), per lane
+    /// from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
     pub first: usize,
 }
@@ -148,11 +168,11 @@ impl<L: Lane> Coords<'_, L> {
 }
 
 impl<'a> LaneMaterial<'a> {
-    /// The footprints of a fragment whose texture coordinates change by
-    /// `g` across its quad: one per texture size the maps have, in the
-    /// order `Coords::footprints` takes them (as `ShadeContext::sample`
-    /// derives them).
-    pub fn footprints(&self, ctx: &ShadeContext, g: Gradients) -> [Footprint; MAX_SIZES] {
+    /// The footprints of a fragment whose texture coordinates (of sets 0
+    /// and 1) change by `g` across its quad: one per slot, in the order
+    /// `Coords::footprints` takes them (as `ShadeContext::sample` derives
+    /// them, the transform applied to the derivatives).
+    pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> [Footprint; MAX_SIZES] {
         let mut out = [Footprint::Lod(0.0); MAX_SIZES];
         if !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
             return out;
@@ -162,8 +182,45 @@ impl<'a> LaneMaterial<'a> {
             max_anisotropy: ctx.max_anisotropy,
             mips: None,
         };
-        for (k, &((w, h), _)) in self.sizes.iter().enumerate() {
+        for (k, slot) in self.slots.iter().enumerate() {
+            if slot.levels == 0 {
+                continue;
+            }
+            let mut g = g[slot.set];
+            if slot.transform != Affine2::IDENTITY {
+                let m = slot.transform.matrix2;
+                g = Gradients {
+                    dx: m * g.dx,
+                    dy: m * g.dy,
+                };
+            }
+            let (w, h) = slot.size;
             out[k] = Texture::footprint_of_size(w, h, g, &f);
+        }
+        out
+    }
+
+    /// Whether some map reads texture coordinates of set 1.
+    pub fn reads_set1(&self) -> bool {
+        self.slots.iter().any(|s| s.set == 1)
+    }
+
+    /// Per slot, the lanes' coordinates of its set (`uv`) through its
+    /// transform (as `TextureRef::sample_grad` applies it).
+    #[inline(always)]
+    pub fn coords<L: Lane>(&self, uv: [(L, L); 2]) -> [(L, L); MAX_SIZES] {
+        let mut out = [uv[0]; MAX_SIZES];
+        for (o, slot) in out.iter_mut().zip(&self.slots) {
+            let (u, v) = uv[slot.set];
+            *o = if slot.transform == Affine2::IDENTITY {
+                (u, v)
+            } else {
+                let (m, t) = (slot.transform.matrix2, slot.transform.translation);
+                (
+                    L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(t.x),
+                    L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(t.y),
+                )
+            };
         }
         out
     }
@@ -175,32 +232,39 @@ impl<'a> LaneMaterial<'a> {
     }
 }
 
-/// Collects a lane material's maps, assigning each a footprint slot by
-/// its texture's size and chain; None where the lanes cannot look one up
-/// as `ShadeContext::sample` does (a transform, a sampler of its own, set
-/// 1, a mesh without coordinates, a fourth texture size, a normal map
-/// that is not in tangent space).
+/// Collects a lane material's maps, assigning each a slot by its
+/// coordinates, transform, texture size and chain; None where the lanes
+/// cannot look one up as `ShadeContext::sample` does (a sampler of its
+/// own, a mesh without the coordinates, a fourth slot, a normal map that
+/// is not in tangent space).
 struct MapSet<'c, 'a> {
     ctx: &'c ShadeContext<'a>,
-    uvs: bool,
+    /// Whether the mesh has texture coordinates of sets 0 and 1.
+    uvs: [bool; 2],
     tangents: bool,
     maps: Vec<Map<'a>>,
-    sizes: SmallVec<[((u32, u32), usize); MAX_SIZES]>,
+    slots: SmallVec<[Slot; MAX_SIZES]>,
 }
 
 impl<'a> MapSet<'_, 'a> {
     fn map(&mut self, t: &'a TextureRef) -> Option<()> {
-        if !t.is_plain() || t.texcoord != 0 || !self.uvs {
+        let set = (t.texcoord as usize).min(1);
+        if t.min_limit.is_some() || t.mag_nearest || !self.uvs[set] {
             return None;
         }
         let tex = &*t.texture;
         let mips = self.ctx.mips.get(tex.id).copied().flatten();
-        let shape = ((tex.width, tex.height), 1 + mips.map_or(0, |m| m.len()));
-        let slot = match self.sizes.iter().position(|s| *s == shape) {
+        let here = Slot {
+            set,
+            transform: t.transform,
+            size: (tex.width, tex.height),
+            levels: mips.map_or(0, |m| 1 + m.len()),
+        };
+        let slot = match self.slots.iter().position(|s| *s == here) {
             Some(k) => k,
-            None if self.sizes.len() < MAX_SIZES => {
-                self.sizes.push(shape);
-                self.sizes.len() - 1
+            None if self.slots.len() < MAX_SIZES => {
+                self.slots.push(here);
+                self.slots.len() - 1
             }
             None => return None,
         };
@@ -208,7 +272,11 @@ impl<'a> MapSet<'_, 'a> {
         let same = self
             .maps
             .iter()
-            .position(|m| std::sync::Arc::ptr_eq(&m.source.texture, &t.texture) && m.mode == mode)
+            .position(|m| {
+                std::sync::Arc::ptr_eq(&m.source.texture, &t.texture)
+                    && m.mode == mode
+                    && m.slot == slot
+            })
             .unwrap_or(self.maps.len());
         self.maps.push(Map {
             chain: tex.chain(mips),
@@ -235,7 +303,7 @@ impl<'a> MapSet<'_, 'a> {
                 map: t,
                 space: NormalSpace::Tangent,
                 ..
-            }) if self.uvs => {
+            }) if self.uvs[(t.texcoord as usize).min(1)] => {
                 if self.tangents {
                     self.map(t)?;
                 }
@@ -300,7 +368,7 @@ impl<'a> ShadeContext<'a> {
     pub fn lane_material(
         &self,
         m: &'a Material,
-        uvs: bool,
+        uvs: [bool; 2],
         tangents: bool,
     ) -> Option<LaneMaterial<'a>> {
         if m.unlit || self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
@@ -318,11 +386,19 @@ impl<'a> ShadeContext<'a> {
             uvs,
             tangents,
             maps: Vec::new(),
-            sizes: SmallVec::new(),
+            slots: SmallVec::new(),
         };
         match kind {
             Kind::BlinnPhong => maps.blinn_phong(m)?,
             Kind::Pbr => maps.pbr(m)?,
+        }
+        // A blended surface's opacity reads these too (`opacity`); a
+        // transmissive one is the one-fragment path's layer.
+        let layers =
+            m.alpha == AlphaMode::Blend && !(kind == Kind::Pbr && m.pbr.transmission.is_some());
+        if layers {
+            maps.optional(&m.map_d)?;
+            maps.optional(&m.map_kd)?;
         }
         let mut maps_read = maps.maps;
         for k in 0..maps_read.len() {
@@ -335,9 +411,10 @@ impl<'a> ShadeContext<'a> {
         Some(LaneMaterial {
             material: m,
             kind,
+            layers,
             maps: maps_read,
             tangents,
-            sizes: maps.sizes,
+            slots: maps.slots,
         })
     }
 
@@ -350,21 +427,33 @@ impl<'a> ShadeContext<'a> {
         f: &Lanes<L>,
         coords: &Coords<'_, L>,
     ) -> V3<L> {
-        let mut fetch = LaneFetch {
-            lm,
-            lookups: Lookups::new(coords),
-            normal: f.normal,
-            shared: None,
-            next: 0,
-        };
-        for (i, map) in lm.maps.iter().enumerate() {
-            if map.same == i {
-                fetch.lookups.prefetch(map);
-            }
-        }
+        self.shade_fetched(lm, f, &mut LaneFetch::new(lm, coords, f.normal))
+    }
+
+    /// The fragments of a blended lane material (`LaneMaterial::layers`)
+    /// as layers: lane by lane `layer`'s colour (`shade`) and opacity
+    /// (before its clamp). `alpha`: the vertex colours' alpha.
+    pub fn layer_lanes<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        f: &Lanes<L>,
+        coords: &Coords<'_, L>,
+        alpha: L,
+    ) -> (V3<L>, L) {
+        let mut fetch = LaneFetch::new(lm, coords, f.normal);
+        let c = self.shade_fetched(lm, f, &mut fetch);
+        (c, self.opacity_of(lm.material, |t| fetch.rgba(t), alpha))
+    }
+
+    fn shade_fetched<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        f: &Lanes<L>,
+        fetch: &mut LaneFetch<'_, 'a, '_, L>,
+    ) -> V3<L> {
         match lm.kind {
-            Kind::BlinnPhong => self.shade_blinn_phong(lm.material, &mut fetch, f, None),
-            Kind::Pbr => self.shade_pbr(lm.material, &mut fetch, f),
+            Kind::BlinnPhong => self.shade_blinn_phong(lm.material, fetch, f, None),
+            Kind::Pbr => self.shade_pbr(lm.material, fetch, f),
         }
     }
 
@@ -445,6 +534,26 @@ struct LaneFetch<'x, 'a, 'p, L: Lane> {
     next: usize,
 }
 
+impl<'x, 'a, 'p, L: Lane> LaneFetch<'x, 'a, 'p, L> {
+    /// `lm`'s maps at `coords`, their distinct lookups started; `normal`:
+    /// the interpolated normals.
+    fn new(lm: &'x LaneMaterial<'a>, coords: &'x Coords<'p, L>, normal: V3<L>) -> Self {
+        let mut fetch = LaneFetch {
+            lm,
+            lookups: Lookups::new(coords),
+            normal,
+            shared: None,
+            next: 0,
+        };
+        for (i, map) in lm.maps.iter().enumerate() {
+            if map.same == i {
+                fetch.lookups.prefetch(map);
+            }
+        }
+        fetch
+    }
+}
+
 impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     #[inline(always)]
     fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
@@ -475,9 +584,12 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         let mut rgba = [[Vec4::ZERO; 4]; 2];
         for (q, out) in rgba.iter_mut().enumerate().take(L::QUADS) {
             let fps = f.footprints4(map.slot, q);
-            *out = map
-                .chain
-                .sample4_rgba(f.u.quad(q), f.v.quad(q), &fps, map.mode);
+            *out = map.chain.sample4_rgba(
+                f.uv[map.slot].0.quad(q),
+                f.uv[map.slot].1.quad(q),
+                &fps,
+                map.mode,
+            );
         }
         let channel = |c: usize| L::from_quads(|q| rgba[q][c]);
         let rgb = V3 {
@@ -624,8 +736,8 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
             self.found |= 1 << s;
             for q in 0..L::QUADS {
                 map.chain.taps4_into(
-                    f.u.quad(q),
-                    f.v.quad(q),
+                    f.uv[s].0.quad(q),
+                    f.uv[s].1.quad(q),
                     &f.footprints4(s, q),
                     &mut self.taps[q][s],
                 );
@@ -654,8 +766,8 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
             *out = match &self.taps[q][map.slot] {
                 Some(t) => map.chain.read4(t, map.mode),
                 None => map.chain.sample4(
-                    f.u.quad(q),
-                    f.v.quad(q),
+                    f.uv[map.slot].0.quad(q),
+                    f.uv[map.slot].1.quad(q),
                     &f.footprints4(map.slot, q),
                     map.mode,
                 ),
@@ -684,8 +796,9 @@ mod tests {
     }
 
     /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
-    /// maps and the KHR layers with their maps do; unlit, texture
-    /// transforms and a fourth texture size do not.
+    /// maps, the KHR layers with their maps and texture transforms do;
+    /// unlit, samplers with filters of their own and a fourth slot do
+    /// not.
     #[test]
     fn which_materials_the_lanes_take() {
         let shadows = Shadows::none();
@@ -702,7 +815,7 @@ mod tests {
             scale: 1.0,
         });
         let kind = |ctx: &ShadeContext, m| {
-            ctx.lane_material(m, true, true).map(|lm| {
+            ctx.lane_material(m, [true; 2], true).map(|lm| {
                 let distinct = lm.maps.iter().enumerate().filter(|(i, m)| m.same == *i);
                 (lm.kind, lm.maps.len(), distinct.count())
             })
@@ -710,7 +823,7 @@ mod tests {
         // The packed texture is one lookup, read twice.
         assert_eq!(kind(&auto, &gltf), Some((Kind::Pbr, 4, 3)));
         // Without coordinates its maps cannot be looked up.
-        assert!(auto.lane_material(&gltf, false, true).is_none());
+        assert!(auto.lane_material(&gltf, [false; 2], true).is_none());
         let mut obj = Material::default_named("obj");
         obj.map_kd = Some(map(16));
         assert_eq!(kind(&auto, &obj), Some((Kind::BlinnPhong, 1, 1)));
@@ -736,7 +849,13 @@ mod tests {
         if let Some(t) = &mut moved.pbr.base_color_map {
             t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
         }
-        assert_eq!(kind(&auto, &moved), None);
+        // A transform is a slot of its own.
+        assert_eq!(kind(&auto, &moved), Some((Kind::Pbr, 4, 3)));
+        let mut limited = gltf.clone();
+        if let Some(t) = &mut limited.pbr.base_color_map {
+            t.mag_nearest = true;
+        }
+        assert_eq!(kind(&auto, &limited), None);
         let mut sizes = gltf.clone();
         sizes.pbr.emissive = Vec3::ONE;
         sizes.pbr.emissive_map = Some(map(32));

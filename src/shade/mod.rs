@@ -296,20 +296,32 @@ impl ShadeContext<'_> {
     }
 
     /// Opacity at the point: d (glTF: the base color's alpha) times map_d
-    /// (its alpha, or red without alpha) times the alpha of map_Kd (glTF:
+    /// (its alpha, or red without alpha) times the alpha of map_kd (glTF:
     /// of the base color texture) times the vertex color's alpha.
     pub fn opacity(&self, m: &Material, tc: &TexCoords, color: Vec4) -> f32 {
-        let mut a = m.d * color.w;
+        let rgba = |t: &TextureRef| self.sample(t, tc).map(|c| (V3::from(c.truncate()), c.w));
+        self.opacity_of(m, rgba, color.w)
+    }
+
+    /// `opacity` at the lanes' points, whose vertex colours have alpha
+    /// `alpha`, reading maps through `rgba` (`Fetch::rgba`).
+    pub(crate) fn opacity_of<L: Lane>(
+        &self,
+        m: &Material,
+        mut rgba: impl FnMut(&TextureRef) -> Option<(V3<L>, L)>,
+        alpha: L,
+    ) -> L {
+        let mut a = L::splat(m.d) * alpha;
         if let Some(t) = &m.map_d
-            && let Some(c) = self.sample(t, tc)
+            && let Some((c, w)) = rgba(t)
         {
-            a *= if t.texture.has_alpha { c.w } else { c.x };
+            a = a * if t.texture.has_alpha { w } else { c.x };
         }
         if let Some(t) = &m.map_kd
             && t.texture.has_alpha
-            && let Some(c) = self.sample(t, tc)
+            && let Some((_, w)) = rgba(t)
         {
-            a *= c.w;
+            a = a * w;
         }
         a
     }
