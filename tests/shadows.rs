@@ -92,7 +92,7 @@ fn depth_exr_of_a_sphere_over_a_plane_matches_the_ray_intersection() {
     assert!(!out.join("f.png").exists(), "color = false writes no PNG");
 
     // The exact surfaces drawn: both meshes' triangles in world space.
-    let s = &job.scene;
+    let s = job.scene();
     let mut tris: Vec<[Vec3; 3]> = Vec::new();
     for m in &s.models {
         for t in &m.mesh.triangles {

@@ -7,9 +7,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use softraster::batch::{
-    FrameDone, FramePlan, JobSummary, RenderJob, thread_pool, with_auto_exposure,
-};
+use softraster::batch::{FrameDone, FramePlan, JobSummary, RenderJob, thread_pool};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::assemble::LoadOptions;
@@ -178,7 +176,8 @@ fn render_one(
     let t0 = Instant::now();
     let scene = Scene::load(path, opts)?;
     let auto = scene.settings.auto_exposure;
-    let scene = with_auto_exposure(scene);
+    let mut job = RenderJob::all(scene);
+    let scene = job.scene();
     let load_s = t0.elapsed().as_secs_f64();
     let one = input.is_none();
     if auto && args.progress == Progress::Json {
@@ -195,24 +194,21 @@ fn render_one(
         eprintln!("warning: {w}");
     }
     let warnings = scene.warnings.len();
-    check_memory(&scene, args.max_memory, path, args.quiet || !one)?;
-    let plan = FramePlan::select(&scene, args.frames.as_deref(), args.camera.as_deref())?;
-    let job = RenderJob {
-        scene,
-        plan,
-        skip_existing: args.skip_existing,
-    };
+    check_memory(scene, args.max_memory, path, args.quiet || !one)?;
+    let plan = FramePlan::select(scene, args.frames.as_deref(), args.camera.as_deref())?;
+    job.plan = plan;
+    job.skip_existing = args.skip_existing;
     if !args.quiet && one {
         eprintln!(
             "{}: {} triangles, {} frame(s) x {} camera(s) at {}x{}, loaded in {:.2} s, writing to {}",
             path.display(),
-            job.scene.triangle_count(),
+            job.scene().triangle_count(),
             job.plan.frames.len(),
             job.plan.cameras.len(),
-            job.scene.settings.width,
-            job.scene.settings.height,
+            job.scene().settings.width,
+            job.scene().settings.height,
             load_s,
-            job.scene.output.dir.display()
+            job.scene().output.dir.display()
         );
     }
     let t0 = Instant::now();

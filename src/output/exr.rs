@@ -20,7 +20,7 @@ pub fn write_channel(
     width: u32,
     height: u32,
     channel: &str,
-    values: &[f32],
+    values: Vec<f32>,
 ) -> Result<(), Error> {
     let encode = |message: String| Error::Encode {
         path: path.to_path_buf(),
@@ -39,7 +39,7 @@ pub fn write_channel(
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(smallvec::smallvec![AnyChannel::new(
             name,
-            FlatSamples::F32(values.to_vec()),
+            FlatSamples::F32(values),
         )]),
     );
     let image = Image::from_layer(layer);
@@ -148,7 +148,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("softraster-exr-{}", std::process::id()));
         let path = dir.join("z.exr");
         let v = vec![1.0, 2.5e-7, f32::INFINITY, 12345.678, 0.0, 3.0];
-        write_channel(&path, 3, 2, "Z", &v).unwrap();
+        write_channel(&path, 3, 2, "Z", v.clone()).unwrap();
         let (w, h, back) = read_channel(&path, "Z").unwrap();
         assert_eq!((w, h), (3, 2));
         assert_eq!(back, v);

@@ -4,9 +4,13 @@
 //! half-written frame under the final name.
 
 pub mod exr;
+mod frame_files;
 pub mod gif;
+pub mod ids;
 pub mod png;
 pub mod video;
+
+pub use frame_files::{FileToWrite, FrameFiles, pack};
 
 /// Tone mapping lives with shading (`shade::tonemap`); its old path stays.
 pub use crate::shade::tonemap;

@@ -11,20 +11,20 @@ use crate::shade::ao::{self, AoView, GPixel};
 /// Per pixel, 1 = unoccluded. `tracer`: the frame's ray tracer (needed
 /// for `AoMethod::Raytraced`, unused otherwise).
 pub(super) fn occlusion(
-    fs: &FrameSetup,
+    setup: &FrameSetup,
     gbuf: &[GPixel],
     width: u32,
     height: u32,
     tracer: Option<&Tracer>,
 ) -> Vec<f32> {
-    let s = &fs.scene.settings;
+    let s = &setup.scene.settings;
     match (s.ao.method, tracer) {
         (AoMethod::Raytraced, Some(tracer)) => {
             ao::raytraced(tracer, gbuf, width, s.ao.samples, s.ao.radius)
         }
         _ => {
-            let view = AoView::new(&fs.camera, width, height);
-            let radius = s.ao.radius.unwrap_or(fs.scene.bounds_radius * 0.2);
+            let view = AoView::new(&setup.camera, width, height);
+            let radius = s.ao.radius.unwrap_or(setup.scene.bounds_radius * 0.2);
             ao::gtao(gbuf, &view, radius, s.ao.samples)
         }
     }

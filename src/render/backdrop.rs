@@ -42,27 +42,27 @@ struct Key {
 }
 
 impl<'a> EnvBackground<'a> {
-    /// The backdrop of the frame `fs` at `width` x `height` pixels, or
+    /// The backdrop of the frame `setup` at `width` x `height` pixels, or
     /// None where the background is not the environment.
     pub fn new(
-        fs: &FrameSetup,
+        setup: &FrameSetup,
         env: Option<&'a EnvLight>,
         width: u32,
         height: u32,
     ) -> Option<EnvBackground<'a>> {
-        let blur = match fs.scene.settings.background {
+        let blur = match setup.scene.settings.background {
             Background::Environment => 0.0,
             Background::Blurred(b) => b,
             _ => return None,
         };
         // The data views show values, not radiance: no environment there.
-        if fs.scene.settings.shading.is_data_view() {
+        if setup.scene.settings.shading.is_data_view() {
             return None;
         }
         Some(EnvBackground {
             env: env?,
             blur,
-            rays: CameraRays::new(&fs.camera, width, height),
+            rays: CameraRays::new(&setup.camera, width, height),
             width,
             cached: None,
         })

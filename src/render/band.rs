@@ -17,10 +17,10 @@
 use glam::{Vec3, Vec4};
 
 use super::display::PlainBackground;
-use super::fragment::{FrameData, LANE_SLOT, Part, Sink, resolve};
+use super::fragment::{FrameData, LANE_SLOT, PixelShare, Sink, resolve};
 use super::frame::AovPixel;
 use super::lanes::{LaneBatches, Pending, QuadAt};
-use super::surface::Reach;
+use super::surface::FragmentLighting;
 use crate::assets::texture::{Footprint, Gradients};
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
@@ -159,7 +159,7 @@ impl<'a> FrameData<'a> {
         let tw = rect.width();
         let n = vis.samples();
         let mut cache = InterpolatorCache::default();
-        let models = &self.fs.scene.models;
+        let models = &self.setup.scene.models;
         let base = |count: fn(&crate::scene::Model) -> u32| -> Vec<u32> {
             models
                 .iter()
@@ -202,7 +202,13 @@ impl<'a> FrameData<'a> {
             } else {
                 [Gradients::default(); 2]
             };
-            let s = self.surface((t, it), frag, (px, py), (grads, [None; 2]), Reach::FULL);
+            let s = self.surface(
+                (t, it),
+                frag,
+                (px, py),
+                (grads, [None; 2]),
+                FragmentLighting::FULL,
+            );
             let (normal, albedo) = self.ctx.aov(&s);
             let d = self.draws[t.draw as usize];
             *a = AovPixel {
@@ -362,7 +368,13 @@ impl<'a> FrameData<'a> {
             lambda: f.lambda,
             w: f.w,
         };
-        let surface = self.surface((t, it), frag, (px, py), (grads, [None; 2]), Reach::FULL);
+        let surface = self.surface(
+            (t, it),
+            frag,
+            (px, py),
+            (grads, [None; 2]),
+            FragmentLighting::FULL,
+        );
         let (add, through, a) = self.ctx.layer(&surface);
         (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
@@ -410,7 +422,7 @@ impl<'a> FrameData<'a> {
             shaded: &mut shaded,
             inv_n,
         };
-        let mut deferred: Vec<(usize, smallvec::SmallVec<[Part; 4]>)> = Vec::new();
+        let mut deferred: Vec<(usize, smallvec::SmallVec<[PixelShare; 4]>)> = Vec::new();
         for qy in (0..th).step_by(2) {
             let below = spans.get(qy + 1).copied().unwrap_or((usize::MAX, 0));
             let (x0, x1) = (spans[qy].0.min(below.0), spans[qy].1.max(below.1));
@@ -468,7 +480,7 @@ impl<'a> FrameData<'a> {
                     let mut at = FragmentAt {
                         px: (px, py),
                         q0,
-                        reach: Reach {
+                        reach: FragmentLighting {
                             ao: occlusion,
                             lights: lights_at(x),
                         },
@@ -565,13 +577,13 @@ impl<'a> FrameData<'a> {
         bg: Vec4,
         mut lanes: Option<&mut LaneBatches>,
         sink: &mut Sink,
-    ) -> (smallvec::SmallVec<[Part; 4]>, bool) {
-        let mut parts: smallvec::SmallVec<[Part; 4]> = smallvec::SmallVec::new();
+    ) -> (smallvec::SmallVec<[PixelShare; 4]>, bool) {
+        let mut parts: smallvec::SmallVec<[PixelShare; 4]> = smallvec::SmallVec::new();
         let mut queued = false;
         for (id, mask) in fragments(ids) {
             let count = mask.count_ones() as f32;
             if id == NO_TRIANGLE {
-                parts.push(Part::Shaded(bg, f32::INFINITY, count));
+                parts.push(PixelShare::Shaded(bg, f32::INFINITY, count));
                 continue;
             }
             match self.fragment(at, id, mask) {
@@ -581,7 +593,7 @@ impl<'a> FrameData<'a> {
                         queued = true;
                         p.pixel = LANE_SLOT;
                         let slot = b.push(self, draw, p, sink);
-                        parts.push(Part::Queued(slot, count));
+                        parts.push(PixelShare::Queued(slot, count));
                     }
                 }
             }
@@ -713,7 +725,7 @@ impl<'a> FrameData<'a> {
         // A NaN from degenerate input must not poison the frame: such a
         // fragment is black.
         let c = if c.is_finite() { c } else { Vec3::ZERO };
-        Shaded::Now(Part::Shaded(c.extend(1.0), d, count))
+        Shaded::Now(PixelShare::Shaded(c.extend(1.0), d, count))
     }
 }
 
@@ -762,7 +774,7 @@ struct QuadEntry {
 struct FragmentAt<'c> {
     px: (i32, i32),
     q0: (i32, i32),
-    reach: Reach,
+    reach: FragmentLighting,
     lanes: bool,
     cache: &'c mut InterpolatorCache,
     quad: &'c mut smallvec::SmallVec<[QuadEntry; 4]>,
@@ -770,7 +782,7 @@ struct FragmentAt<'c> {
 
 /// A fragment shaded now, or waiting for the lanes (its draw and data).
 enum Shaded {
-    Now(Part),
+    Now(PixelShare),
     Later(u32, Pending),
 }
 

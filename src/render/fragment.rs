@@ -2,7 +2,7 @@
 //! pixel: the frame's data (`FrameData`, built once per frame: set-up,
 //! shading context, vertices, draws, per-draw lane materials, the
 //! backgrounds) and the sink that takes shaded fragments
-//! (`Sink`, `Part`, `resolve`). The band loop (`band`) and the lane
+//! (`Sink`, `PixelShare`, `resolve`). The band loop (`band`) and the lane
 //! shading (`lanes`) both build on it; it depends on neither.
 
 use glam::{Vec3, Vec4};
@@ -22,7 +22,7 @@ use crate::shade::{ShadeContext, background};
 
 /// What every band of one frame reads.
 pub(super) struct FrameData<'a> {
-    pub fs: &'a FrameSetup<'a>,
+    pub setup: &'a FrameSetup<'a>,
     pub ctx: ShadeContext<'a>,
     pub verts: &'a [ModelVertices],
     pub draws: &'a [Draw],
@@ -73,18 +73,18 @@ impl<'a> FrameData<'a> {
     /// fragments at a time (`shade::lanes`), skip lights per tile
     /// (`light_tiles`); the same pixels either way.
     pub fn new(
-        fs: &'a FrameSetup<'a>,
+        setup: &'a FrameSetup<'a>,
         ctx: ShadeContext<'a>,
         (verts, geo): (&'a [ModelVertices], &'a Geometry),
         (pattern, grads): (&'static [(i8, i8)], bool),
         tracer: Option<&'a Tracer<'a>>,
         paths: Paths,
     ) -> FrameData<'a> {
-        let s = &fs.scene.settings;
+        let s = &setup.scene.settings;
         let alpha = geo
             .draws
             .iter()
-            .map(|d| fs.scene.models[d.model].materials[d.material].alpha)
+            .map(|d| setup.scene.models[d.model].materials[d.material].alpha)
             .collect();
         let geo_normal = s.shading == ShadingMode::Flat
             || !ctx.shadows.lights.is_empty()
@@ -94,7 +94,7 @@ impl<'a> FrameData<'a> {
             .draws
             .iter()
             .map(|d| {
-                let model = &fs.scene.models[d.model];
+                let model = &setup.scene.models[d.model];
                 let uvs = [!model.mesh.uvs.is_empty(), !model.mesh.uvs1.is_empty()];
                 let tangents = !geo.tangents[d.model].is_empty();
                 let m = &model.materials[d.material];
@@ -109,14 +109,14 @@ impl<'a> FrameData<'a> {
             .then(|| {
                 Culling::new(
                     ctx.lights,
-                    fs.clip_from_world,
+                    setup.clip_from_world,
                     geo.grid.width,
                     geo.grid.height,
                 )
             })
             .flatten();
         FrameData {
-            fs,
+            setup,
             verts,
             draws: &geo.draws,
             alpha,
@@ -125,8 +125,8 @@ impl<'a> FrameData<'a> {
             pattern,
             reverse: s.depth == DepthMode::ReverseZ,
             bg: background(s.background),
-            env_bg: EnvBackground::new(fs, ctx.env, geo.grid.width, geo.grid.height),
-            ground: Ground::new(fs, &ctx, tracer, geo.grid.width, geo.grid.height),
+            env_bg: EnvBackground::new(setup, ctx.env, geo.grid.width, geo.grid.height),
+            ground: Ground::new(setup, &ctx, tracer, geo.grid.width, geo.grid.height),
             grads,
             geo_normal,
             lanes,
@@ -169,14 +169,14 @@ impl Sink<'_> {
         } else {
             let i = pixel as usize;
             (self.color[i], self.depth[i]) =
-                resolve(&[Part::Queued(0, count)], &[(c, d)], self.inv_n);
+                resolve(&[PixelShare::Queued(0, count)], &[(c, d)], self.inv_n);
         }
     }
 }
 
 /// One fragment's share of a pixel: shaded already (linear RGBA, view
 /// depth, sample count) or queued for the lanes (slot, sample count).
-pub(super) enum Part {
+pub(super) enum PixelShare {
     Shaded(Vec4, f32, f32),
     Queued(u32, f32),
 }
@@ -184,13 +184,13 @@ pub(super) enum Part {
 /// A pixel's colour and depth from its fragments in order: their colours
 /// weighted by sample counts over `1 / inv_n` samples, the nearest depth.
 /// `shaded`: the lane results by slot.
-pub(super) fn resolve(parts: &[Part], shaded: &[(Vec3, f32)], inv_n: f32) -> (Vec4, f32) {
+pub(super) fn resolve(parts: &[PixelShare], shaded: &[(Vec3, f32)], inv_n: f32) -> (Vec4, f32) {
     let mut acc = Vec4::ZERO;
     let mut nearest = f32::INFINITY;
     for p in parts {
         let (c, d, count) = match *p {
-            Part::Shaded(c, d, count) => (c, d, count),
-            Part::Queued(slot, count) => {
+            PixelShare::Shaded(c, d, count) => (c, d, count),
+            PixelShare::Queued(slot, count) => {
                 let (c, d) = shaded[slot as usize];
                 (c.extend(1.0), d, count)
             }

@@ -70,12 +70,12 @@ impl Geometry {
 
 /// `densities`: whether to measure texel densities (filters with mip maps).
 pub(super) fn setup_and_bin(
-    fs: &FrameSetup,
+    setup: &FrameSetup,
     verts: &[ModelVertices],
     vp: Viewport,
     densities: bool,
 ) -> Geometry {
-    let scene = fs.scene;
+    let scene = setup.scene;
     let mut draws = Vec::new();
     for (mi, m) in scene.models.iter().enumerate() {
         for g in &m.mesh.groups {
@@ -100,7 +100,7 @@ pub(super) fn setup_and_bin(
     let grid = TileGrid::bands(vp.width, vp.height);
     let corners = corners_all(verts, vp);
     let mut tangents: Vec<Vec<Vec4>> = (0..verts.len())
-        .map(|m| vec![Vec4::ZERO; vertex::tangent_source(fs, m).len()])
+        .map(|m| vec![Vec4::ZERO; vertex::tangent_source(setup, m).len()])
         .collect();
     let models: Vec<usize> = ranges.iter().map(|r| draws[r.0].model).collect();
     let spans: Vec<(u32, u32)> = ranges.iter().map(|r| (r.1, r.2)).collect();
@@ -123,7 +123,7 @@ pub(super) fn setup_and_bin(
             let measure = densities && material.maps().next().is_some();
             let mv = &verts[d.model];
             let (tris, density) = setup_range(
-                fs,
+                setup,
                 (mv, &corners[d.model]),
                 (d, di),
                 start..end,
@@ -134,7 +134,7 @@ pub(super) fn setup_and_bin(
             if let Some(out) = tangent_out {
                 // Each mesh triangle's corners once, however many
                 // triangles its clipped polygon became.
-                let source = vertex::tangent_source(fs, d.model);
+                let source = vertex::tangent_source(setup, d.model);
                 let mut last = None;
                 for t in &tris {
                     if last != Some(t.prim) {
@@ -167,7 +167,7 @@ pub(super) fn setup_and_bin(
     for (m, (mv, t)) in verts.iter().zip(&mut tangents).enumerate() {
         if !owned[m] && !t.is_empty() {
             // Groups that overlap: every corner.
-            let source = vertex::tangent_source(fs, m);
+            let source = vertex::tangent_source(setup, m);
             t.par_chunks_mut(3).enumerate().for_each(|(prim, out)| {
                 if let Ok(out) = <&mut [Vec4; 3]>::try_from(out) {
                     mv.turn_tangents(source, prim as u32, out);
@@ -266,7 +266,7 @@ fn corners_all_of(clip: &[Vec4], vp: Viewport) -> Vec<Corner> {
 /// corners' projections, which is what `clip_triangle` and `setup` would
 /// give them; only the others are clipped.
 fn setup_range(
-    fs: &FrameSetup,
+    setup: &FrameSetup,
     (mv, corners): (&ModelVertices, &[Corner]),
     (d, di): (Draw, usize),
     prims: std::ops::Range<u32>,
@@ -274,7 +274,7 @@ fn setup_range(
     cull: CullMode,
     measure: bool,
 ) -> (Vec<Tri>, [f32; 2]) {
-    let mesh = &fs.scene.models[d.model].mesh;
+    let mesh = &setup.scene.models[d.model].mesh;
     let mut tris = Vec::with_capacity(prims.len());
     let mut max_density = [0.0f32; 2];
     let mut place = Placer {
@@ -397,15 +397,15 @@ mod tests {
         Scene::from_text(&dir.join("s.toml"), text, &opts).unwrap()
     }
 
-    /// Frame `fs` transformed, set up and binned at `width` x `height`.
-    fn geometry_of(fs: &FrameSetup, width: u32, height: u32, densities: bool) -> Geometry {
-        let verts = super::super::vertex::transform_all(fs);
+    /// Frame `setup` transformed, set up and binned at `width` x `height`.
+    fn geometry_of(setup: &FrameSetup, width: u32, height: u32, densities: bool) -> Geometry {
+        let verts = super::super::vertex::transform_all(setup);
         let vp = Viewport {
             width,
             height,
             msaa: false,
         };
-        setup_and_bin(fs, &verts, vp, densities)
+        setup_and_bin(setup, &verts, vp, densities)
     }
 
     /// `clip_triangle` then `setup` on every triangle, as before corners
@@ -520,14 +520,14 @@ mod tests {
                     [[camera]]\neye = [0.3, -0.2, 5.0]\ntarget = [0.0, 0.0, 0.0]\nnear = 0.5\n\
                     [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\n";
         let scene = scene_in(&dir, text);
-        let fs = FrameSetup::new(&scene, 0, 0);
-        let geo = geometry_of(&fs, 48, 40, true);
+        let setup = FrameSetup::new(&scene, 0, 0);
+        let geo = geometry_of(&setup, 48, 40, true);
         let (mut checked, mut cut) = (0, 0);
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
-            let m = glam::Mat3::from_mat4(fs.world_from_object[d.model]);
+            let m = glam::Mat3::from_mat4(setup.world_from_object[d.model]);
             let flip = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
-            let source = super::super::vertex::tangent_source(&fs, d.model);
+            let source = super::super::vertex::tangent_source(&setup, d.model);
             let end = geo
                 .chunks
                 .iter()
@@ -654,8 +654,8 @@ mod tests {
                     [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
                     projection = \"orthographic\"\nheight = 2.0\nnear = 0.1\nfar = 10.0\n";
         let scene = scene_in(&dir, text);
-        let fs = FrameSetup::new(&scene, 0, 0);
-        let geo = geometry_of(&fs, 32, 32, false);
+        let setup = FrameSetup::new(&scene, 0, 0);
+        let geo = geometry_of(&setup, 32, 32, false);
         assert_eq!(geo.draws.len(), 1);
         // The quad behind the camera is clipped away.
         assert_eq!(geo.tris.len(), 2);

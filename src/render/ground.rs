@@ -56,15 +56,15 @@ fn luminance(c: Vec3) -> f32 {
 impl<'a> Ground<'a> {
     /// The frame's catcher, when the scene asks for one.
     pub fn new(
-        fs: &'a FrameSetup<'a>,
+        setup: &'a FrameSetup<'a>,
         ctx: &ShadeContext<'a>,
         tracer: Option<&'a Tracer<'a>>,
         width: u32,
         height: u32,
     ) -> Option<Ground<'a>> {
-        let plane = fs.scene.ground.as_ref()?;
+        let plane = setup.scene.ground.as_ref()?;
         let tracer = tracer?;
-        if fs.scene.settings.shading.is_data_view() {
+        if setup.scene.settings.shading.is_data_view() {
             return None;
         }
         let ambient = match ctx.env {
@@ -77,15 +77,15 @@ impl<'a> Ground<'a> {
             Vec::new()
         };
         Some(Ground {
-            rays: CameraRays::new(&fs.camera, width, height),
+            rays: CameraRays::new(&setup.camera, width, height),
             height: plane.height,
             center: plane.center,
             radius: plane.radius,
-            lights: &fs.lights,
+            lights: &setup.lights,
             tracer,
             ambient,
             ao,
-            transparent: fs.scene.settings.background == Background::Transparent,
+            transparent: setup.scene.settings.background == Background::Transparent,
         })
     }
 

@@ -268,7 +268,7 @@ fn put_quad(
     let inv_n = 1.0 / n as f32;
     for (k, &i) in pixels.iter().enumerate() {
         (color[i], depth[i]) = super::fragment::resolve(
-            &[super::fragment::Part::Queued(0, n as f32)],
+            &[super::fragment::PixelShare::Queued(0, n as f32)],
             &out[k..k + 1],
             inv_n,
         );
@@ -409,7 +409,7 @@ impl<'a> FrameData<'a> {
     #[inline]
     pub(super) fn corners(&self, draw: usize, t: &Tri) -> Corners {
         let d = self.draws[draw];
-        let mesh = &self.fs.scene.models[d.model].mesh;
+        let mesh = &self.setup.scene.models[d.model].mesh;
         let mv = &self.verts[d.model];
         let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
         let tt = &self.tangents[d.model];
@@ -452,7 +452,7 @@ impl<'a> FrameData<'a> {
         at: usize,
     ) -> (Lanes<L>, Coords<'p, L>, L) {
         let d = self.draws[p.draw];
-        let mesh = &self.fs.scene.models[d.model].mesh;
+        let mesh = &self.setup.scene.models[d.model].mesh;
         let ctx = &self.ctx;
         let c = |k: usize| corners[at + k];
         let l = V3::<L>::from_fn(|k| p.lambda[at + k]);
@@ -552,7 +552,7 @@ impl<'a> FrameData<'a> {
         let (lanes, coords, depth) = self.lanes::<L>(lm, p, corners, at);
         if p.layer {
             // The vertex colours' alpha (exactly 1 without them).
-            let mesh = &self.fs.scene.models[self.draws[p.draw].model].mesh;
+            let mesh = &self.setup.scene.models[self.draws[p.draw].model].mesh;
             let alpha = if mesh.colors.is_empty() {
                 L::splat(1.0)
             } else {

@@ -30,20 +30,21 @@ struct End {
 const DEPTH_SLACK: f32 = 2e-3;
 
 /// Whether some model of the scene has lines or points to draw.
-pub(super) fn any(fs: &FrameSetup) -> bool {
-    fs.scene
+pub(super) fn any(setup: &FrameSetup) -> bool {
+    setup
+        .scene
         .models
         .iter()
         .any(|m| !m.mesh.lines.is_empty() || !m.mesh.points.is_empty())
 }
 
-pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, out: &mut Frame) {
-    let s = &fs.scene.settings;
-    let view = fs.camera.view_from_world();
-    let near = fs.camera.near;
+pub(super) fn draw(setup: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, out: &mut Frame) {
+    let s = &setup.scene.settings;
+    let view = setup.camera.view_from_world();
+    let near = setup.camera.near;
     let half_line = 0.5 * s.line_width * pixel_scale;
     let radius = 0.5 * s.point_size * pixel_scale;
-    for (m, mv) in fs.scene.models.iter().zip(verts) {
+    for (m, mv) in setup.scene.models.iter().zip(verts) {
         let mesh = &m.mesh;
         if mesh.lines.is_empty() && mesh.points.is_empty() {
             continue;
@@ -74,8 +75,8 @@ pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, o
             };
             let ((pa, da), (pb, db)) = (cut(pa, da, pb, db), cut(pb, db, pa, da));
             let (Some(ea), Some(eb)) = (
-                project(fs.clip_from_world, pa, da, ca, out),
-                project(fs.clip_from_world, pb, db, cb, out),
+                project(setup.clip_from_world, pa, da, ca, out),
+                project(setup.clip_from_world, pb, db, cb, out),
             ) else {
                 continue;
             };
@@ -88,7 +89,7 @@ pub(super) fn draw(fs: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, o
             if d.is_nan() || d < near {
                 continue;
             }
-            if let Some(e) = project(fs.clip_from_world, w, d, color(v, p.material), out) {
+            if let Some(e) = project(setup.clip_from_world, w, d, color(v, p.material), out) {
                 disc(e, radius, out);
             }
         }

@@ -222,14 +222,14 @@ impl Renderer {
                 .with_lane_width(self.lane_width)
                 .render_frame(scene, camera, frame, out, display);
         }
-        let fs = FrameSetup::new(scene, camera, frame);
+        let setup = FrameSetup::new(scene, camera, frame);
         let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
         if k == 1 {
-            self.render_at(&fs, s.width, s.height, out, display, None);
+            self.render_at(&setup, s.width, s.height, out, display, None);
             return;
         }
         let mut big = Frame::new(0, 0);
-        self.render_at(&fs, s.width * k, s.height * k, &mut big, None, None);
+        self.render_at(&setup, s.width * k, s.height * k, &mut big, None, None);
         frame::downsample(&big, k, out);
         if let Some(image) = display {
             display::resolve_into(out, s, image);
@@ -258,8 +258,8 @@ impl Renderer {
             known.clear();
             return self.render_frame(scene, camera, frame, out, image);
         }
-        let fs = FrameSetup::new(scene, camera, frame);
-        self.render_at(&fs, s.width, s.height, out, image, Some(known));
+        let setup = FrameSetup::new(scene, camera, frame);
+        self.render_at(&setup, s.width, s.height, out, image, Some(known));
     }
 
     /// Builds every texture's mip chain now (a benchmark counts them as
@@ -346,13 +346,13 @@ impl Renderer {
     /// frame's posed models (`posed_bvhs`).
     fn tracer<'a>(
         &'a self,
-        fs: &FrameSetup,
+        setup: &FrameSetup,
         posed: &'a [Option<(Bvh, (Vec3, Vec3))>],
     ) -> Tracer<'a> {
         let placed = self
             .model_mesh
             .iter()
-            .zip(&fs.world_from_object)
+            .zip(&setup.world_from_object)
             .zip(posed)
             .map(|((&k, &world_from_object), posed)| {
                 let (bvh, bounds) = match posed {
@@ -368,18 +368,19 @@ impl Renderer {
                     world_from_object,
                 }
             });
-        Tracer::new(placed, fs.scene.bounds_radius)
+        Tracer::new(placed, setup.scene.bounds_radius)
     }
 
     /// Per model: the BVH of its vertices as this frame poses them, the
     /// kept BVH of its rest pose refitted (None for models at rest, whose
     /// BVH the renderer keeps).
-    fn posed_bvhs(&self, fs: &FrameSetup) -> Vec<Option<(Bvh, (Vec3, Vec3))>> {
-        fs.scene
+    fn posed_bvhs(&self, setup: &FrameSetup) -> Vec<Option<(Bvh, (Vec3, Vec3))>> {
+        setup
+            .scene
             .models
             .par_iter()
             .zip(&self.model_mesh)
-            .zip(&fs.posed)
+            .zip(&setup.posed)
             .map(|((m, &k), p)| {
                 let (p, _) = p.as_ref()?;
                 let bounds = p.positions.iter().fold(
@@ -399,14 +400,14 @@ impl Renderer {
     /// with `display`, resolved into it too.
     fn render_at(
         &self,
-        fs: &FrameSetup,
+        setup: &FrameSetup,
         width: u32,
         height: u32,
         out: &mut Frame,
         mut display: Option<&mut Image8>,
         known: Option<&mut Vec<Option<display::PlainBackground>>>,
     ) {
-        let s = &fs.scene.settings;
+        let s = &setup.scene.settings;
         out.resize(width, height);
         let pattern = sample_pattern(s.msaa).unwrap_or(&[(0, 0)]);
         let vp = Viewport {
@@ -415,25 +416,25 @@ impl Renderer {
             msaa: pattern.len() > 1,
         };
         let shadow_rays =
-            s.shadows == ShadowMethod::Raytraced && fs.lights.iter().any(|l| l.shadows);
-        let sampled = self.env_sampler(fs.scene);
+            s.shadows == ShadowMethod::Raytraced && setup.lights.iter().any(|l| l.shadows);
+        let sampled = self.env_sampler(setup.scene);
         let traced = shadow_rays
             || s.ao.method == AoMethod::Raytraced
             || sampled.is_some()
-            || fs.scene.ground.is_some();
+            || setup.scene.ground.is_some();
         let posed_bvhs = if traced {
-            self.posed_bvhs(fs)
+            self.posed_bvhs(setup)
         } else {
             Vec::new()
         };
-        let tracer = traced.then(|| self.tracer(fs, &posed_bvhs));
+        let tracer = traced.then(|| self.tracer(setup, &posed_bvhs));
 
-        let mut verts = vertex::transform_all(fs);
-        let shadows = shadow_pass::shadows(fs, &verts, tracer.as_ref(), &self.shadow_maps);
-        let env = self.env_light(fs.scene);
+        let mut verts = vertex::transform_all(setup);
+        let shadows = shadow_pass::shadows(setup, &verts, tracer.as_ref(), &self.shadow_maps);
+        let env = self.env_light(setup.scene);
         if s.shading == ShadingMode::Gouraud {
-            let ctx = shade_context(fs, &[], &shadows, env);
-            for (m, mv) in fs.scene.models.iter().zip(&mut verts) {
+            let ctx = shade_context(setup, &[], &shadows, env);
+            for (m, mv) in setup.scene.models.iter().zip(&mut verts) {
                 mv.light = gouraud::vertex_light(&ctx, m, &mv.world, &mv.normal);
             }
         }
@@ -441,15 +442,15 @@ impl Renderer {
             s.texture_filter,
             TextureFilter::Trilinear | TextureFilter::Anisotropic
         ) && !self.textures.is_empty();
-        let geo = geometry::setup_and_bin(fs, &verts, vp, filtered);
-        let mips = self.frame_mips(fs, &geo);
+        let geo = geometry::setup_and_bin(setup, &verts, vp, filtered);
+        let mips = self.frame_mips(setup, &geo);
 
-        let mut ctx = shade_context(fs, &mips, &shadows, env);
+        let mut ctx = shade_context(setup, &mips, &shadows, env);
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let mut data = fragment::FrameData::new(
-            fs,
+            setup,
             ctx,
             (&verts, &geo),
             (pattern, filtered),
@@ -463,7 +464,7 @@ impl Renderer {
         if let Some(bg) = &mut data.env_bg {
             self.backdrops.attach(bg);
         }
-        let overlay = !s.shading.is_data_view() && lines::any(fs);
+        let overlay = !s.shading.is_data_view() && lines::any(setup);
         let fused = if overlay {
             None
         } else {
@@ -475,7 +476,7 @@ impl Renderer {
         if overlay {
             // Lines may cross the plain background anywhere.
             known.clear();
-            lines::draw(fs, &verts, width as f32 / s.width as f32, out);
+            lines::draw(setup, &verts, width as f32 / s.width as f32, out);
             if let Some(image) = display {
                 display::resolve_into(out, s, image);
             }
@@ -498,7 +499,7 @@ impl Renderer {
         let band = (grid.tile_w * grid.tile_h) as usize;
         // The data passes: a buffer the bands fill beside their colour, or
         // an empty chunk per band.
-        let aovs = data.fs.scene.output.writes_aovs();
+        let aovs = data.setup.scene.output.writes_aovs();
         if aovs {
             out.aov.resize(out.color.len(), AovPixel::EMPTY);
         } else {
@@ -513,7 +514,7 @@ impl Renderer {
         // band without one.
         let (encoder, bytes): (_, Vec<&mut [u8]>) = match display {
             Some(image) => {
-                let e = display::Encoder::new(&data.fs.scene.settings);
+                let e = display::Encoder::new(&data.setup.scene.settings);
                 e.shape(out.width, out.height, image);
                 (
                     Some(e),
@@ -528,7 +529,7 @@ impl Renderer {
                 e.band(color, width, plain, bytes);
             }
         };
-        if data.fs.scene.settings.ao.method == AoMethod::Off {
+        if data.setup.scene.settings.ao.method == AoMethod::Off {
             out.ao.clear();
             let chunks = aov_chunks(&mut out.aov, band, bands);
             out.color
@@ -561,7 +562,7 @@ impl Renderer {
                 (vis, blended)
             })
             .collect();
-        out.ao = ao_pass::occlusion(data.fs, &gbuf, out.width, out.height, tracer);
+        out.ao = ao_pass::occlusion(data.setup, &gbuf, out.width, out.height, tracer);
         let chunks = aov_chunks(&mut out.aov, band, bands);
         out.color
             .par_chunks_mut(band)
@@ -588,11 +589,11 @@ impl Renderer {
     /// triangle's footprint reaches half a texel (the level of detail can
     /// pass 0 there); the others read level 0 only, so a frame's pixels do
     /// not depend on which frames came before.
-    fn frame_mips(&self, fs: &FrameSetup, geo: &Geometry) -> Vec<Option<&[Level]>> {
+    fn frame_mips(&self, setup: &FrameSetup, geo: &Geometry) -> Vec<Option<&[Level]>> {
         let mut needed = vec![false; self.textures.len()];
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
-            for map in fs.scene.models[d.model].materials[d.material].maps() {
+            for map in setup.scene.models[d.model].materials[d.material].maps() {
                 let t = &map.texture;
                 let texels = c.density[(map.texcoord as usize).min(1)]
                     * t.width as f32
@@ -623,21 +624,21 @@ fn aov_chunks(aov: &mut [AovPixel], band: usize, bands: usize) -> Vec<&mut [AovP
 }
 
 fn shade_context<'a>(
-    fs: &'a FrameSetup,
+    setup: &'a FrameSetup,
     mips: &'a [Option<&'a [Level]>],
     shadows: &'a Shadows<'a>,
     env: Option<&'a EnvLight>,
 ) -> ShadeContext<'a> {
-    let s = &fs.scene.settings;
-    let cam = &fs.camera;
+    let s = &setup.scene.settings;
+    let cam = &setup.camera;
     let forward = cam.forward();
-    let dist = (fs.scene.bounds_center - cam.eye).dot(forward);
-    let r = fs.scene.bounds_radius;
+    let dist = (setup.scene.bounds_center - cam.eye).dot(forward);
+    let r = setup.scene.bounds_radius;
     let lo = (dist - r).max(cam.near);
     let hi = (dist + r).max(lo + 1e-6);
     ShadeContext {
         mode: s.shading,
-        lights: &fs.lights,
+        lights: &setup.lights,
         ambient: s.ambient,
         eye: cam.eye,
         forward,

@@ -91,13 +91,13 @@ struct MapKey {
 /// `render.shadows = "raytraced"` tests against. `cache`: the maps of the
 /// renderer's last frame.
 pub(super) fn shadows<'a>(
-    fs: &FrameSetup,
+    setup: &FrameSetup,
     mv: &[ModelVertices],
     tracer: Option<&'a Tracer<'a>>,
     cache: &MapCache,
 ) -> Shadows<'a> {
-    let s = &fs.scene.settings;
-    if s.shadows == ShadowMethod::Off || !fs.lights.iter().any(|l| l.shadows) {
+    let s = &setup.scene.settings;
+    if s.shadows == ShadowMethod::Off || !setup.lights.iter().any(|l| l.shadows) {
         return Shadows::none();
     }
     let filter = if s.shadows == ShadowMethod::Hard {
@@ -113,13 +113,17 @@ pub(super) fn shadows<'a>(
     };
     if s.shadows == ShadowMethod::Raytraced {
         out.tracer = tracer;
-        out.lights = light_shadows(fs, mv, &mut Vec::new()).into();
+        out.lights = light_shadows(setup, mv, &mut Vec::new()).into();
         return out;
     }
     let key = MapKey {
-        lights: fs.lights.clone(),
-        world_from_object: fs.world_from_object.clone(),
-        poses: fs.posed.iter().map(|p| p.as_ref().map(|p| p.1)).collect(),
+        lights: setup.lights.clone(),
+        world_from_object: setup.world_from_object.clone(),
+        poses: setup
+            .posed
+            .iter()
+            .map(|p| p.as_ref().map(|p| p.1))
+            .collect(),
         method: s.shadows,
         size: s.shadow_map_size,
     };
@@ -151,7 +155,7 @@ pub(super) fn shadows<'a>(
                     }
                 }
             }
-            let maps: Arc<[LightShadow]> = light_shadows(fs, mv, &mut spare).into();
+            let maps: Arc<[LightShadow]> = light_shadows(setup, mv, &mut spare).into();
             *cache.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, maps.clone()));
             maps
         }
@@ -162,25 +166,25 @@ pub(super) fn shadows<'a>(
 /// Each light's shadow: its map(s), rays, or none. Maps draw into the
 /// buffers of `spare` where they fit.
 fn light_shadows(
-    fs: &FrameSetup,
+    setup: &FrameSetup,
     mv: &[ModelVertices],
     spare: &mut Vec<Spare>,
 ) -> Vec<LightShadow> {
-    let s = &fs.scene.settings;
-    let mut out = Vec::with_capacity(fs.lights.len());
+    let s = &setup.scene.settings;
+    let mut out = Vec::with_capacity(setup.lights.len());
     let size = s.shadow_map_size;
     let verts: Vec<Geo> = mv
         .iter()
-        .zip(&fs.scene.models)
+        .zip(&setup.scene.models)
         .map(|(v, m)| Geo {
             world: &v.world,
             triangles: &m.mesh.triangles,
             casts: true,
         })
         .collect();
-    let eps = 1e-5 * fs.scene.bounds_radius.max(f32::MIN_POSITIVE);
+    let eps = 1e-5 * setup.scene.bounds_radius.max(f32::MIN_POSITIVE);
     let planes: Vec<Option<Plane>> = verts.iter().map(|g| plane_of(g, eps)).collect();
-    for light in &fs.lights {
+    for light in &setup.lights {
         let mut verts = verts.clone();
         for (k, plane) in planes.iter().enumerate() {
             if let Some(plane) = plane {

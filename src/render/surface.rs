@@ -48,7 +48,7 @@ impl<'a> FrameData<'a> {
         l: Vec3,
     ) -> (&crate::scene::Material, [Option<Vec2>; 2], Vec4) {
         let d = self.draws[t.draw as usize];
-        let model = &self.fs.scene.models[d.model];
+        let model = &self.setup.scene.models[d.model];
         let mesh = &model.mesh;
         let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
         let at = |uv: &[Vec2]| {
@@ -103,7 +103,7 @@ impl<'a> FrameData<'a> {
     /// `gradients` of set 0 alone.
     pub(super) fn gradients0(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
         let d = self.draws[t.draw as usize];
-        let mesh = &self.fs.scene.models[d.model].mesh;
+        let mesh = &self.setup.scene.models[d.model].mesh;
         let uv = &mesh.uvs;
         if uv.is_empty() {
             return Gradients::default();
@@ -129,7 +129,7 @@ impl<'a> FrameData<'a> {
         frag: Fragment,
         px: (i32, i32),
         texture: ([Gradients; 2], [Option<SizedFootprint>; 2]),
-        reach: Reach,
+        reach: FragmentLighting,
     ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
         let surface = self.surface(tri, frag, px, texture, reach);
         (
@@ -148,12 +148,12 @@ impl<'a> FrameData<'a> {
         frag: Fragment,
         (px, py): (i32, i32),
         (grads, footprints): ([Gradients; 2], [Option<SizedFootprint>; 2]),
-        reach: Reach,
+        reach: FragmentLighting,
     ) -> Surface<'_> {
         let ctx = &self.ctx;
         let mode = ctx.mode;
         let d = self.draws[t.draw as usize];
-        let model = &self.fs.scene.models[d.model];
+        let model = &self.setup.scene.models[d.model];
         let mv = &self.verts[d.model];
         let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
         let l = frag.lambda;
@@ -213,7 +213,7 @@ impl<'a> FrameData<'a> {
     pub(super) fn point(&self, t: &Tri, frag: Fragment) -> Point {
         let ctx = &self.ctx;
         let d = self.draws[t.draw as usize];
-        let model = &self.fs.scene.models[d.model];
+        let model = &self.setup.scene.models[d.model];
         let mv = &self.verts[d.model];
         let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
         let l = frag.lambda;
@@ -252,14 +252,14 @@ impl<'a> FrameData<'a> {
 /// What reaches a fragment besides its triangle: its ambient occlusion
 /// (1: none) and the lights that may reach its tile.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Reach {
+pub(super) struct FragmentLighting {
     pub ao: f32,
     pub lights: LightMask,
 }
 
-impl Reach {
+impl FragmentLighting {
     /// No occlusion, every light.
-    pub const FULL: Reach = Reach {
+    pub const FULL: FragmentLighting = FragmentLighting {
         ao: 1.0,
         lights: LightMask::ALL,
     };

@@ -39,26 +39,27 @@ impl ModelVertices {
 }
 
 /// Model `m`'s per-corner tangents (at rest or posed) in object space.
-pub(super) fn tangent_source<'a>(fs: &'a FrameSetup, m: usize) -> &'a [Vec4] {
-    match &fs.posed[m] {
+pub(super) fn tangent_source<'a>(setup: &'a FrameSetup, m: usize) -> &'a [Vec4] {
+    match &setup.posed[m] {
         Some((p, _)) => &p.tangents,
-        None => &fs.scene.models[m].mesh.tangents,
+        None => &setup.scene.models[m].mesh.tangents,
     }
 }
 
 /// Every model of the frame, in scene order.
-pub(super) fn transform_all(fs: &FrameSetup) -> Vec<ModelVertices> {
-    fs.scene
+pub(super) fn transform_all(setup: &FrameSetup) -> Vec<ModelVertices> {
+    setup
+        .scene
         .models
         .iter()
-        .zip(&fs.world_from_object)
-        .zip(&fs.posed)
+        .zip(&setup.world_from_object)
+        .zip(&setup.posed)
         .map(|((m, world), posed)| {
             let (positions, normals) = match posed {
                 Some((p, _)) => (&p.positions, &p.normals),
                 None => (&m.mesh.positions, &m.mesh.normals),
             };
-            transform(fs.clip_from_world, positions, normals, *world)
+            transform(setup.clip_from_world, positions, normals, *world)
         })
         .collect()
 }

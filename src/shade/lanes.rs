@@ -64,7 +64,7 @@ pub(super) struct Map<'a> {
 
 /// The shading model of a lane material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Kind {
+pub(super) enum LaneShading {
     BlinnPhong,
     Pbr,
 }
@@ -72,7 +72,7 @@ pub(super) enum Kind {
 /// A material the lanes can shade, prepared for one frame.
 pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
-    pub(super) kind: Kind,
+    pub(super) kind: LaneShading,
     /// Whether its blended surfaces are layers the lanes shade
     /// (`layer_lanes`): blended, and not transmissive.
     pub layers: bool,
@@ -375,10 +375,10 @@ impl<'a> ShadeContext<'a> {
             return None;
         }
         let kind = match self.mode {
-            ShadingMode::BlinnPhong => Kind::BlinnPhong,
-            ShadingMode::Pbr => Kind::Pbr,
-            ShadingMode::Auto if m.native == Native::BlinnPhong => Kind::BlinnPhong,
-            ShadingMode::Auto => Kind::Pbr,
+            ShadingMode::BlinnPhong => LaneShading::BlinnPhong,
+            ShadingMode::Pbr => LaneShading::Pbr,
+            ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,
+            ShadingMode::Auto => LaneShading::Pbr,
             _ => return None,
         };
         let mut maps = MapSet {
@@ -389,13 +389,13 @@ impl<'a> ShadeContext<'a> {
             slots: SmallVec::new(),
         };
         match kind {
-            Kind::BlinnPhong => maps.blinn_phong(m)?,
-            Kind::Pbr => maps.pbr(m)?,
+            LaneShading::BlinnPhong => maps.blinn_phong(m)?,
+            LaneShading::Pbr => maps.pbr(m)?,
         }
         // A blended surface's opacity reads these too (`opacity`); a
         // transmissive one is the one-fragment path's layer.
-        let layers =
-            m.alpha == AlphaMode::Blend && !(kind == Kind::Pbr && m.pbr.transmission.is_some());
+        let layers = m.alpha == AlphaMode::Blend
+            && !(kind == LaneShading::Pbr && m.pbr.transmission.is_some());
         if layers {
             maps.optional(&m.map_d)?;
             maps.optional(&m.map_kd)?;
@@ -452,8 +452,8 @@ impl<'a> ShadeContext<'a> {
         fetch: &mut LaneFetch<'_, 'a, '_, L>,
     ) -> V3<L> {
         match lm.kind {
-            Kind::BlinnPhong => self.shade_blinn_phong(lm.material, fetch, f, None),
-            Kind::Pbr => self.shade_pbr(lm.material, fetch, f),
+            LaneShading::BlinnPhong => self.shade_blinn_phong(lm.material, fetch, f, None),
+            LaneShading::Pbr => self.shade_pbr(lm.material, fetch, f),
         }
     }
 
@@ -821,15 +821,15 @@ mod tests {
             })
         };
         // The packed texture is one lookup, read twice.
-        assert_eq!(kind(&auto, &gltf), Some((Kind::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &gltf), Some((LaneShading::Pbr, 4, 3)));
         // Without coordinates its maps cannot be looked up.
         assert!(auto.lane_material(&gltf, [false; 2], true).is_none());
         let mut obj = Material::default_named("obj");
         obj.map_kd = Some(map(16));
-        assert_eq!(kind(&auto, &obj), Some((Kind::BlinnPhong, 1, 1)));
+        assert_eq!(kind(&auto, &obj), Some((LaneShading::BlinnPhong, 1, 1)));
         // Forced pbr shading takes the OBJ material's pbr view.
         let pbr = context(&shadows, ShadingMode::Pbr);
-        assert_eq!(kind(&pbr, &obj), Some((Kind::Pbr, 0, 0)));
+        assert_eq!(kind(&pbr, &obj), Some((LaneShading::Pbr, 0, 0)));
         let flat = context(&shadows, ShadingMode::Flat);
         assert_eq!(kind(&flat, &obj), None);
 
@@ -841,7 +841,7 @@ mod tests {
             roughness_map: Some(map(16)),
             normal_map: None,
         });
-        assert_eq!(kind(&auto, &coat), Some((Kind::Pbr, 5, 4)));
+        assert_eq!(kind(&auto, &coat), Some((LaneShading::Pbr, 5, 4)));
         let mut unlit = gltf.clone();
         unlit.unlit = true;
         assert_eq!(kind(&auto, &unlit), None);
@@ -850,7 +850,7 @@ mod tests {
             t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
         }
         // A transform is a slot of its own.
-        assert_eq!(kind(&auto, &moved), Some((Kind::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &moved), Some((LaneShading::Pbr, 4, 3)));
         let mut limited = gltf.clone();
         if let Some(t) = &mut limited.pbr.base_color_map {
             t.mag_nearest = true;
@@ -859,7 +859,7 @@ mod tests {
         let mut sizes = gltf.clone();
         sizes.pbr.emissive = Vec3::ONE;
         sizes.pbr.emissive_map = Some(map(32));
-        assert_eq!(kind(&auto, &sizes), Some((Kind::Pbr, 5, 4)));
+        assert_eq!(kind(&auto, &sizes), Some((LaneShading::Pbr, 5, 4)));
         let mut four = sizes.clone();
         four.pbr.base_color_map = Some(map(4));
         assert_eq!(kind(&auto, &four), None);

@@ -21,7 +21,7 @@ use crate::error::Error;
 use crate::scene::Model;
 use crate::scene::animation::Animation;
 use crate::scene::camera::{Camera, CameraKey, CameraPath, Projection, fitted_planes};
-use crate::scene::desc::{self, Ctx, S, SceneDesc};
+use crate::scene::desc::{self, Ctx, SceneDesc, Spanned};
 
 /// The default elevation of fitted cameras, degrees above the horizon.
 const ELEVATION: f32 = 20.0;
@@ -211,7 +211,7 @@ fn check_name(name: &str) -> Result<(), String> {
 /// when given). With one of them: the other from the fitted camera's
 /// offset (a missing target is the models' center). Up +Y, fov 45.
 fn from_desc(
-    c: &S<desc::CameraDesc>,
+    c: &Spanned<desc::CameraDesc>,
     name: String,
     ctx: &Ctx,
     b: Bounds,

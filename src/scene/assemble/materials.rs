@@ -12,7 +12,7 @@ use crate::assets::gltf::{GltfAlphaMode, GltfMaterial, ImageSource, TexInfo};
 use crate::assets::obj::{self, MapSpec, MtlMaterial};
 use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
-use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, S};
+use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, Spanned};
 use crate::scene::material::{
     AlphaMode, Clearcoat, DielectricSpecular, IridescenceLayer, Material, Native, NormalMap,
     NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
@@ -106,7 +106,7 @@ impl SourceMaterial {
 }
 
 fn map_override(
-    v: &Option<S<String>>,
+    v: &Option<Spanned<String>>,
     scene_dir: &Path,
     ctx: &Ctx,
 ) -> Result<Option<MapSpec>, Error> {

@@ -17,7 +17,7 @@ use glam::Vec3;
 
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
-use super::desc::{self, Ctx, S, SceneDesc};
+use super::desc::{self, Ctx, SceneDesc, Spanned};
 use super::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::EnvImage;
@@ -179,7 +179,7 @@ fn model_as_scene(path: &Path) -> Option<String> {
 }
 
 /// The value of an optional key, or its default.
-fn get<T: Clone>(v: &Option<S<T>>, default: T) -> T {
+fn get<T: Clone>(v: &Option<Spanned<T>>, default: T) -> T {
     v.as_ref().map(|s| s.get_ref().clone()).unwrap_or(default)
 }
 

@@ -17,7 +17,7 @@ use crate::scene::settings::{
 };
 
 /// An optional key's value, or the renderer's default for it.
-fn pick<T: Copy + Default>(v: &Option<desc::S<T>>) -> T {
+fn pick<T: Copy + Default>(v: &Option<desc::Spanned<T>>) -> T {
     v.as_ref().map(|v| *v.get_ref()).unwrap_or_default()
 }
 

@@ -8,7 +8,6 @@ use std::path::Path;
 
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
-use toml::Spanned;
 
 use super::animation::TurntableTarget;
 use super::camera::Interpolation;
@@ -25,7 +24,7 @@ mod validate;
 use messages::{in_words, source_excerpt};
 use validate::*;
 
-pub type S<T> = Spanned<T>;
+pub use toml::Spanned;
 
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -37,15 +36,15 @@ pub struct SceneDesc {
     #[serde(default)]
     pub ambient: AmbientDesc,
     #[serde(default, rename = "model")]
-    pub models: Vec<S<ModelDesc>>,
+    pub models: Vec<Spanned<ModelDesc>>,
     #[serde(default, rename = "light")]
-    pub lights: Vec<S<LightDesc>>,
+    pub lights: Vec<Spanned<LightDesc>>,
     #[serde(default, rename = "camera")]
-    pub cameras: Vec<S<CameraDesc>>,
+    pub cameras: Vec<Spanned<CameraDesc>>,
     #[serde(default)]
     pub animation: AnimationDesc,
     /// Version 2: image-based lighting.
-    pub environment: Option<S<EnvironmentDesc>>,
+    pub environment: Option<Spanned<EnvironmentDesc>>,
     /// Version 2: the shadow catcher.
     #[serde(default)]
     pub ground: GroundDesc,
@@ -55,7 +54,7 @@ pub struct SceneDesc {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct GroundDesc {
-    pub shadow: Option<S<bool>>,
+    pub shadow: Option<Spanned<bool>>,
 }
 
 /// `[environment]`: an equirectangular HDR image lighting the scene.
@@ -64,21 +63,21 @@ pub struct GroundDesc {
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
     /// `.hdr` or `.exr`, relative to the scene file (or `preset`).
-    pub path: Option<S<String>>,
+    pub path: Option<Spanned<String>>,
     /// A built-in environment: "studio" or "neutral".
-    pub preset: Option<S<EnvPreset>>,
-    pub intensity: Option<S<f32>>,
+    pub preset: Option<Spanned<EnvPreset>>,
+    pub intensity: Option<Spanned<f32>>,
     /// Degrees about +Y, counter-clockwise seen from above.
-    pub rotation: Option<S<f32>>,
+    pub rotation: Option<Spanned<f32>>,
     /// "prefiltered" (default) or "sampled" (the Monte Carlo reference).
-    pub method: Option<S<EnvMethodName>>,
+    pub method: Option<Spanned<EnvMethodName>>,
     /// Sampled: direction pairs a point (default 64).
-    pub samples: Option<S<i64>>,
+    pub samples: Option<Spanned<i64>>,
     /// Prefiltered: width in texels of the sharpest glossy level
     /// (roughness 0.2; the rougher levels get half); default 128.
-    pub prefilter_size: Option<S<i64>>,
+    pub prefilter_size: Option<Spanned<i64>>,
     /// A shadow-casting directional light from the brightest region.
-    pub sun: Option<S<bool>>,
+    pub sun: Option<Spanned<bool>>,
 }
 
 /// The built-in environments.
@@ -102,30 +101,30 @@ pub enum EnvMethodName {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct OutputDesc {
-    pub width: Option<S<i64>>,
-    pub height: Option<S<i64>>,
-    pub dir: Option<S<String>>,
-    pub name: Option<S<String>>,
-    pub color: Option<S<bool>>,
-    pub depth: Option<S<bool>>,
-    pub ao: Option<S<bool>>,
-    pub gif: Option<S<String>>,
-    pub gif_delay_ms: Option<S<i64>>,
+    pub width: Option<Spanned<i64>>,
+    pub height: Option<Spanned<i64>>,
+    pub dir: Option<Spanned<String>>,
+    pub name: Option<Spanned<String>>,
+    pub color: Option<Spanned<bool>>,
+    pub depth: Option<Spanned<bool>>,
+    pub ao: Option<Spanned<bool>>,
+    pub gif: Option<Spanned<String>>,
+    pub gif_delay_ms: Option<Spanned<i64>>,
     /// Extension: "none" (default), "ordered" or "floyd-steinberg".
-    pub gif_dither: Option<S<GifDither>>,
-    pub background: Option<S<Background>>,
+    pub gif_dither: Option<Spanned<GifDither>>,
+    pub background: Option<Spanned<Background>>,
     /// Version 2: how blurred `background = "blurred"` is, 0..1 (0.5).
-    pub background_blur: Option<S<f32>>,
+    pub background_blur: Option<Spanned<f32>>,
     /// Version 2: an H.264 MP4 of each camera's colour frames.
-    pub video: Option<S<String>>,
-    pub video_fps: Option<S<f32>>,
+    pub video: Option<Spanned<String>>,
+    pub video_fps: Option<Spanned<f32>>,
     /// 1 to 100, or a bitrate string such as "2500k".
-    pub video_quality: Option<S<VideoQualityDesc>>,
+    pub video_quality: Option<Spanned<VideoQualityDesc>>,
     /// Version 2: the data passes as EXR.
-    pub normal: Option<S<bool>>,
-    pub albedo: Option<S<bool>>,
-    pub position: Option<S<bool>>,
-    pub id: Option<S<bool>>,
+    pub normal: Option<Spanned<bool>>,
+    pub albedo: Option<Spanned<bool>>,
+    pub position: Option<Spanned<bool>>,
+    pub id: Option<Spanned<bool>>,
 }
 
 /// `output.video_quality` as written: a number or a string.
@@ -162,78 +161,78 @@ impl<'de> Deserialize<'de> for VideoQualityDesc {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RenderDesc {
-    pub shading: Option<S<ShadingMode>>,
-    pub msaa: Option<S<i64>>,
+    pub shading: Option<Spanned<ShadingMode>>,
+    pub msaa: Option<Spanned<i64>>,
     /// Extension: supersampling, the frame rendered at this many times the
     /// output size per axis and box-filtered down (default 1).
-    pub ssaa: Option<S<i64>>,
-    pub texture_filter: Option<S<TextureFilter>>,
-    pub max_anisotropy: Option<S<i64>>,
-    pub address: Option<S<AddressMode>>,
-    pub cull: Option<S<CullMode>>,
-    pub depth: Option<S<DepthMode>>,
-    pub shadows: Option<S<ShadowMethod>>,
-    pub shadow_map_size: Option<S<i64>>,
+    pub ssaa: Option<Spanned<i64>>,
+    pub texture_filter: Option<Spanned<TextureFilter>>,
+    pub max_anisotropy: Option<Spanned<i64>>,
+    pub address: Option<Spanned<AddressMode>>,
+    pub cull: Option<Spanned<CullMode>>,
+    pub depth: Option<Spanned<DepthMode>>,
+    pub shadows: Option<Spanned<ShadowMethod>>,
+    pub shadow_map_size: Option<Spanned<i64>>,
     /// Extension: shadow-map bias in texels.
-    pub shadow_bias: Option<S<ShadowBiasDesc>>,
-    pub ao: Option<S<AoDesc>>,
+    pub shadow_bias: Option<Spanned<ShadowBiasDesc>>,
+    pub ao: Option<Spanned<AoDesc>>,
     /// Extension: refuse to render when the memory estimate exceeds this
     /// (`"512M"`, `"2G"`, or bytes).
-    pub max_memory: Option<S<MemorySize>>,
+    pub max_memory: Option<Spanned<MemorySize>>,
     /// Version 3: every read stays inside the scene's folder (no `..`,
     /// absolute path or URI scheme); `--sandbox` sets it too.
-    pub sandbox: Option<S<bool>>,
+    pub sandbox: Option<Spanned<bool>>,
     /// Points (OBJ `p`, glTF points) are discs this many output pixels
     /// across (default 4).
-    pub point_size: Option<S<f32>>,
+    pub point_size: Option<Spanned<f32>>,
     /// Lines (OBJ `l`, glTF lines) are this many output pixels wide
     /// (default 1.5).
-    pub line_width: Option<S<f32>>,
-    pub tonemap: Option<S<Tonemap>>,
+    pub line_width: Option<Spanned<f32>>,
+    pub tonemap: Option<Spanned<Tonemap>>,
     /// Stops, or "auto" (version 2).
-    pub exposure: Option<S<Exposure>>,
+    pub exposure: Option<Spanned<Exposure>>,
 }
 
 /// `render.shadow_bias` (extension), in shadow-map texels at the receiver.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ShadowBiasDesc {
-    pub constant: Option<S<f32>>,
-    pub slope: Option<S<f32>>,
-    pub normal: Option<S<f32>>,
+    pub constant: Option<Spanned<f32>>,
+    pub slope: Option<Spanned<f32>>,
+    pub normal: Option<Spanned<f32>>,
 }
 
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct AoDesc {
-    pub method: Option<S<AoMethod>>,
-    pub radius: Option<S<f32>>,
-    pub samples: Option<S<i64>>,
+    pub method: Option<Spanned<AoMethod>>,
+    pub radius: Option<Spanned<f32>>,
+    pub samples: Option<Spanned<i64>>,
 }
 
 /// `[ambient]`. Default color 0.03 grey.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct AmbientDesc {
-    pub color: Option<S<[f32; 3]>>,
+    pub color: Option<Spanned<[f32; 3]>>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelDesc {
-    pub name: Option<S<String>>,
-    pub path: S<String>,
-    pub translate: Option<S<[f32; 3]>>,
-    pub rotate: Option<S<[f32; 3]>>,
-    pub scale: Option<S<Scale>>,
-    pub normalize: Option<S<bool>>,
-    pub lights: Option<S<bool>>,
-    pub cameras: Option<S<bool>>,
-    pub material: Option<S<MaterialOverride>>,
+    pub name: Option<Spanned<String>>,
+    pub path: Spanned<String>,
+    pub translate: Option<Spanned<[f32; 3]>>,
+    pub rotate: Option<Spanned<[f32; 3]>>,
+    pub scale: Option<Spanned<Scale>>,
+    pub normalize: Option<Spanned<bool>>,
+    pub lights: Option<Spanned<bool>>,
+    pub cameras: Option<Spanned<bool>>,
+    pub material: Option<Spanned<MaterialOverride>>,
     #[serde(default)]
-    pub materials: std::collections::BTreeMap<String, S<MaterialOverride>>,
+    pub materials: std::collections::BTreeMap<String, Spanned<MaterialOverride>>,
     /// Version 2: a glTF animation to play, by name or index.
-    pub animation: Option<S<ClipRef>>,
+    pub animation: Option<Spanned<ClipRef>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -329,37 +328,37 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
 #[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialOverride {
-    pub ka: Option<S<[f32; 3]>>,
-    pub kd: Option<S<[f32; 3]>>,
-    pub ks: Option<S<[f32; 3]>>,
-    pub ke: Option<S<[f32; 3]>>,
-    pub ns: Option<S<f32>>,
-    pub ni: Option<S<f32>>,
-    pub d: Option<S<f32>>,
-    pub illum: Option<S<i64>>,
-    pub map_ka: Option<S<String>>,
-    pub map_kd: Option<S<String>>,
-    pub map_ks: Option<S<String>>,
-    pub map_ke: Option<S<String>>,
-    pub map_ns: Option<S<String>>,
-    pub map_d: Option<S<String>>,
-    pub map_bump: Option<S<String>>,
-    pub norm: Option<S<String>>,
-    pub disp: Option<S<String>>,
-    pub bump_scale: Option<S<f32>>,
-    pub normal_space: Option<S<NormalSpace>>,
+    pub ka: Option<Spanned<[f32; 3]>>,
+    pub kd: Option<Spanned<[f32; 3]>>,
+    pub ks: Option<Spanned<[f32; 3]>>,
+    pub ke: Option<Spanned<[f32; 3]>>,
+    pub ns: Option<Spanned<f32>>,
+    pub ni: Option<Spanned<f32>>,
+    pub d: Option<Spanned<f32>>,
+    pub illum: Option<Spanned<i64>>,
+    pub map_ka: Option<Spanned<String>>,
+    pub map_kd: Option<Spanned<String>>,
+    pub map_ks: Option<Spanned<String>>,
+    pub map_ke: Option<Spanned<String>>,
+    pub map_ns: Option<Spanned<String>>,
+    pub map_d: Option<Spanned<String>>,
+    pub map_bump: Option<Spanned<String>>,
+    pub norm: Option<Spanned<String>>,
+    pub disp: Option<Spanned<String>>,
+    pub bump_scale: Option<Spanned<f32>>,
+    pub normal_space: Option<Spanned<NormalSpace>>,
     /// Extension: "opaque" | "mask" | "blend" (default: from d, map_d and
     /// the alpha of map_Kd).
-    pub alpha_mode: Option<S<AlphaModeDesc>>,
+    pub alpha_mode: Option<Spanned<AlphaModeDesc>>,
     /// Extension: opacity below which a "mask" pixel is dropped (0.5).
-    pub alpha_cutoff: Option<S<f32>>,
+    pub alpha_cutoff: Option<Spanned<f32>>,
     /// Extension: world units per unit of `disp` height (default 1, or the
     /// MTL's `-mm` gain).
-    pub disp_scale: Option<S<f32>>,
+    pub disp_scale: Option<Spanned<f32>>,
     /// Extension (pbr shading): metallic factor in [0, 1].
-    pub metallic: Option<S<f32>>,
+    pub metallic: Option<Spanned<f32>>,
     /// Extension (pbr shading): perceptual roughness in [0, 1].
-    pub roughness: Option<S<f32>>,
+    pub roughness: Option<Spanned<f32>>,
 }
 
 /// The file's spelling of [`super::material::AlphaMode`].
@@ -386,18 +385,18 @@ pub enum LightKind {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct LightDesc {
-    pub kind: Option<S<LightKind>>,
-    pub position: Option<S<[f32; 3]>>,
-    pub direction: Option<S<[f32; 3]>>,
-    pub intensity: Option<S<f32>>,
-    pub irradiance: Option<S<f32>>,
-    pub color: Option<S<[f32; 3]>>,
-    pub shadows: Option<S<bool>>,
-    pub inner_angle: Option<S<f32>>,
-    pub outer_angle: Option<S<f32>>,
+    pub kind: Option<Spanned<LightKind>>,
+    pub position: Option<Spanned<[f32; 3]>>,
+    pub direction: Option<Spanned<[f32; 3]>>,
+    pub intensity: Option<Spanned<f32>>,
+    pub irradiance: Option<Spanned<f32>>,
+    pub color: Option<Spanned<[f32; 3]>>,
+    pub shadows: Option<Spanned<bool>>,
+    pub inner_angle: Option<Spanned<f32>>,
+    pub outer_angle: Option<Spanned<f32>>,
     /// Point and spot: the distance where the light ends (the
     /// KHR_lights_punctual window); none: unlimited.
-    pub range: Option<S<f32>>,
+    pub range: Option<Spanned<f32>>,
 }
 
 /// The file's spelling of [`super::camera::Projection`].
@@ -413,56 +412,56 @@ pub enum Projection {
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
-    pub name: Option<S<String>>,
-    pub eye: Option<S<[f32; 3]>>,
-    pub target: Option<S<[f32; 3]>>,
-    pub up: Option<S<[f32; 3]>>,
-    pub fov: Option<S<f32>>,
-    pub projection: Option<S<Projection>>,
-    pub height: Option<S<f32>>,
-    pub near: Option<S<f32>>,
-    pub far: Option<S<f32>>,
+    pub name: Option<Spanned<String>>,
+    pub eye: Option<Spanned<[f32; 3]>>,
+    pub target: Option<Spanned<[f32; 3]>>,
+    pub up: Option<Spanned<[f32; 3]>>,
+    pub fov: Option<Spanned<f32>>,
+    pub projection: Option<Spanned<Projection>>,
+    pub height: Option<Spanned<f32>>,
+    pub near: Option<Spanned<f32>>,
+    pub far: Option<Spanned<f32>>,
     /// Version 2, fitted cameras: degrees above the horizon (20).
-    pub elevation: Option<S<f32>>,
+    pub elevation: Option<Spanned<f32>>,
     /// Version 2, fitted cameras: degrees about +Y, 0 = from +Z.
-    pub azimuth: Option<S<f32>>,
+    pub azimuth: Option<Spanned<f32>>,
     /// Version 2: a camera path's keys (`[[camera.keys]]`).
     #[serde(default)]
-    pub keys: Vec<S<CameraKeyDesc>>,
+    pub keys: Vec<Spanned<CameraKeyDesc>>,
     /// Version 2: "smooth" (Catmull-Rom, the default) or "linear".
-    pub interpolation: Option<S<Interpolation>>,
+    pub interpolation: Option<Spanned<Interpolation>>,
 }
 
 /// `[[camera.keys]]`: where the camera is at a frame.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraKeyDesc {
-    pub frame: S<i64>,
-    pub eye: S<[f32; 3]>,
-    pub target: S<[f32; 3]>,
-    pub up: Option<S<[f32; 3]>>,
-    pub fov: Option<S<f32>>,
+    pub frame: Spanned<i64>,
+    pub eye: Spanned<[f32; 3]>,
+    pub target: Spanned<[f32; 3]>,
+    pub up: Option<Spanned<[f32; 3]>>,
+    pub fov: Option<Spanned<f32>>,
 }
 
 /// `[animation]`. Default: one frame, no turntable.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct AnimationDesc {
-    pub frames: Option<S<i64>>,
+    pub frames: Option<Spanned<i64>>,
     /// Version 2: frame i is at time i / fps (24).
-    pub fps: Option<S<f32>>,
-    pub turntable: Option<S<TurntableDesc>>,
+    pub fps: Option<Spanned<f32>>,
+    pub turntable: Option<Spanned<TurntableDesc>>,
 }
 
 /// Defaults: axis +Y, 360 degrees, rotate the models.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct TurntableDesc {
-    pub axis: Option<S<[f32; 3]>>,
-    pub degrees: Option<S<f32>>,
-    pub rotate: Option<S<TurntableTarget>>,
+    pub axis: Option<Spanned<[f32; 3]>>,
+    pub degrees: Option<Spanned<f32>>,
+    pub rotate: Option<Spanned<TurntableTarget>>,
     /// Version 2: degrees above the plane of the turn (`rotate = "camera"`).
-    pub elevation: Option<S<f32>>,
+    pub elevation: Option<Spanned<f32>>,
 }
 
 // ---------------------------------------------------------------------------
@@ -787,7 +786,13 @@ impl Ctx<'_> {
         Location::from_offset(self.file, self.text, span.start)
     }
 
-    fn int_range(&self, v: &Option<S<i64>>, key: &str, lo: i64, hi: i64) -> Result<(), Error> {
+    fn int_range(
+        &self,
+        v: &Option<Spanned<i64>>,
+        key: &str,
+        lo: i64,
+        hi: i64,
+    ) -> Result<(), Error> {
         if let Some(v) = v
             && !(lo..=hi).contains(v.get_ref())
         {
@@ -802,7 +807,13 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    fn float_range(&self, v: &Option<S<f32>>, key: &str, lo: f32, hi: f32) -> Result<(), Error> {
+    fn float_range(
+        &self,
+        v: &Option<Spanned<f32>>,
+        key: &str,
+        lo: f32,
+        hi: f32,
+    ) -> Result<(), Error> {
         if let Some(v) = v {
             let x = *v.get_ref();
             if !(x.is_finite() && x >= lo && x <= hi) {
@@ -815,11 +826,11 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    fn finite(&self, v: &Option<S<f32>>, key: &str) -> Result<(), Error> {
+    fn finite(&self, v: &Option<Spanned<f32>>, key: &str) -> Result<(), Error> {
         self.float_range(v, key, f32::MIN, f32::MAX)
     }
 
-    fn vec3(&self, v: &Option<S<[f32; 3]>>, key: &str) -> Result<(), Error> {
+    fn vec3(&self, v: &Option<Spanned<[f32; 3]>>, key: &str) -> Result<(), Error> {
         if let Some(v) = v
             && v.get_ref().iter().any(|x| !x.is_finite())
         {
@@ -828,7 +839,7 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    fn direction(&self, v: &Option<S<[f32; 3]>>, key: &str) -> Result<(), Error> {
+    fn direction(&self, v: &Option<Spanned<[f32; 3]>>, key: &str) -> Result<(), Error> {
         self.vec3(v, key)?;
         if let Some(v) = v
             && v.get_ref().iter().all(|x| *x == 0.0)

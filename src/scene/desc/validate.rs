@@ -42,11 +42,11 @@ pub(super) fn validate_video(c: &Ctx, o: &OutputDesc) -> Result<(), Error> {
     Ok(())
 }
 
-pub(super) fn get_i64(v: &Option<S<i64>>, default: i64) -> i64 {
+pub(super) fn get_i64(v: &Option<Spanned<i64>>, default: i64) -> i64 {
     v.as_ref().map(|v| *v.get_ref()).unwrap_or(default)
 }
 
-pub(super) fn validate_environment(c: &Ctx, e: &S<EnvironmentDesc>) -> Result<(), Error> {
+pub(super) fn validate_environment(c: &Ctx, e: &Spanned<EnvironmentDesc>) -> Result<(), Error> {
     let e = e.get_ref();
     match (&e.path, &e.preset) {
         (Some(p), None) if p.get_ref().trim().is_empty() => {
