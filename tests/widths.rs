@@ -371,6 +371,64 @@ fn texture_transforms_and_set_1_are_the_same_at_every_width() {
 }
 
 #[test]
+fn unlit_materials_are_the_same_at_every_width() {
+    // KHR_materials_unlit (the base colour and its map times the vertex
+    // colours), opaque and blended, over a lit cube, in the auto and pbr
+    // modes, with one sample and MSAA 4.
+    let dir = scratch("lanes_unlit");
+    layer_texture(&dir.join("t.png"));
+    let mut cube = common::cube();
+    cube.colors = (0..cube.positions.len())
+        .map(|k| {
+            [
+                1.0 - (k % 3) as f32 * 0.3,
+                0.8,
+                0.5 + (k % 2) as f32 * 0.4,
+                0.6,
+            ]
+        })
+        .collect();
+    for (file, extra) in [
+        ("o.gltf", r#""alphaMode": "OPAQUE""#),
+        (
+            "c.gltf",
+            r#""alphaMode": "BLEND", "extensions": {"KHR_materials_unlit": {}}"#,
+        ),
+        (
+            "u.gltf",
+            r#""alphaMode": "OPAQUE", "extensions": {"KHR_materials_unlit": {}}"#,
+        ),
+    ] {
+        let (text, _) = common::gltf_text(
+            &cube,
+            r#", "material": 0"#,
+            &format!(
+                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}], "extensionsUsed": ["KHR_materials_unlit"],
+                "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.7, 0.5, 0.8], "baseColorTexture": {{"index": 0}}}}, {extra}}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+        [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+        [[model]]\npath = \"u.gltf\"\ntranslate = [-0.8, -0.5, -1.0]\nscale = 0.5\n\
+        [[model]]\npath = \"c.gltf\"\n";
+    scene_in(&dir, scene, &[]);
+    let file = dir.join("scene.toml");
+    for sets in [
+        vec![],
+        vec!["render.msaa=4"],
+        vec!["render.shading=\"pbr\"", "render.msaa=4"],
+    ] {
+        same_both_ways(&load_with(&file, &sets), &[0], &format!("unlit, {sets:?}"));
+    }
+}
+
+#[test]
 fn pbr_models_are_the_same_at_every_width() {
     // The walker: pbr factors without maps under the default look (studio
     // environment, its ground shadow), MSAA 4.

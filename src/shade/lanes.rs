@@ -67,6 +67,8 @@ pub(super) struct Map<'a> {
 pub(super) enum LaneShading {
     BlinnPhong,
     Pbr,
+    /// KHR_materials_unlit: the base colour alone.
+    Unlit,
 }
 
 /// A material the lanes can shade, prepared for one frame.
@@ -371,10 +373,14 @@ impl<'a> ShadeContext<'a> {
         uvs: [bool; 2],
         tangents: bool,
     ) -> Option<LaneMaterial<'a>> {
-        if m.unlit || self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
+        if self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
             return None;
         }
         let kind = match self.mode {
+            // KHR_materials_unlit: the base colour in every lit mode.
+            ShadingMode::BlinnPhong | ShadingMode::Pbr | ShadingMode::Auto if m.unlit => {
+                LaneShading::Unlit
+            }
             ShadingMode::BlinnPhong => LaneShading::BlinnPhong,
             ShadingMode::Pbr => LaneShading::Pbr,
             ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,
@@ -390,12 +396,12 @@ impl<'a> ShadeContext<'a> {
         };
         match kind {
             LaneShading::BlinnPhong => maps.blinn_phong(m)?,
-            LaneShading::Pbr => maps.pbr(m)?,
+            LaneShading::Pbr | LaneShading::Unlit => maps.pbr(m)?,
         }
         // A blended surface's opacity reads these too (`opacity`); a
         // transmissive one is the one-fragment path's layer.
-        let layers = m.alpha == AlphaMode::Blend
-            && !(kind == LaneShading::Pbr && m.pbr.transmission.is_some());
+        let layers =
+            m.alpha == AlphaMode::Blend && !(m.pbr.transmission.is_some() && self.shades_pbr(m));
         if layers {
             maps.optional(&m.map_d)?;
             maps.optional(&m.map_kd)?;
@@ -454,6 +460,7 @@ impl<'a> ShadeContext<'a> {
         match lm.kind {
             LaneShading::BlinnPhong => self.shade_blinn_phong(lm.material, fetch, f, None),
             LaneShading::Pbr => self.shade_pbr(lm.material, fetch, f),
+            LaneShading::Unlit => self.pbr_color(lm.material, fetch, f).base,
         }
     }
 
@@ -796,9 +803,9 @@ mod tests {
     }
 
     /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
-    /// maps, the KHR layers with their maps and texture transforms do;
-    /// unlit, samplers with filters of their own and a fourth slot do
-    /// not.
+    /// maps, the KHR layers with their maps, texture transforms and unlit
+    /// materials do; samplers with filters of their own and a fourth slot
+    /// do not.
     #[test]
     fn which_materials_the_lanes_take() {
         let shadows = Shadows::none();
@@ -844,7 +851,7 @@ mod tests {
         assert_eq!(kind(&auto, &coat), Some((LaneShading::Pbr, 5, 4)));
         let mut unlit = gltf.clone();
         unlit.unlit = true;
-        assert_eq!(kind(&auto, &unlit), None);
+        assert_eq!(kind(&auto, &unlit), Some((LaneShading::Unlit, 4, 3)));
         let mut moved = gltf.clone();
         if let Some(t) = &mut moved.pbr.base_color_map {
             t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
