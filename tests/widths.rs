@@ -429,6 +429,48 @@ fn unlit_materials_are_the_same_at_every_width() {
 }
 
 #[test]
+fn maps_without_coordinates_are_the_same_at_every_width() {
+    // A glTF cube with coordinates of set 0 alone whose material reads
+    // maps of set 1 too: those count as 1 (the metallic-roughness and
+    // emissive maps) and leave the normal as it is (the normal map),
+    // opaque and blended, with one sample and MSAA 4.
+    let dir = scratch("lanes_no_uvs");
+    layer_texture(&dir.join("t.png"));
+    let set1 = r#"{"index": 0, "texCoord": 1}"#;
+    for (file, alpha) in [("o.gltf", "OPAQUE"), ("c.gltf", "BLEND")] {
+        let (text, _) = common::gltf_text(
+            &common::cube(),
+            r#", "material": 0"#,
+            &format!(
+                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.6, 0.4, 0.7], "baseColorTexture": {{"index": 0}},
+                    "metallicRoughnessTexture": {set1}, "metallicFactor": 0.7, "roughnessFactor": 0.3}},
+                    "normalTexture": {set1}, "emissiveTexture": {set1}, "emissiveFactor": [0.3, 0.1, 0.0], "alphaMode": "{alpha}"}}]"#
+            ),
+            None,
+        );
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+        [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+        [[model]]\npath = \"c.gltf\"\n";
+    let s = scene_in(&dir, scene, &[]);
+    let (mesh, m) = (&s.models[0].mesh, &s.models[0].materials[0]);
+    assert!(mesh.uvs1.is_empty() && m.pbr.metallic_roughness_map.is_some());
+    let file = dir.join("scene.toml");
+    for sets in [vec![], vec!["render.msaa=4"]] {
+        same_both_ways(
+            &load_with(&file, &sets),
+            &[0],
+            &format!("set 1 missing, {sets:?}"),
+        );
+    }
+}
+
+#[test]
 fn pbr_models_are_the_same_at_every_width() {
     // The walker: pbr factors without maps under the default look (studio
     // environment, its ground shadow), MSAA 4.

@@ -251,7 +251,12 @@ struct MapSet<'c, 'a> {
 impl<'a> MapSet<'_, 'a> {
     fn map(&mut self, t: &'a TextureRef) -> Option<()> {
         let set = (t.texcoord as usize).min(1);
-        if t.min_limit.is_some() || t.mag_nearest || !self.uvs[set] {
+        if !self.uvs[set] {
+            // Without its coordinates a map counts as 1 (`Fetch::rgba`
+            // finds no lookup for it).
+            return Some(());
+        }
+        if t.min_limit.is_some() || t.mag_nearest {
             return None;
         }
         let tex = &*t.texture;
@@ -299,19 +304,25 @@ impl<'a> MapSet<'_, 'a> {
     }
 
     fn normal(&mut self, m: &'a Option<NormalMap>) -> Option<()> {
+        let t = match m {
+            None => return Some(()),
+            Some(NormalMap::Normals { map, .. } | NormalMap::Height { map, .. }) => map,
+        };
+        if !self.uvs[(t.texcoord as usize).min(1)] {
+            // Without its coordinates a map leaves the normal as it is.
+            return Some(());
+        }
         match m {
-            None => Some(()),
             Some(NormalMap::Normals {
-                map: t,
                 space: NormalSpace::Tangent,
                 ..
-            }) if self.uvs[(t.texcoord as usize).min(1)] => {
+            }) => {
                 if self.tangents {
                     self.map(t)?;
                 }
                 Some(())
             }
-            Some(_) => None,
+            _ => None,
         }
     }
 
@@ -829,8 +840,13 @@ mod tests {
         };
         // The packed texture is one lookup, read twice.
         assert_eq!(kind(&auto, &gltf), Some((LaneShading::Pbr, 4, 3)));
-        // Without coordinates its maps cannot be looked up.
-        assert!(auto.lane_material(&gltf, [false; 2], true).is_none());
+        // Without coordinates its maps count as 1 and its normal map
+        // leaves the normal as it is: nothing to look up.
+        assert_eq!(
+            auto.lane_material(&gltf, [false; 2], true)
+                .map(|lm| (lm.kind, lm.maps.len())),
+            Some((LaneShading::Pbr, 0))
+        );
         let mut obj = Material::default_named("obj");
         obj.map_kd = Some(map(16));
         assert_eq!(kind(&auto, &obj), Some((LaneShading::BlinnPhong, 1, 1)));
