@@ -471,6 +471,56 @@ fn maps_without_coordinates_are_the_same_at_every_width() {
 }
 
 #[test]
+fn object_space_normal_maps_are_the_same_at_every_width() {
+    // Object-space normal maps (`normal_space = "object"`) on a turned
+    // quad seen from both sides (culling off), lit, as Blinn-Phong and as
+    // pbr, opaque and blended, with one sample and MSAA 4.
+    let dir = scratch("lanes_object_space");
+    let img = image::RgbaImage::from_fn(16, 16, |x, y| {
+        image::Rgba([100 + (x * 8) as u8, 110 + (y * 6) as u8, 230, 255])
+    });
+    img.save(dir.join("n.png")).unwrap();
+    let obj = "mtllib m.mtl\n\
+        v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+        usemtl bumpy\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n\
+        v -0.6 -0.6 0.4\nv 0.6 -0.6 0.4\nv 0 0.8 0.4\n\
+        usemtl glass\nf 5/1/1 6/2/1 7/3/1\n";
+    let mtl = "newmtl bumpy\nKd 0.8 0.6 0.4\nKs 0.5 0.5 0.5\nNs 30\nnorm n.png\n\
+        newmtl glass\nKd 0.3 0.5 0.9\nKs 0.5 0.5 0.5\nNs 60\nd 0.5\nnorm n.png\n";
+    let object = "[model.material]\nnormal_space = \"object\"\n";
+    for (turn, what) in [("20.0", "front"), ("160.0", "back")] {
+        let scene = QUAD_SCENE.replace(
+            "rotate = [-35.0, 20.0, 0.0]",
+            &format!("rotate = [-35.0, {turn}, 0.0]"),
+        );
+        let s = scene_in(
+            &dir,
+            &format!("{scene}{object}"),
+            &[("quad.obj", obj), ("m.mtl", mtl)],
+        );
+        let object_maps = s.models[0].materials.iter().filter(|m| {
+            matches!(
+                m.normal_map,
+                Some(softraster::scene::material::NormalMap::Normals {
+                    space: softraster::scene::material::NormalSpace::Object,
+                    ..
+                })
+            )
+        });
+        assert_eq!(object_maps.count(), 2);
+        let file = dir.join("scene.toml");
+        for sets in [vec![], vec!["render.shading=\"pbr\"", "render.msaa=4"]] {
+            same_both_ways(
+                &load_with(&file, &sets),
+                &[0],
+                &format!("object space, {what}, {sets:?}"),
+            );
+        }
+    }
+}
+
+#[test]
 fn pbr_models_are_the_same_at_every_width() {
     // The walker: pbr factors without maps under the default look (studio
     // environment, its ground shadow), MSAA 4.

@@ -466,7 +466,8 @@ impl<'a> FrameData<'a> {
         } else {
             w
         };
-        let n = lerp(|k| k.normal).normalize_or(V3::splat(Vec3::Y));
+        let raw = lerp(|k| k.normal);
+        let n = raw.normalize_or(V3::splat(Vec3::Y));
         let front = L::from_fn(|k| c(k).front as u32 as f32).cmpgt(L::splat(0.0));
         let normal = V3::select(front, n, -n);
         let mut geo_normal = [Vec3::ZERO; MAX_LANES];
@@ -510,6 +511,8 @@ impl<'a> FrameData<'a> {
             uv: lm.coords([uv(0), set1]),
             tangent,
             sign: L::from_fn(|k| c(k).tangent[0].w),
+            normal_from_object: self.verts[d.model].normal_from_object,
+            back: normal.dot(raw).cmplt(L::splat(0.0)),
             footprints: &p.footprints,
             first: at,
         };

@@ -6,12 +6,12 @@
 //!
 //! What differs between the widths is where texels come from (`Fetch`).
 //! A lone fragment reads them through `ShadeContext::sample`, which takes
-//! every map (samplers with filters of their own, object-space and bump
-//! maps). The renderer gathers the visible fragments of a band into
+//! every map (samplers with filters of their own, bump maps). The renderer gathers the visible fragments of a band into
 //! wider calls wherever `ShadeContext::lane_material` accepts the
 //! material: its maps use the frame's filter (no sampler limits of their
 //! own) and fall in at most three slots (coordinate set, transform,
-//! texture size and chain), and its normal maps are in tangent space.
+//! texture size and chain), and its normal maps are in tangent or object
+//! space (not bump maps).
 //! Their lookups are found four lanes at a time for all maps of one slot
 //! (`Texture::taps4`) and gathered per lane.
 //!
@@ -20,7 +20,7 @@
 // Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Affine2, Vec3, Vec4};
+use glam::{Affine2, Mat3, Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::light::{LightMask, LightSet};
@@ -130,6 +130,11 @@ pub struct Coords<'p, L: Lane = Vec4> {
     /// a normal map).
     pub tangent: V3<L>,
     pub sign: L,
+    /// Object-space normal maps: object to world for normals, and the
+    /// lanes whose surface is seen from behind (the interpolated normal
+    /// points away from the shading normal).
+    pub normal_from_object: Mat3,
+    pub back: L::Mask,
     /// Per slot of the material (`LaneMaterial::footprints`), per lane
     /// from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
@@ -322,6 +327,10 @@ impl<'a> MapSet<'_, 'a> {
                 }
                 Some(())
             }
+            Some(NormalMap::Normals {
+                space: NormalSpace::Object,
+                ..
+            }) => self.map(t),
             _ => None,
         }
     }
@@ -620,21 +629,39 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
 
     #[inline(always)]
     fn normal(&mut self, m: &NormalMap) -> V3<L> {
-        let (t, scale) = match m {
-            NormalMap::Normals { map, scale, .. } => (map, *scale),
+        let (t, scale, space) = match m {
+            NormalMap::Normals { map, scale, space } => (map, *scale, *space),
             NormalMap::Height { .. } => return self.normal,
         };
-        if !self.lm.tangents {
+        if space == NormalSpace::Tangent && !self.lm.tangents {
             return self.normal;
         }
-        match self.rgb(t) {
-            Some(c) => {
-                let coords = self.lookups.coords;
+        let Some(c) = self.rgb(t) else {
+            return self.normal;
+        };
+        let coords = self.lookups.coords;
+        match space {
+            NormalSpace::Tangent => {
                 tangent_space(self.normal, (coords.tangent, coords.sign), c, scale)
             }
-            None => self.normal,
+            NormalSpace::Object => {
+                object_space(self.normal, coords.back, coords.normal_from_object, c)
+            }
         }
     }
+}
+
+/// An object-space normal map whose texels are `c` (RGB) at unit normals
+/// `n`: its normals taken to world space by `m` (object to world for
+/// normals) and flipped in the lanes `back` (seen from behind), unit (`n`
+/// where they have no length).
+#[inline(always)]
+pub(super) fn object_space<L: Lane>(n: V3<L>, back: L::Mask, m: Mat3, c: V3<L>) -> V3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    let w = V3::splat(m.x_axis).scale(c.x * two - one)
+        + V3::splat(m.y_axis).scale(c.y * two - one)
+        + V3::splat(m.z_axis).scale(c.z * two - one);
+    V3::select(back, -w, w).normalize_or(n)
 }
 
 /// A tangent-space normal map whose texels are `c` (RGB), scaled by
@@ -886,13 +913,20 @@ mod tests {
         let mut four = sizes.clone();
         four.pbr.base_color_map = Some(map(4));
         assert_eq!(kind(&auto, &four), None);
-        // An object-space normal map is the one-fragment path's.
+        // An object-space normal map is a map like the others; a bump
+        // map is the one-fragment path's.
         let mut object = gltf.clone();
         object.normal_map = Some(NormalMap::Normals {
             map: map(16),
             space: NormalSpace::Object,
             scale: 1.0,
         });
-        assert_eq!(kind(&auto, &object), None);
+        assert_eq!(kind(&auto, &object), Some((LaneShading::Pbr, 4, 3)));
+        let mut bump = gltf.clone();
+        bump.normal_map = Some(NormalMap::Height {
+            map: map(16),
+            scale: 1.0,
+        });
+        assert_eq!(kind(&auto, &bump), None);
     }
 }

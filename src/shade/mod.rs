@@ -367,14 +367,11 @@ impl ShadeContext<'_> {
                 let Some(c) = self.sample(map, tc) else {
                     return n;
                 };
-                let c = c.truncate() * 2.0 - Vec3::ONE;
-                let w = s.normal_from_object * c;
-                // Back faces are lit on their flipped side.
-                if s.normal.dot(s.raw_normal) < 0.0 {
-                    -w
-                } else {
-                    w
-                }
+                // The lanes' code at one lane (already unit). Back faces
+                // are lit on their flipped side.
+                let back = s.normal.dot(s.raw_normal) < 0.0;
+                let c = V3::from(c.truncate());
+                return lanes::object_space(V3::from(n), back, s.normal_from_object, c).into();
             }
             NormalMap::Height { map, scale } => {
                 let Some(t) = s.tangent else { return n };
