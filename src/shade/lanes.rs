@@ -6,12 +6,12 @@
 //!
 //! What differs between the widths is where texels come from (`Fetch`).
 //! A lone fragment reads them through `ShadeContext::sample`, which takes
-//! every map (samplers with filters of their own, bump maps). The renderer gathers the visible fragments of a band into
-//! wider calls wherever `ShadeContext::lane_material` accepts the
-//! material: its maps use the frame's filter (no sampler limits of their
-//! own) and fall in at most three slots (coordinate set, transform,
-//! texture size and chain), and its normal maps are in tangent or object
-//! space (not bump maps).
+//! every map (samplers with filters of their own, bump maps). The
+//! renderer gathers the visible fragments of a band into wider calls
+//! wherever `ShadeContext::lane_material` accepts the material: its maps
+//! use the frame's filter (no sampler limits of their own) and fall in at
+//! most three slots (coordinate set, transform, texture size and chain),
+//! and its normal maps are in tangent or object space (not bump maps).
 //! Their lookups are found four lanes at a time for all maps of one slot
 //! (`Texture::taps4`) and gathered per lane.
 //!
@@ -242,8 +242,8 @@ impl<'a> LaneMaterial<'a> {
 /// Collects a lane material's maps, assigning each a slot by its
 /// coordinates, transform, texture size and chain; None where the lanes
 /// cannot look one up as `ShadeContext::sample` does (a sampler of its
-/// own, a mesh without the coordinates, a fourth slot, a normal map that
-/// is not in tangent space).
+/// own, a fourth slot, a bump map). A map of a coordinate set the mesh
+/// lacks is left out: it counts as 1.
 struct MapSet<'c, 'a> {
     ctx: &'c ShadeContext<'a>,
     /// Whether the mesh has texture coordinates of sets 0 and 1.
