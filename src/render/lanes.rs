@@ -496,7 +496,8 @@ impl<'a> FrameData<'a> {
                 v0 * l.x + v1 * l.y + v2 * l.z,
             )
         };
-        let set1 = if lm.reads_set1() { uv(1) } else { uv(0) };
+        let uv0 = uv(0);
+        let uv1 = if lm.reads_set1() { uv(1) } else { uv0 };
         let tangent = lerp(|k| k.tangent.map(|t| t.truncate()));
         let color = (!mesh.colors.is_empty()).then(|| lerp(|k| k.color.map(|c| c.truncate())));
         let lanes = Lanes {
@@ -508,7 +509,7 @@ impl<'a> FrameData<'a> {
             lights: p.lights,
         };
         let coords = Coords {
-            uv: lm.coords([uv(0), set1]),
+            uv: lm.coords([uv0, uv1]),
             tangent,
             sign: L::from_fn(|k| c(k).tangent[0].w),
             normal_from_object: self.verts[d.model].normal_from_object,

@@ -85,6 +85,9 @@ pub struct LaneMaterial<'a> {
     tangents: bool,
     /// Where its maps are looked up: the slots of `Map::slot`.
     slots: SmallVec<[Slot; MAX_SIZES]>,
+    /// Some slot reads set 1; some slot reads set 1 or has a transform.
+    set1: bool,
+    moved_or_set1: bool,
 }
 
 /// Where a lane material's maps of one slot are looked up: the same
@@ -102,6 +105,8 @@ struct Slot {
     /// Levels of its chain this frame; 0: level 0 alone, without a chain
     /// (never minified), looked up bilinearly (`Texture::sample_grad`).
     levels: usize,
+    /// The transform is not the identity.
+    moved: bool,
 }
 
 /// The points of the fragments in the lanes: what shading needs of a
@@ -194,7 +199,7 @@ impl<'a> LaneMaterial<'a> {
                 continue;
             }
             let mut g = g[slot.set];
-            if slot.transform != Affine2::IDENTITY {
+            if slot.moved {
                 let m = slot.transform.matrix2;
                 g = Gradients {
                     dx: m * g.dx,
@@ -208,8 +213,9 @@ impl<'a> LaneMaterial<'a> {
     }
 
     /// Whether some map reads texture coordinates of set 1.
+    #[inline(always)]
     pub fn reads_set1(&self) -> bool {
-        self.slots.iter().any(|s| s.set == 1)
+        self.set1
     }
 
     /// Per slot, the lanes' coordinates of its set (`uv`) through its
@@ -217,9 +223,12 @@ impl<'a> LaneMaterial<'a> {
     #[inline(always)]
     pub fn coords<L: Lane>(&self, uv: [(L, L); 2]) -> [(L, L); MAX_SIZES] {
         let mut out = [uv[0]; MAX_SIZES];
+        if !self.moved_or_set1 {
+            return out;
+        }
         for (o, slot) in out.iter_mut().zip(&self.slots) {
             let (u, v) = uv[slot.set];
-            *o = if slot.transform == Affine2::IDENTITY {
+            *o = if !slot.moved {
                 (u, v)
             } else {
                 let (m, t) = (slot.transform.matrix2, slot.transform.translation);
@@ -271,6 +280,7 @@ impl<'a> MapSet<'_, 'a> {
             transform: t.transform,
             size: (tex.width, tex.height),
             levels: mips.map_or(0, |m| 1 + m.len()),
+            moved: t.transform != Affine2::IDENTITY,
         };
         let slot = match self.slots.iter().position(|s| *s == here) {
             Some(k) => k,
@@ -440,6 +450,8 @@ impl<'a> ShadeContext<'a> {
             layers,
             maps: maps_read,
             tangents,
+            set1: maps.slots.iter().any(|s| s.set == 1),
+            moved_or_set1: maps.slots.iter().any(|s| s.set == 1 || s.moved),
             slots: maps.slots,
         })
     }
