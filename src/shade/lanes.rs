@@ -465,7 +465,17 @@ impl<'a> ShadeContext<'a> {
         f: &Lanes<L>,
         coords: &Coords<'_, L>,
     ) -> V3<L> {
-        self.shade_fetched(lm, f, &mut LaneFetch::new(lm, coords, f.normal))
+        // (Built here, not returned by a function: the fetch is large,
+        // and a returned one was copied at every call.)
+        let mut fetch = LaneFetch {
+            lm,
+            lookups: Lookups::new(coords),
+            normal: f.normal,
+            shared: None,
+            next: 0,
+        };
+        fetch.start();
+        self.shade_fetched(lm, f, &mut fetch)
     }
 
     /// The fragments of a blended lane material (`LaneMaterial::layers`)
@@ -478,7 +488,14 @@ impl<'a> ShadeContext<'a> {
         coords: &Coords<'_, L>,
         alpha: L,
     ) -> (V3<L>, L) {
-        let mut fetch = LaneFetch::new(lm, coords, f.normal);
+        let mut fetch = LaneFetch {
+            lm,
+            lookups: Lookups::new(coords),
+            normal: f.normal,
+            shared: None,
+            next: 0,
+        };
+        fetch.start();
         let c = self.shade_fetched(lm, f, &mut fetch);
         (c, self.opacity_of(lm.material, |t| fetch.rgba(t), alpha))
     }
@@ -573,23 +590,15 @@ struct LaneFetch<'x, 'a, 'p, L: Lane> {
     next: usize,
 }
 
-impl<'x, 'a, 'p, L: Lane> LaneFetch<'x, 'a, 'p, L> {
-    /// `lm`'s maps at `coords`, their distinct lookups started; `normal`:
-    /// the interpolated normals.
-    fn new(lm: &'x LaneMaterial<'a>, coords: &'x Coords<'p, L>, normal: V3<L>) -> Self {
-        let mut fetch = LaneFetch {
-            lm,
-            lookups: Lookups::new(coords),
-            normal,
-            shared: None,
-            next: 0,
-        };
-        for (i, map) in lm.maps.iter().enumerate() {
+impl<L: Lane> LaneFetch<'_, '_, '_, L> {
+    /// Starts loading the texels of every distinct lookup.
+    #[inline(always)]
+    fn start(&mut self) {
+        for (i, map) in self.lm.maps.iter().enumerate() {
             if map.same == i {
-                fetch.lookups.prefetch(map);
+                self.lookups.prefetch(map);
             }
         }
-        fetch
     }
 }
 
