@@ -97,11 +97,8 @@ fuzz_target!(|data: &[u8]| {
     let Ok(plan) = FramePlan::select(&scene, None, None) else {
         return;
     };
-    let job = RenderJob {
-        scene,
-        plan,
-        skip_existing: false,
-    };
+    let mut job = RenderJob::all(scene);
+    job.plan = plan;
     let _ = job.run(|_| {});
     for f in files(&root) {
         assert!(
