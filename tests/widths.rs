@@ -423,6 +423,10 @@ fn unlit_materials_are_the_same_at_every_width() {
         vec![],
         vec!["render.msaa=4"],
         vec!["render.shading=\"pbr\"", "render.msaa=4"],
+        vec!["render.shading=\"unlit\""],
+        vec!["render.shading=\"flat\"", "render.msaa=4"],
+        vec!["render.shading=\"normals\""],
+        vec!["render.shading=\"depth\"", "render.msaa=4"],
     ] {
         same_both_ways(&load_with(&file, &sets), &[0], &format!("unlit, {sets:?}"));
     }
@@ -816,5 +820,189 @@ fn khr_layers_with_maps_are_the_same_at_every_width() {
             &[0],
             &format!("maps, {name}, studio"),
         );
+    }
+}
+
+/// Writes `file` in `dir`: `cube` turned, its one primitive drawn with
+/// material 0, and `body` (images, textures, samplers, materials,
+/// extensions) beside the node.
+fn turned_cube(dir: &Path, file: &str, cube: &common::Prim, body: &str) {
+    let (text, _) = common::gltf_text(
+        cube,
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0, {body}"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join(file), text).unwrap();
+}
+
+#[test]
+fn samplers_and_the_nearest_filter_are_the_same_at_every_width() {
+    // glTF samplers with filters of their own: NEAREST magnification,
+    // NEAREST and LINEAR minification without mip maps, on maps of one
+    // material (base colour and occlusion, metallic-roughness, emission,
+    // normal map); cubes magnified, near a texel a pixel and minified,
+    // opaque and blended, with the scene's filters anisotropic,
+    // trilinear, bilinear and nearest, and MSAA 4.
+    let dir = scratch("lanes_samplers");
+    layer_texture(&dir.join("t.png"));
+    for (file, alpha) in [("o.gltf", "OPAQUE"), ("c.gltf", "BLEND")] {
+        turned_cube(
+            &dir,
+            file,
+            &common::cube(),
+            &format!(
+                r#""images": [{{"uri": "t.png"}}],
+                "samplers": [{{"magFilter": 9728}}, {{"magFilter": 9729, "minFilter": 9728}}, {{"magFilter": 9728, "minFilter": 9729}}],
+                "textures": [{{"source": 0, "sampler": 0}}, {{"source": 0, "sampler": 1}}, {{"source": 0, "sampler": 2}}],
+                "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.6, 0.4, 0.7], "baseColorTexture": {{"index": 0}},
+                    "metallicRoughnessTexture": {{"index": 1}}, "metallicFactor": 0.6, "roughnessFactor": 0.8}},
+                    "normalTexture": {{"index": 0}}, "occlusionTexture": {{"index": 0}},
+                    "emissiveTexture": {{"index": 2}}, "emissiveFactor": [0.2, 0.1, 0.0], "alphaMode": "{alpha}"}}]"#
+            ),
+        );
+    }
+    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+        [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+        [[model]]\npath = \"o.gltf\"\ntranslate = [-1.5, -0.8, -9.0]\n\
+        [[model]]\npath = \"o.gltf\"\ntranslate = [-0.9, 0.5, 0.5]\nscale = 1.6\n\
+        [[model]]\npath = \"c.gltf\"\n";
+    let s = scene_in(&dir, scene, &[]);
+    let base = s.models[0].materials[0].pbr.base_color_map.as_ref();
+    assert!(base.is_some_and(|t| t.mag_nearest && t.min_limit.is_none()));
+    let file = dir.join("scene.toml");
+    for filter in ["anisotropic", "trilinear", "bilinear", "nearest"] {
+        for msaa in [1, 4] {
+            let sets = [
+                format!("render.texture_filter=\"{filter}\""),
+                format!("render.msaa={msaa}"),
+            ];
+            let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+            same_both_ways(
+                &load_with(&file, &sets),
+                &[0],
+                &format!("samplers, {sets:?}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn bump_maps_are_the_same_at_every_width() {
+    // MTL bump (height) maps, scaled by -bm, one plain and one moved by
+    // -s and -o on a blended triangle, on a turned quad seen from both
+    // sides (culling off), as Blinn-Phong and as pbr, with one sample
+    // and MSAA 4, anisotropic, trilinear and bilinear filtering.
+    let dir = scratch("lanes_bump");
+    let img = image::GrayImage::from_fn(32, 32, |x, y| {
+        let (x, y) = (x as f32 / 32.0, y as f32 / 32.0);
+        let h = 0.5 + 0.25 * (x * 13.0).sin() + 0.2 * (y * 9.0 + x * 4.0).cos();
+        image::Luma([(h * 255.0) as u8])
+    });
+    img.save(dir.join("h.png")).unwrap();
+    let obj = "mtllib m.mtl\n\
+        v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+        usemtl bumpy\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n\
+        v -0.6 -0.6 0.4\nv 0.6 -0.6 0.4\nv 0 0.8 0.4\n\
+        usemtl glass\nf 5/1/1 6/2/1 7/3/1\n";
+    let mtl = "newmtl bumpy\nKd 0.8 0.6 0.4\nKs 0.5 0.5 0.5\nNs 30\nbump -bm 0.8 h.png\n\
+        newmtl glass\nKd 0.3 0.5 0.9\nKs 0.5 0.5 0.5\nNs 60\nd 0.5\n\
+        bump -s 2 1.5 1 -o 0.1 0.2 0 h.png\n";
+    for (turn, what) in [("20.0", "front"), ("160.0", "back")] {
+        let scene = QUAD_SCENE.replace(
+            "rotate = [-35.0, 20.0, 0.0]",
+            &format!("rotate = [-35.0, {turn}, 0.0]"),
+        );
+        let s = scene_in(&dir, &scene, &[("quad.obj", obj), ("m.mtl", mtl)]);
+        let bumps = s.models[0].materials.iter().filter(|m| {
+            matches!(
+                m.normal_map,
+                Some(softraster::scene::material::NormalMap::Height { .. })
+            )
+        });
+        assert_eq!(bumps.count(), 2);
+        let file = dir.join("scene.toml");
+        for sets in [
+            vec![],
+            vec!["render.shading=\"pbr\"", "render.msaa=4"],
+            vec!["render.texture_filter=\"trilinear\""],
+            vec!["render.texture_filter=\"bilinear\"", "render.msaa=4"],
+            vec!["render.shading=\"normals\""],
+            vec!["render.shading=\"flat\""],
+        ] {
+            same_both_ways(
+                &load_with(&file, &sets),
+                &[0],
+                &format!("bump, {what}, {sets:?}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn the_sampled_environment_is_the_same_at_every_width() {
+    // `method = "sampled"` (the Monte Carlo reference) on the showcase's
+    // MTL materials (Blinn-Phong lobes) and the walker's pbr factors,
+    // with MSAA 4 and one sample.
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let sampled = [
+        "output.width=96",
+        "output.height=72",
+        "environment.method=\"sampled\"",
+        "environment.samples=4",
+    ];
+    for (file, frame) in [("showcase.toml", 4), ("walker.toml", 10)] {
+        let scene = load_with(&scenes.join(file), &sampled);
+        let env = scene.environment.as_ref().map(|e| e.method);
+        let reference = softraster::scene::environment::EnvMethod::Sampled { samples: 4 };
+        assert_eq!(env, Some(reference));
+        same_both_ways(&scene, &[frame], &format!("{file} sampled"));
+        let mut one = sampled.to_vec();
+        one.push("render.msaa=1");
+        same_both_ways(
+            &load_with(&scenes.join(file), &one),
+            &[frame],
+            &format!("{file} sampled, one sample"),
+        );
+    }
+}
+
+#[test]
+fn shading_modes_are_the_same_at_every_width() {
+    // The modes besides auto on the showcase's MTL materials (maps,
+    // normal maps, lights, shadows, SSAO, the studio look) and the
+    // walker's pbr factors: flat, unlit, the normals and depth views,
+    // Blinn-Phong, Gouraud and wireframe, with MSAA 4 and one sample.
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for mode in [
+        "flat",
+        "unlit",
+        "normals",
+        "depth",
+        "blinn-phong",
+        "gouraud",
+        "wireframe",
+    ] {
+        for (file, frame) in [("showcase.toml", 6), ("walker.toml", 20)] {
+            for msaa in [1, 4] {
+                let sets = [
+                    "output.width=96".to_string(),
+                    "output.height=72".to_string(),
+                    format!("render.shading=\"{mode}\""),
+                    format!("render.msaa={msaa}"),
+                ];
+                let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+                same_both_ways(
+                    &load_with(&scenes.join(file), &sets),
+                    &[frame],
+                    &format!("{file}, {mode}, MSAA {msaa}"),
+                );
+            }
+        }
     }
 }

@@ -21,7 +21,7 @@ use super::fragment::{FrameData, LANE_SLOT, PixelShare, Sink, resolve};
 use super::frame::AovPixel;
 use super::lanes::{LaneBatches, Pending, QuadAt};
 use super::surface::FragmentLighting;
-use crate::assets::texture::{Footprint, Gradients};
+use crate::assets::texture::Gradients;
 use crate::raster::bin::TileRect;
 use crate::raster::coverage::{
     MAX_SAMPLES, NO_TRIANGLE, Visibility, in_front, raster_samples, raster_triangle,
@@ -30,7 +30,7 @@ use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
 use crate::scene::material::AlphaMode;
 use crate::shade::ao::GPixel;
-use crate::shade::lanes::{LaneMaterial, MAX_SIZES};
+use crate::shade::lanes::{Footprints, LaneMaterial};
 use crate::shade::light::LightMask;
 use crate::shade::{SizedFootprint, TexCoords};
 
@@ -295,9 +295,9 @@ impl<'a> FrameData<'a> {
         let rect = vis.rect;
         let tw = rect.width();
         let n = vis.samples();
-        let mut quad: Option<((i32, i32), [Footprint; MAX_SIZES])> = None;
+        let mut quad: Option<((i32, i32), Footprints)> = None;
         let mut push = |px: i32, py: i32, frag: Fragment, count: f32| {
-            let mut footprints = [Footprint::Lod(0.0); MAX_SIZES];
+            let mut footprints = Footprints::NONE;
             if let Some(lm) = lane {
                 let q0 = (px & !1, py & !1);
                 footprints = match quad {
@@ -765,7 +765,7 @@ struct QuadEntry {
     grads: [Gradients; 2],
     footprints: [Option<SizedFootprint>; 2],
     /// Lane-shaded materials: the footprints per texture size.
-    lane_footprints: Option<[Footprint; MAX_SIZES]>,
+    lane_footprints: Option<Footprints>,
 }
 
 /// Where `FrameData::fragment` shades: the pixel's position and its

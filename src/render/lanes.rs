@@ -16,8 +16,9 @@ use crate::assets::texture::Footprint;
 use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
+use crate::scene::settings::ShadingMode;
 use crate::shade::lanes::LaneMaterial;
-use crate::shade::lanes::{Coords, Lanes, MAX_LANES, MAX_SIZES};
+use crate::shade::lanes::{Coords, Footprints, Lanes, MAX_LANES, MAX_SIZES};
 use crate::shade::light::LightMask;
 use crate::simd::{F8, Lane, V3, lerp3};
 
@@ -35,8 +36,9 @@ pub(super) struct Pending {
     /// Barycentrics at the shading point, and w there.
     pub lambda: Vec3,
     pub w: f32,
-    /// Filter footprints per texture size (`LaneMaterial::footprints`).
-    pub footprints: [Footprint; MAX_SIZES],
+    /// Filter footprints per slot, and the bump map's step
+    /// (`LaneMaterial::footprints`).
+    pub footprints: Footprints,
     pub ao: f32,
     /// The lights that may reach its tile.
     pub lights: LightMask,
@@ -126,7 +128,7 @@ impl Pending {
         count: 1.0,
         lambda: Vec3::ZERO,
         w: 0.0,
-        footprints: [Footprint::Lod(0.0); MAX_SIZES],
+        footprints: Footprints::NONE,
         ao: 1.0,
         lights: LightMask::NONE,
     };
@@ -358,6 +360,7 @@ pub(super) struct Prepared {
     w: [f32; MAX_LANES],
     ao: [f32; MAX_LANES],
     footprints: [[Footprint; MAX_LANES]; MAX_SIZES],
+    bump: [Vec2; MAX_LANES],
     lights: LightMask,
     /// Blended layers (`layer_lanes`): each lane's result is its colour
     /// and opacity instead of its colour and view depth.
@@ -373,6 +376,7 @@ impl Prepared {
         for s in 0..MAX_SIZES {
             self.footprints[s][4..].copy_from_slice(&other.footprints[s][..4]);
         }
+        self.bump[4..].copy_from_slice(&other.bump[..4]);
         self.len = 8;
         self.lights = self.lights.union(other.lights);
     }
@@ -500,12 +504,19 @@ impl<'a> FrameData<'a> {
         let uv1 = if lm.reads_set1() { uv(1) } else { uv0 };
         let tangent = lerp(|k| k.tangent.map(|t| t.truncate()));
         let color = (!mesh.colors.is_empty()).then(|| lerp(|k| k.color.map(|c| c.truncate())));
+        // Flat shading: the triangles' normals (as `surface` has them).
+        let normal = if ctx.mode == ShadingMode::Flat {
+            V3::from_fn(|k| geo_normal[k])
+        } else {
+            normal
+        };
         let lanes = Lanes {
             position,
             normal,
             color,
             geo_normal,
             ao: L::from_fn(|k| p.ao[at + k]),
+            depth,
             lights: p.lights,
         };
         let coords = Coords {
@@ -516,6 +527,8 @@ impl<'a> FrameData<'a> {
             back: normal.dot(raw).cmplt(L::splat(0.0)),
             footprints: &p.footprints,
             first: at,
+            sets: [uv0, uv1],
+            bump: &p.bump,
         };
         (lanes, coords, depth)
     }
@@ -647,7 +660,8 @@ impl<'a> FrameData<'a> {
             lambda: std::array::from_fn(|k| f[pick(k)].lambda),
             w: std::array::from_fn(|k| f[pick(k)].w),
             ao: std::array::from_fn(|k| q.ao[pick(k)]),
-            footprints: fp.map(|f| [f; MAX_LANES]),
+            footprints: fp.slots.map(|f| [f; MAX_LANES]),
+            bump: [fp.bump; MAX_LANES],
             lights: q.lights,
             layer: false,
         }
@@ -664,6 +678,7 @@ impl<'a> FrameData<'a> {
             w: [0.0; MAX_LANES],
             ao: [1.0; MAX_LANES],
             footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
+            bump: [Vec2::ZERO; MAX_LANES],
             lights: LightMask::NONE,
             layer: false,
         };
@@ -672,8 +687,9 @@ impl<'a> FrameData<'a> {
             p.w[k] = f.w;
             p.ao[k] = f.ao;
             for (s, fp) in p.footprints.iter_mut().enumerate() {
-                fp[k] = f.footprints[s];
+                fp[k] = f.footprints.slots[s];
             }
+            p.bump[k] = f.footprints.bump;
             p.lights = p.lights.union(f.lights);
         }
         p

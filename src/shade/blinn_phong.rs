@@ -270,6 +270,7 @@ mod tests {
                 color: None,
                 geo_normal: [n; 8],
                 ao: 1.0,
+                depth: 5.0,
                 lights: LightMask::ALL,
             };
             ctx.shade_blinn_phong(&material(illum), &mut Plain, &f, None)

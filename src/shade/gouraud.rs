@@ -48,6 +48,7 @@ pub fn vertex_light(
                 color: None,
                 geo_normal: [nn; MAX_LANES],
                 ao: 1.0,
+                depth: 0.0,
                 lights: LightMask::ALL,
             };
             let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), Exponent::One(ns[i]), spec[i]);

@@ -5,22 +5,22 @@
 //! every lane of a wider call is bit for bit that instance's answer.
 //!
 //! What differs between the widths is where texels come from (`Fetch`).
-//! A lone fragment reads them through `ShadeContext::sample`, which takes
-//! every map (samplers with filters of their own, bump maps). The
+//! A lone fragment reads them through `ShadeContext::sample`. The
 //! renderer gathers the visible fragments of a band into wider calls
 //! wherever `ShadeContext::lane_material` accepts the material: its maps
-//! use the frame's filter (no sampler limits of their own) and fall in at
-//! most three slots (coordinate set, transform, texture size and chain),
-//! and its normal maps are in tangent or object space (not bump maps).
-//! Their lookups are found four lanes at a time for all maps of one slot
-//! (`Texture::taps4`) and gathered per lane.
+//! fall in at most three slots (coordinate set, transform, sampler
+//! filters, texture size and chain), and the mode is not wireframe or
+//! Gouraud. Their lookups are found four lanes at a time for all maps of
+//! one slot (`Texture::taps4`) and gathered per lane; a slot's footprint
+//! per fragment carries its filter (the frame's, lowered or magnified
+//! with the nearest texel by the map's sampler).
 //!
 //! The lanes of one call share a material but not a triangle.
 
 // Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{Affine2, Mat3, Vec3, Vec4};
+use glam::{Affine2, Mat3, Vec2, Vec3, Vec4};
 use smallvec::SmallVec;
 
 use super::light::{LightMask, LightSet};
@@ -32,7 +32,7 @@ use crate::assets::texture::{
 use crate::scene::Material;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::{AlphaMode, Native, NormalMap, NormalSpace};
-use crate::scene::settings::{ShadingMode, TextureFilter};
+use crate::scene::settings::ShadingMode;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 /// At most this many slots (coordinate set and transform, texture size
@@ -69,6 +69,11 @@ pub(super) enum LaneShading {
     Pbr,
     /// KHR_materials_unlit: the base colour alone.
     Unlit,
+    /// The `unlit` mode: the base colour (diffuse) plus the emission.
+    Emitted,
+    /// The data views: the shading normal, the depth.
+    Normals,
+    Depth,
 }
 
 /// A material the lanes can shade, prepared for one frame.
@@ -88,6 +93,11 @@ pub struct LaneMaterial<'a> {
     /// Some slot reads set 1; some slot reads set 1 or has a transform.
     set1: bool,
     moved_or_set1: bool,
+    /// Some slot's sampler has filters of its own.
+    samplers: bool,
+    /// A bump map's coordinate set and texture size (times its
+    /// transform's scale along u and v).
+    bump: Option<(usize, Vec2)>,
 }
 
 /// Where a lane material's maps of one slot are looked up: the same
@@ -107,6 +117,67 @@ struct Slot {
     levels: usize,
     /// The transform is not the identity.
     moved: bool,
+    /// The sampler's filters (`TextureRef::mag_nearest`, `min_limit`).
+    mag_nearest: bool,
+    min_limit: Option<Filter>,
+}
+
+impl Slot {
+    /// The footprint of a lookup in this slot whose coordinates change by
+    /// `g` (transformed) across its quad, as `TextureRef::sample_grad`
+    /// filters it: the sampler's NEAREST magnification where a texel
+    /// covers the pixel, its limit lowering the frame's filter otherwise.
+    #[inline]
+    fn footprint(&self, ctx: &ShadeContext, g: Gradients) -> Footprint {
+        let (w, h) = self.size;
+        let mut filter = ctx.filter;
+        if self.mag_nearest || self.min_limit.is_some() {
+            let size = glam::Vec2::new(w as f32, h as f32);
+            let texels = (g.dx * size).length().max((g.dy * size).length());
+            if texels <= 1.0 {
+                if self.mag_nearest {
+                    return Footprint::Nearest;
+                }
+            } else if let Some(limit) = self.min_limit
+                && limit < filter
+            {
+                filter = limit;
+            }
+        }
+        match filter {
+            Filter::Nearest => Footprint::Nearest,
+            Filter::Bilinear => Footprint::Lod(0.0),
+            _ if self.levels == 0 => Footprint::Lod(0.0),
+            _ => {
+                let f = Filtering {
+                    filter,
+                    max_anisotropy: ctx.max_anisotropy,
+                    mips: None,
+                };
+                Texture::footprint_of_size(w, h, g, &f)
+            }
+        }
+    }
+}
+
+/// What a fragment's lookups of a lane material cover
+/// (`LaneMaterial::footprints`).
+#[derive(Debug, Clone, Copy)]
+pub struct Footprints {
+    /// Per slot of the material.
+    pub slots: [Footprint; MAX_SIZES],
+    /// Where the material has a bump map: the step between its height
+    /// samples, in texture coordinates (one pixel's footprint, at least
+    /// a texel).
+    pub bump: Vec2,
+}
+
+impl Footprints {
+    /// Level 0 in every slot, no bump step.
+    pub const NONE: Footprints = Footprints {
+        slots: [Footprint::Lod(0.0); MAX_SIZES],
+        bump: Vec2::ZERO,
+    };
 }
 
 /// The points of the fragments in the lanes: what shading needs of a
@@ -121,6 +192,8 @@ pub struct Lanes<L: Lane = Vec4> {
     /// first `L::WIDTH`).
     pub geo_normal: [Vec3; MAX_LANES],
     pub ao: L,
+    /// View depth.
+    pub depth: L,
     /// The lights that may reach some lane (the union of the lanes'
     /// tiles'); the others give every lane nothing.
     pub lights: LightMask,
@@ -144,6 +217,11 @@ pub struct Coords<'p, L: Lane = Vec4> {
     /// from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
     pub first: usize,
+    /// A bump map's: the lanes' coordinates of sets 0 and 1 (before any
+    /// transform), and its steps (`Footprints::bump`) per lane from lane
+    /// `first`.
+    pub sets: [(L, L); 2],
+    pub bump: &'p [Vec2; MAX_LANES],
 }
 
 impl<L: Lane> Lanes<L> {
@@ -184,20 +262,22 @@ impl<'a> LaneMaterial<'a> {
     /// and 1) change by `g` across its quad: one per slot, in the order
     /// `Coords::footprints` takes them (as `ShadeContext::sample` derives
     /// them, the transform applied to the derivatives).
-    pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> [Footprint; MAX_SIZES] {
-        let mut out = [Footprint::Lod(0.0); MAX_SIZES];
-        if !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
+    pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> Footprints {
+        let mut out = Footprints::NONE;
+        if let Some((set, size)) = self.bump {
+            // As `ShadeContext::apply_normal_map` steps.
+            let g = g[set];
+            let texels = (g.dx * size).length().max((g.dy * size).length());
+            out.bump = texels.max(1.0) / size;
+        }
+        if ctx.filter == Filter::Nearest {
+            out.slots = [Footprint::Nearest; MAX_SIZES];
             return out;
         }
-        let f = Filtering {
-            filter: ctx.filter,
-            max_anisotropy: ctx.max_anisotropy,
-            mips: None,
-        };
+        if !self.samplers && !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
+            return out;
+        }
         for (k, slot) in self.slots.iter().enumerate() {
-            if slot.levels == 0 {
-                continue;
-            }
             let mut g = g[slot.set];
             if slot.moved {
                 let m = slot.transform.matrix2;
@@ -206,8 +286,7 @@ impl<'a> LaneMaterial<'a> {
                     dy: m * g.dy,
                 };
             }
-            let (w, h) = slot.size;
-            out[k] = Texture::footprint_of_size(w, h, g, &f);
+            out.slots[k] = slot.footprint(ctx, g);
         }
         out
     }
@@ -260,6 +339,7 @@ struct MapSet<'c, 'a> {
     tangents: bool,
     maps: Vec<Map<'a>>,
     slots: SmallVec<[Slot; MAX_SIZES]>,
+    bump: Option<(usize, Vec2)>,
 }
 
 impl<'a> MapSet<'_, 'a> {
@@ -270,9 +350,6 @@ impl<'a> MapSet<'_, 'a> {
             // finds no lookup for it).
             return Some(());
         }
-        if t.min_limit.is_some() || t.mag_nearest {
-            return None;
-        }
         let tex = &*t.texture;
         let mips = self.ctx.mips.get(tex.id).copied().flatten();
         let here = Slot {
@@ -281,6 +358,8 @@ impl<'a> MapSet<'_, 'a> {
             size: (tex.width, tex.height),
             levels: mips.map_or(0, |m| 1 + m.len()),
             moved: t.transform != Affine2::IDENTITY,
+            mag_nearest: t.mag_nearest,
+            min_limit: t.min_limit,
         };
         let slot = match self.slots.iter().position(|s| *s == here) {
             Some(k) => k,
@@ -319,6 +398,10 @@ impl<'a> MapSet<'_, 'a> {
     }
 
     fn normal(&mut self, m: &'a Option<NormalMap>) -> Option<()> {
+        if self.ctx.mode == ShadingMode::Flat {
+            // Flat shading keeps the triangles' normals: not looked up.
+            return Some(());
+        }
         let t = match m {
             None => return Some(()),
             Some(NormalMap::Normals { map, .. } | NormalMap::Height { map, .. }) => map,
@@ -341,7 +424,17 @@ impl<'a> MapSet<'_, 'a> {
                 space: NormalSpace::Object,
                 ..
             }) => self.map(t),
-            _ => None,
+            Some(NormalMap::Height { .. }) => {
+                if self.tangents {
+                    self.map(t)?;
+                    let m = t.transform.matrix2;
+                    let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
+                        * Vec2::new(m.x_axis.length(), m.y_axis.length());
+                    self.bump = Some(((t.texcoord as usize).min(1), size));
+                }
+                Some(())
+            }
+            None => Some(()),
         }
     }
 
@@ -403,19 +496,22 @@ impl<'a> ShadeContext<'a> {
         uvs: [bool; 2],
         tangents: bool,
     ) -> Option<LaneMaterial<'a>> {
-        if self.env_sampled.is_some() || self.filter == TextureFilter::Nearest {
-            return None;
-        }
         let kind = match self.mode {
-            // KHR_materials_unlit: the base colour in every lit mode.
-            ShadingMode::BlinnPhong | ShadingMode::Pbr | ShadingMode::Auto if m.unlit => {
-                LaneShading::Unlit
-            }
-            ShadingMode::BlinnPhong => LaneShading::BlinnPhong,
+            ShadingMode::Normals => LaneShading::Normals,
+            ShadingMode::Depth => LaneShading::Depth,
+            // Edge distances: the one-fragment path's.
+            ShadingMode::Wireframe => return None,
+            // KHR_materials_unlit: the base colour in every mode but the
+            // data views.
+            _ if m.unlit => LaneShading::Unlit,
+            // Vertex lighting: the one-fragment path's.
+            ShadingMode::Gouraud => return None,
+            ShadingMode::Unlit => LaneShading::Emitted,
+            // Flat: the triangles' normals (`FrameData::lanes`).
+            ShadingMode::BlinnPhong | ShadingMode::Flat => LaneShading::BlinnPhong,
             ShadingMode::Pbr => LaneShading::Pbr,
             ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,
             ShadingMode::Auto => LaneShading::Pbr,
-            _ => return None,
         };
         let mut maps = MapSet {
             ctx: self,
@@ -423,10 +519,14 @@ impl<'a> ShadeContext<'a> {
             tangents,
             maps: Vec::new(),
             slots: SmallVec::new(),
+            bump: None,
         };
         match kind {
             LaneShading::BlinnPhong => maps.blinn_phong(m)?,
-            LaneShading::Pbr | LaneShading::Unlit => maps.pbr(m)?,
+            LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m)?,
+            LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m)?,
+            LaneShading::Normals => maps.normal(&m.normal_map)?,
+            LaneShading::Depth => {}
         }
         // A blended surface's opacity reads these too (`opacity`); a
         // transmissive one is the one-fragment path's layer.
@@ -452,6 +552,11 @@ impl<'a> ShadeContext<'a> {
             tangents,
             set1: maps.slots.iter().any(|s| s.set == 1),
             moved_or_set1: maps.slots.iter().any(|s| s.set == 1 || s.moved),
+            samplers: maps
+                .slots
+                .iter()
+                .any(|s| s.mag_nearest || s.min_limit.is_some()),
+            bump: maps.bump,
             slots: maps.slots,
         })
     }
@@ -506,10 +611,36 @@ impl<'a> ShadeContext<'a> {
         f: &Lanes<L>,
         fetch: &mut LaneFetch<'_, 'a, '_, L>,
     ) -> V3<L> {
+        let m = lm.material;
         match lm.kind {
-            LaneShading::BlinnPhong => self.shade_blinn_phong(lm.material, fetch, f, None),
-            LaneShading::Pbr => self.shade_pbr(lm.material, fetch, f),
-            LaneShading::Unlit => self.pbr_color(lm.material, fetch, f).base,
+            LaneShading::BlinnPhong => self.shade_blinn_phong(m, fetch, f, None),
+            LaneShading::Pbr => self.shade_pbr(m, fetch, f),
+            LaneShading::Unlit => self.pbr_color(m, fetch, f).base,
+            LaneShading::Emitted if m.native == Native::Pbr => {
+                let c = self.pbr_color(m, fetch, f);
+                c.base + c.emissive
+            }
+            LaneShading::Emitted => {
+                let c = self.surface_color(m, fetch, f.color);
+                c.kd + c.ke
+            }
+            LaneShading::Normals => {
+                let n = match &m.normal_map {
+                    Some(map) => fetch.normal(map),
+                    None => f.normal,
+                };
+                let half = L::splat(0.5);
+                V3 {
+                    x: n.x * half + half,
+                    y: n.y * half + half,
+                    z: n.z * half + half,
+                }
+            }
+            LaneShading::Depth => {
+                let (lo, hi) = self.depth_range;
+                let d = L::splat(1.0) - clamp01((f.depth - L::splat(lo)) / L::splat(hi - lo));
+                V3 { x: d, y: d, z: d }
+            }
         }
     }
 
@@ -602,6 +733,54 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
     }
 }
 
+impl<L: Lane> LaneFetch<'_, '_, '_, L> {
+    /// The interpolated normals bent by the bump map `t` scaled by
+    /// `scale` (`ShadeContext::apply_normal_map`): the height's central
+    /// differences one step (`Footprints::bump`) along u and along v,
+    /// each lookup filtered over the lanes' footprints.
+    fn bump(&mut self, t: &TextureRef, scale: f32) -> V3<L> {
+        let Some(i) = self.lm.index_of(t) else {
+            // No coordinates or no tangents: the normal as it is.
+            return self.normal;
+        };
+        let map = &self.lm.maps[i];
+        let f = self.lookups.coords;
+        let (u, v) = f.sets[(t.texcoord as usize).min(1)];
+        let step = |axis: fn(Vec2) -> f32| L::from_fn(|k| axis(f.bump[f.first + k]));
+        let (su, sv) = (step(|s| s.x), step(|s| s.y));
+        let zero = L::splat(0.0);
+        let height = |du: L, dv: L| {
+            let (u, v) = (u + du, v + dv);
+            let (u, v) = if map.source.transform == Affine2::IDENTITY {
+                (u, v)
+            } else {
+                let (m, o) = (
+                    map.source.transform.matrix2,
+                    map.source.transform.translation,
+                );
+                (
+                    L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(o.x),
+                    L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(o.y),
+                )
+            };
+            let mut red = [Vec4::ZERO; 2];
+            for (q, r) in red.iter_mut().enumerate().take(L::QUADS) {
+                let fps = f.footprints4(map.slot, q);
+                *r = map.chain.sample4(u.quad(q), v.quad(q), &fps, map.mode)[0];
+            }
+            L::from_quads(|q| red[q])
+        };
+        let half = L::splat(0.5);
+        let du = (height(su, zero) - height(-su, zero)) * half;
+        // Image rows run down; the bitangent points up the image.
+        let dv = (height(zero, -sv) - height(zero, sv)) * half;
+        let n = self.normal;
+        let (tt, b) = tangent_frame(n, (f.tangent, f.sign));
+        let scale = L::splat(scale);
+        (n - tt.scale(du * scale) - b.scale(dv * scale)).normalize_or(n)
+    }
+}
+
 impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     #[inline(always)]
     fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
@@ -652,7 +831,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     fn normal(&mut self, m: &NormalMap) -> V3<L> {
         let (t, scale, space) = match m {
             NormalMap::Normals { map, scale, space } => (map, *scale, *space),
-            NormalMap::Height { .. } => return self.normal,
+            NormalMap::Height { map, scale } => return self.bump(map, *scale),
         };
         if space == NormalSpace::Tangent && !self.lm.tangents {
             return self.normal;
@@ -701,6 +880,19 @@ pub(super) fn tangent_space<L: Lane>(
         y: c.y * two - one,
         z: c.z * two - one,
     };
+    let (tt, b) = tangent_frame(n, (t, sign));
+    let scale = L::splat(scale);
+    let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
+    mapped.normalize_or(n)
+}
+
+/// The unit tangents and bitangents of unit normals `n` given the
+/// interpolated tangents and their bitangent signs `(t, sign)`: `t` made
+/// orthogonal to `n` (any such vector where it has no length left), and
+/// n x t, negated where the sign is negative.
+#[inline(always)]
+fn tangent_frame<L: Lane>(n: V3<L>, (t, sign): (V3<L>, L)) -> (V3<L>, V3<L>) {
+    let one = L::splat(1.0);
     let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
     let tt = if ok.all() {
         tt
@@ -709,10 +901,7 @@ pub(super) fn tangent_space<L: Lane>(
         V3::select(ok, tt, fallback)
     };
     let sign = L::select(sign.cmplt(L::splat(0.0)), -one, one);
-    let b = n.cross(tt).scale(sign);
-    let scale = L::splat(scale);
-    let mapped = tt.scale(c.x * scale) + b.scale(c.y * scale) + n.scale(c.z);
-    mapped.normalize_or(n)
+    (tt, n.cross(tt).scale(sign))
 }
 
 /// `light::incidence(light, p)` at each lane's point: direction,
@@ -862,9 +1051,9 @@ mod tests {
     }
 
     /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
-    /// maps, the KHR layers with their maps, texture transforms and unlit
-    /// materials do; samplers with filters of their own and a fourth slot
-    /// do not.
+    /// maps, the KHR layers with their maps, texture transforms, samplers
+    /// with filters of their own and unlit materials do; a fourth slot
+    /// does not.
     #[test]
     fn which_materials_the_lanes_take() {
         let shadows = Shadows::none();
@@ -901,8 +1090,17 @@ mod tests {
         // Forced pbr shading takes the OBJ material's pbr view.
         let pbr = context(&shadows, ShadingMode::Pbr);
         assert_eq!(kind(&pbr, &obj), Some((LaneShading::Pbr, 0, 0)));
+        // Flat shading reads no normal map.
         let flat = context(&shadows, ShadingMode::Flat);
-        assert_eq!(kind(&flat, &obj), None);
+        let mut bumpy = obj.clone();
+        bumpy.normal_map = Some(NormalMap::Normals {
+            map: map(32),
+            space: NormalSpace::Tangent,
+            scale: 1.0,
+        });
+        assert_eq!(kind(&flat, &bumpy), Some((LaneShading::BlinnPhong, 1, 1)));
+        let wireframe = context(&shadows, ShadingMode::Wireframe);
+        assert_eq!(kind(&wireframe, &obj), None);
 
         let mut coat = gltf.clone();
         coat.pbr.clearcoat = Some(Clearcoat {
@@ -926,7 +1124,11 @@ mod tests {
         if let Some(t) = &mut limited.pbr.base_color_map {
             t.mag_nearest = true;
         }
-        assert_eq!(kind(&auto, &limited), None);
+        // So is a sampler with filters of its own.
+        assert_eq!(kind(&auto, &limited), Some((LaneShading::Pbr, 4, 3)));
+        let mut nearest = context(&shadows, ShadingMode::Auto);
+        nearest.filter = Filter::Nearest;
+        assert_eq!(kind(&nearest, &gltf), Some((LaneShading::Pbr, 4, 3)));
         let mut sizes = gltf.clone();
         sizes.pbr.emissive = Vec3::ONE;
         sizes.pbr.emissive_map = Some(map(32));
@@ -934,8 +1136,8 @@ mod tests {
         let mut four = sizes.clone();
         four.pbr.base_color_map = Some(map(4));
         assert_eq!(kind(&auto, &four), None);
-        // An object-space normal map is a map like the others; a bump
-        // map is the one-fragment path's.
+        // An object-space normal map is a map like the others, and so is
+        // a bump map.
         let mut object = gltf.clone();
         object.normal_map = Some(NormalMap::Normals {
             map: map(16),
@@ -948,6 +1150,8 @@ mod tests {
             map: map(16),
             scale: 1.0,
         });
-        assert_eq!(kind(&auto, &bump), None);
+        assert_eq!(kind(&auto, &bump), Some((LaneShading::Pbr, 4, 3)));
+        let lm = auto.lane_material(&bump, [true; 2], true);
+        assert_eq!(lm.and_then(|lm| lm.bump), Some((0, Vec2::splat(16.0))));
     }
 }

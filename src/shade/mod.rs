@@ -467,6 +467,7 @@ impl Lanes<f32> {
             color: Some(V3::from(s.color.truncate())),
             geo_normal: [s.geo_normal; lanes::MAX_LANES],
             ao: s.ao,
+            depth: s.view_depth,
             lights: s.lights,
         }
     }

@@ -2,7 +2,7 @@
 //! fragments side by side (`shade::lanes`): the coordinates and
 //! results are held per channel with one lane per lookup (a structure of
 //! arrays), and every lane is bit for bit what the one-lookup functions
-//! give for it (`Texture::sample_footprint`).
+//! give for it (`Chain::sample1`).
 //!
 //! A lookup is found in two steps. `Texture::taps4` places the four
 //! footprints: per lane the level or two levels read, and in each the
@@ -131,15 +131,52 @@ impl<'t> Chain<'t> {
         mode: Wrap,
         live: u32,
     ) -> [Vec4; N] {
+        let nearest = fps.iter().enumerate().fold(0, |m, (k, f)| {
+            m | (u32::from(*f == Footprint::Nearest) << k)
+        }) & live;
+        if nearest != 0 {
+            return self.with_nearest(u, v, fps, mode, (live, nearest));
+        }
         match self.taps4(u, v, fps) {
             Some(taps) => self.read(&taps.only(live), mode),
             None => self.probes(u, v, fps, mode, live),
         }
     }
 
+    /// `sample` where the lanes `nearest` (of the lanes `live`) read the
+    /// nearest texel (`Texture::sample_nearest`, lane by lane).
+    #[cold]
+    fn with_nearest<const N: usize>(
+        &self,
+        u: Vec4,
+        v: Vec4,
+        fps: &[Footprint; 4],
+        mode: Wrap,
+        (live, nearest): (u32, u32),
+    ) -> [Vec4; N] {
+        let rest = live & !nearest;
+        let mut out = [Vec4::ZERO; N];
+        if rest != 0 {
+            let others = fps.map(|f| match f {
+                Footprint::Nearest => Footprint::Lod(0.0),
+                f => f,
+            });
+            out = self.sample(u, v, &others, mode, rest);
+        }
+        for k in 0..4 {
+            if nearest & (1 << k) != 0 {
+                let c = self.texture.sample_nearest(Vec2::new(u[k], v[k]), mode);
+                for (ch, o) in out.iter_mut().enumerate() {
+                    o[k] = c[ch];
+                }
+            }
+        }
+        out
+    }
+
     /// Where `sample4` reads at one trilinear probe per lane
     /// (`Footprint::Lod`), in this chain or any other of its shape; None
-    /// where some lane takes anisotropic probes.
+    /// where some lane takes anisotropic probes or the nearest texel.
     #[inline]
     pub fn taps4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4]) -> Option<Taps4> {
         let mut out = None;
@@ -154,7 +191,7 @@ impl<'t> Chain<'t> {
         for k in 0..4 {
             match fps[k] {
                 Footprint::Lod(l) => lod[k] = l,
-                Footprint::Probes { .. } => {
+                Footprint::Probes { .. } | Footprint::Nearest => {
                     *out = None;
                     return;
                 }
@@ -371,6 +408,8 @@ impl<'t> Chain<'t> {
         for k in 0..4 {
             match fps[k] {
                 Footprint::Lod(l) => lod[k] = l,
+                // (`sample` looks these up before the probes.)
+                Footprint::Nearest => {}
                 Footprint::Probes {
                     n: pn,
                     lod: l,
@@ -605,13 +644,15 @@ mod tests {
                 }
                 sum / n
             }
+            Footprint::Nearest => t.sample_nearest(uv, mode),
         }
     }
 
     /// Every lane, and every lone lookup, equals the texel-by-texel
     /// reference bit for bit in all four channels: inside the image,
-    /// across its edges (address modes), between levels and with
-    /// anisotropic probes of different counts per lane.
+    /// across its edges (address modes), between levels, with
+    /// anisotropic probes of different counts per lane and with some
+    /// lanes reading the nearest texel.
     #[test]
     fn lanes_equal_texel_by_texel_filtering() {
         for srgb in [false, true] {
@@ -663,6 +704,15 @@ mod tests {
                         if round % 4 == 1 {
                             // A quad of one triangle: one footprint.
                             fps = [fps[0]; 4];
+                        }
+                        if round % 6 == 5 {
+                            // A sampler magnifying with the nearest
+                            // texel: some lanes, or all.
+                            for f in &mut fps {
+                                if rnd() < 0.6 {
+                                    *f = Footprint::Nearest;
+                                }
+                            }
                         }
                         let mips = if round % 5 == 4 {
                             None

@@ -189,6 +189,9 @@ pub enum Footprint {
     /// `n` trilinear probes at `lod`, spread over `axis` (texture
     /// coordinates) centred on the lookup.
     Probes { n: f32, lod: f32, axis: Vec2 },
+    /// The nearest texel of the image (level 0): the scene's `nearest`
+    /// filter, or a sampler's magnification filter NEAREST.
+    Nearest,
 }
 
 /// The first bytes of a texture-cache entry (`Texture::to_cache_bytes`);
