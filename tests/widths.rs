@@ -8,8 +8,10 @@
 //! shadows, the environment, AO, MSAA, anisotropic and trilinear
 //! filtering, address modes, orthographic cameras, illum 0 and 1; pbr
 //! with packed occlusion-roughness-metallic maps, emission, the KHR layers
-//! with and without maps of their own) with lone fragments and at each
-//! width, and compares colour and depth bit for bit.
+//! with and without maps of their own; samplers, bump maps, the sampled
+//! environment, every shading mode, transmissive layers) with lone
+//! fragments and at each width, and compares colour and depth bit for
+//! bit.
 
 mod common;
 
@@ -1004,5 +1006,71 @@ fn shading_modes_are_the_same_at_every_width() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn transmissive_layers_are_the_same_at_every_width() {
+    // KHR_materials_transmission (a factor and a map, with a clearcoat,
+    // a normal map and vertex colours) on a cube in front of an opaque
+    // one: its layers let the colour behind through, tinted; lit and
+    // under the studio look, with one sample and MSAA 4 (over a
+    // transparent background: the opacity counts), and as the
+    // Blinn-Phong mode sees it (blended by its opacity).
+    let dir = scratch("lanes_transmission");
+    layer_texture(&dir.join("t.png"));
+    let mut cube = common::cube();
+    cube.colors = (0..cube.positions.len())
+        .map(|k| [1.0, 0.8 + (k % 2) as f32 * 0.2, 0.7, 0.9])
+        .collect();
+    let images = r#""images": [{"uri": "t.png"}], "textures": [{"source": 0}]"#;
+    turned_cube(
+        &dir,
+        "o.gltf",
+        &common::cube(),
+        &format!(
+            r#"{images}, "materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}}}}}]"#
+        ),
+    );
+    turned_cube(
+        &dir,
+        "c.gltf",
+        &cube,
+        &format!(
+            r#"{images}, "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_clearcoat"],
+            "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.6, 0.9, 0.7, 1.0], "metallicFactor": 0.1, "roughnessFactor": 0.3}},
+                "normalTexture": {{"index": 0}},
+                "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 0.8, "transmissionTexture": {{"index": 0}}}},
+                    "KHR_materials_clearcoat": {{"clearcoatFactor": 0.5}}}}}}]"#
+        ),
+    );
+    let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+        [[model]]\npath = \"c.gltf\"\n";
+    let lit = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
+    let s = scene_in(&dir, &format!("{lit}{models}"), &[]);
+    assert!(s.models[1].materials[0].pbr.transmission.is_some());
+    let file = dir.join("scene.toml");
+    let studio = dir.join("studio.toml");
+    std::fs::write(
+        &studio,
+        format!("[output]\nwidth = 64\nheight = 64\n[environment]\npreset = \"studio\"\n{models}"),
+    )
+    .unwrap();
+    for (scene, sets) in [
+        (&file, vec![]),
+        (
+            &file,
+            vec!["render.msaa=4", "output.background=\"transparent\""],
+        ),
+        (&file, vec!["render.shading=\"blinn-phong\""]),
+        (&studio, vec!["render.msaa=4"]),
+    ] {
+        same_both_ways(
+            &load_with(scene, &sets),
+            &[0],
+            &format!("transmission, {scene:?}, {sets:?}"),
+        );
     }
 }

@@ -257,9 +257,7 @@ impl<'a> FrameData<'a> {
             }
             for (k, f) in frags.iter().enumerate() {
                 let layer = match layers.get(k) {
-                    Some(&(c, a)) => {
-                        let a = a.clamp(0.0, 1.0);
-                        let (add, through) = (c * a, Vec3::splat(1.0 - a));
+                    Some(&(add, through, a)) => {
                         (add.is_finite() && through.is_finite()).then_some((add, through, a))
                     }
                     None => self.layer(vis, (t, &it), f),
@@ -320,6 +318,7 @@ impl<'a> FrameData<'a> {
                 // Blended fragments may lie in front of the tile's visible
                 // depths: every light.
                 lights: LightMask::ALL,
+                edge: self.edge_distance(it, px, py, frag.lambda),
             });
         };
         if n == 1 {
@@ -715,6 +714,7 @@ impl<'a> FrameData<'a> {
                     footprints,
                     ao: at.reach.ao,
                     lights: at.reach.lights,
+                    edge: self.edge_distance(it, px, py, frag.lambda),
                 },
             );
         }

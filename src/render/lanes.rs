@@ -18,7 +18,7 @@ use crate::raster::interp::Interpolator;
 use crate::raster::setup::Tri;
 use crate::scene::settings::ShadingMode;
 use crate::shade::lanes::LaneMaterial;
-use crate::shade::lanes::{Coords, Footprints, Lanes, MAX_LANES, MAX_SIZES};
+use crate::shade::lanes::{Coords, Footprints, Lanes, Layer, MAX_LANES, MAX_SIZES};
 use crate::shade::light::LightMask;
 use crate::simd::{F8, Lane, V3, lerp3};
 
@@ -42,6 +42,9 @@ pub(super) struct Pending {
     pub ao: f32,
     /// The lights that may reach its tile.
     pub lights: LightMask,
+    /// Wireframe: its distance to its triangle's nearest edge, in
+    /// pixels (`FrameData::edge_distance`).
+    pub edge: f32,
 }
 
 /// A band's lane fragments waiting for their group: per draw, up to one
@@ -131,6 +134,7 @@ impl Pending {
         footprints: Footprints::NONE,
         ao: 1.0,
         lights: LightMask::NONE,
+        edge: f32::INFINITY,
     };
 }
 
@@ -359,12 +363,10 @@ pub(super) struct Prepared {
     lambda: [Vec3; MAX_LANES],
     w: [f32; MAX_LANES],
     ao: [f32; MAX_LANES],
+    edge: [f32; MAX_LANES],
     footprints: [[Footprint; MAX_LANES]; MAX_SIZES],
     bump: [Vec2; MAX_LANES],
     lights: LightMask,
-    /// Blended layers (`layer_lanes`): each lane's result is its colour
-    /// and opacity instead of its colour and view depth.
-    layer: bool,
 }
 
 impl Prepared {
@@ -373,6 +375,7 @@ impl Prepared {
         self.lambda[4..].copy_from_slice(&other.lambda[..4]);
         self.w[4..].copy_from_slice(&other.w[..4]);
         self.ao[4..].copy_from_slice(&other.ao[..4]);
+        self.edge[4..].copy_from_slice(&other.edge[..4]);
         for s in 0..MAX_SIZES {
             self.footprints[s][4..].copy_from_slice(&other.footprints[s][..4]);
         }
@@ -392,6 +395,8 @@ pub(super) struct Corners {
     /// Per corner, with the bitangent sign in w (zero without tangents).
     tangent: [Vec4; 3],
     color: [Vec4; 3],
+    /// Its index in the mesh (Gouraud shading finds its vertices' light).
+    prim: u32,
     /// Counter-clockwise as the camera sees it.
     front: bool,
 }
@@ -404,6 +409,7 @@ impl Corners {
         uv: [[Vec2::ZERO; 3]; 2],
         tangent: [Vec4::ZERO; 3],
         color: [Vec4::ZERO; 3],
+        prim: 0,
         front: false,
     };
 }
@@ -439,6 +445,7 @@ impl<'a> FrameData<'a> {
             } else {
                 idx.map(|i| mesh.colors[i])
             },
+            prim: t.prim,
             front: t.front,
         }
     }
@@ -517,7 +524,9 @@ impl<'a> FrameData<'a> {
             geo_normal,
             ao: L::from_fn(|k| p.ao[at + k]),
             depth,
+            edge: L::from_fn(|k| p.edge[at + k]),
             lights: p.lights,
+            vertex_light: self.vertex_light(p.draw, corners, at, l),
         };
         let coords = Coords {
             uv: lm.coords([uv0, uv1]),
@@ -531,6 +540,33 @@ impl<'a> FrameData<'a> {
             bump: &p.bump,
         };
         (lanes, coords, depth)
+    }
+
+    /// Gouraud shading: the lanes' light sums (diffuse, specular)
+    /// interpolated from their triangles' vertices (`surface`'s
+    /// `vertex_light`); None in the other modes.
+    #[inline(always)]
+    fn vertex_light<L: Lane>(
+        &self,
+        draw: usize,
+        corners: &[&Corners; MAX_LANES],
+        at: usize,
+        l: V3<L>,
+    ) -> Option<(V3<L>, V3<L>)> {
+        let d = self.draws[draw];
+        let light = &self.verts[d.model].light;
+        if light.is_empty() {
+            return None;
+        }
+        let triangles = &self.setup.scene.models[d.model].mesh.triangles;
+        let corner = |j: usize, specular: bool| {
+            V3::<L>::from_fn(|k| {
+                let v = triangles[corners[at + k].prim as usize][j] as usize;
+                if specular { light[v].1 } else { light[v].0 }
+            })
+        };
+        let sum = |s: bool| lerp3(corner(0, s), corner(1, s), corner(2, s), l);
+        Some((sum(false), sum(true)))
     }
 
     /// Shades the fragments of `p`, `width` lanes at a time: per lane,
@@ -567,22 +603,6 @@ impl<'a> FrameData<'a> {
         out: &mut [(Vec3, f32); MAX_LANES],
     ) {
         let (lanes, coords, depth) = self.lanes::<L>(lm, p, corners, at);
-        if p.layer {
-            // The vertex colours' alpha (exactly 1 without them).
-            let mesh = &self.setup.scene.models[self.draws[p.draw].model].mesh;
-            let alpha = if mesh.colors.is_empty() {
-                L::splat(1.0)
-            } else {
-                let l = V3::<L>::from_fn(|k| p.lambda[at + k]);
-                let a = |j: usize| L::from_fn(|k| corners[at + k].color[j].w);
-                a(0) * l.x + a(1) * l.y + a(2) * l.z
-            };
-            let (c, a) = self.ctx.layer_lanes(lm, &lanes, &coords, alpha);
-            for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
-                *o = (c.lane(k), a.lane(k));
-            }
-            return;
-        }
         let c = self.ctx.shade_lanes(lm, &lanes, &coords);
         for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
             let c = c.lane(k);
@@ -592,21 +612,52 @@ impl<'a> FrameData<'a> {
 
     /// The fragments `frags` of the blended triangle `t`, whose material
     /// the lanes shade as layers (`LaneMaterial::layers`), a lane group
-    /// at a time: per fragment, in order, its colour and opacity
+    /// at a time: per fragment, in order, what it adds, the share of the
+    /// colour behind it lets through, and its opacity
     /// (`ShadeContext::layer_lanes`) into `out`.
-    pub(super) fn layers(&self, t: &Tri, frags: &[Pending], out: &mut Vec<(Vec3, f32)>) {
+    pub(super) fn layers(&self, t: &Tri, frags: &[Pending], out: &mut Vec<Layer>) {
         let draw = t.draw as usize;
+        let Some(lm) = self.lane_material(draw) else {
+            return;
+        };
         let c = self.corners(draw, t);
-        let refs = [&c; MAX_LANES];
+        let corners = [&c; MAX_LANES];
         let width = self.lane_width;
+        let mut res = [(Vec3::ZERO, Vec3::ZERO, 0.0); MAX_LANES];
         for chunk in frags.chunks(width) {
             let mut group = [chunk[chunk.len() - 1]; MAX_LANES];
             group[..chunk.len()].copy_from_slice(chunk);
             let mut p = self.prepare_group(&group, width);
-            (p.draw, p.layer) = (draw, true);
-            let res = self.shade_prepared(&p, &refs, width);
+            p.draw = draw;
+            let (p, corners) = (&p, &corners);
+            match width {
+                8 => self.layer_at::<F8>(lm, (p, corners), &mut res),
+                4 => self.layer_at::<Vec4>(lm, (p, corners), &mut res),
+                _ => self.layer_at::<f32>(lm, (p, corners), &mut res),
+            }
             out.extend_from_slice(&res[..chunk.len()]);
         }
+    }
+
+    /// `layers` of the lanes of `p`.
+    #[inline(never)]
+    fn layer_at<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        (p, corners): (&Prepared, &[&Corners; MAX_LANES]),
+        out: &mut [Layer; MAX_LANES],
+    ) {
+        let (lanes, coords, _) = self.lanes::<L>(lm, p, corners, 0);
+        // The vertex colours' alpha (exactly 1 without them).
+        let mesh = &self.setup.scene.models[self.draws[p.draw].model].mesh;
+        let alpha = if mesh.colors.is_empty() {
+            L::splat(1.0)
+        } else {
+            let l = V3::<L>::from_fn(|k| p.lambda[k]);
+            let a = |j: usize| L::from_fn(|k| corners[k].color[j].w);
+            a(0) * l.x + a(1) * l.y + a(2) * l.z
+        };
+        self.ctx.layer_lanes(lm, &lanes, &coords, alpha, out);
     }
 
     /// The four pixels of the quad `q`, all of one triangle, one sample
@@ -660,10 +711,13 @@ impl<'a> FrameData<'a> {
             lambda: std::array::from_fn(|k| f[pick(k)].lambda),
             w: std::array::from_fn(|k| f[pick(k)].w),
             ao: std::array::from_fn(|k| q.ao[pick(k)]),
+            edge: std::array::from_fn(|k| {
+                let ((x, y), l) = (px[pick(k)], f[pick(k)].lambda);
+                self.edge_distance(it, x, y, l)
+            }),
             footprints: fp.slots.map(|f| [f; MAX_LANES]),
             bump: [fp.bump; MAX_LANES],
             lights: q.lights,
-            layer: false,
         }
     }
 
@@ -677,15 +731,16 @@ impl<'a> FrameData<'a> {
             lambda: [Vec3::ZERO; MAX_LANES],
             w: [0.0; MAX_LANES],
             ao: [1.0; MAX_LANES],
+            edge: [f32::INFINITY; MAX_LANES],
             footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
             bump: [Vec2::ZERO; MAX_LANES],
             lights: LightMask::NONE,
-            layer: false,
         };
         for (k, f) in frags.iter().enumerate().take(width) {
             p.lambda[k] = f.lambda;
             p.w[k] = f.w;
             p.ao[k] = f.ao;
+            p.edge[k] = f.edge;
             for (s, fp) in p.footprints.iter_mut().enumerate() {
                 fp[k] = f.footprints.slots[s];
             }

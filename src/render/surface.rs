@@ -185,11 +185,7 @@ impl<'a> FrameData<'a> {
                 a.1 * l.x + b.1 * l.y + c.1 * l.z,
             )
         });
-        let edge_distance = if mode == ShadingMode::Wireframe {
-            edge_distance(it, px, py, l)
-        } else {
-            f32::INFINITY
-        };
+        let edge_distance = self.edge_distance(it, px, py, l);
         Surface {
             material: &model.materials[d.material],
             position,
@@ -263,6 +259,20 @@ impl FragmentLighting {
         ao: 1.0,
         lights: LightMask::ALL,
     };
+}
+
+impl FrameData<'_> {
+    /// Wireframe shading: the distance in pixels from the shading point
+    /// (barycentrics `l`) in pixel (px, py) to the nearest edge of the
+    /// triangle `it` interpolates; infinite in the other modes.
+    #[inline]
+    pub(super) fn edge_distance(&self, it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
+        if self.ctx.mode == ShadingMode::Wireframe {
+            edge_distance(it, px, py, l)
+        } else {
+            f32::INFINITY
+        }
+    }
 }
 
 /// Screen-space distance (pixels) from the pixel center to the nearest edge

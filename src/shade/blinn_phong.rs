@@ -271,7 +271,9 @@ mod tests {
                 geo_normal: [n; 8],
                 ao: 1.0,
                 depth: 5.0,
+                edge: f32::INFINITY,
                 lights: LightMask::ALL,
+                vertex_light: None,
             };
             ctx.shade_blinn_phong(&material(illum), &mut Plain, &f, None)
                 .into()

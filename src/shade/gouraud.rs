@@ -49,7 +49,9 @@ pub fn vertex_light(
                 geo_normal: [nn; MAX_LANES],
                 ao: 1.0,
                 depth: 0.0,
+                edge: f32::INFINITY,
                 lights: LightMask::ALL,
+                vertex_light: None,
             };
             let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), Exponent::One(ns[i]), spec[i]);
             (d.into(), s.into())

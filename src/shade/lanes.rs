@@ -41,6 +41,10 @@ use crate::simd::{Lane, Mask, V3, clamp01};
 /// their lookups fall (`Texture::taps4`).
 pub const MAX_SIZES: usize = 3;
 
+/// A blended fragment's colour over what lies behind it: what it adds,
+/// the share of the colour behind that it lets through, its opacity.
+pub type Layer = (Vec3, Vec3, f32);
+
 /// The most lanes a call shades (`simd::F8`).
 pub const MAX_LANES: usize = crate::simd::MAX_WIDTH;
 
@@ -71,9 +75,12 @@ pub(super) enum LaneShading {
     Unlit,
     /// The `unlit` mode: the base colour (diffuse) plus the emission.
     Emitted,
-    /// The data views: the shading normal, the depth.
+    /// Blinn-Phong with the lights summed at the vertices.
+    Gouraud,
+    /// The data views: the shading normal, the depth, the edges.
     Normals,
     Depth,
+    Wireframe,
 }
 
 /// A material the lanes can shade, prepared for one frame.
@@ -194,6 +201,11 @@ pub struct Lanes<L: Lane = Vec4> {
     pub ao: L,
     /// View depth.
     pub depth: L,
+    /// Wireframe: the distance to the nearest edge, in pixels.
+    pub edge: L,
+    /// Gouraud shading: the light sums (diffuse, specular) interpolated
+    /// from the vertices.
+    pub vertex_light: Option<(V3<L>, V3<L>)>,
     /// The lights that may reach some lane (the union of the lanes'
     /// tiles'); the others give every lane nothing.
     pub lights: LightMask,
@@ -499,13 +511,11 @@ impl<'a> ShadeContext<'a> {
         let kind = match self.mode {
             ShadingMode::Normals => LaneShading::Normals,
             ShadingMode::Depth => LaneShading::Depth,
-            // Edge distances: the one-fragment path's.
-            ShadingMode::Wireframe => return None,
+            ShadingMode::Wireframe => LaneShading::Wireframe,
             // KHR_materials_unlit: the base colour in every mode but the
             // data views.
             _ if m.unlit => LaneShading::Unlit,
-            // Vertex lighting: the one-fragment path's.
-            ShadingMode::Gouraud => return None,
+            ShadingMode::Gouraud => LaneShading::Gouraud,
             ShadingMode::Unlit => LaneShading::Emitted,
             // Flat: the triangles' normals (`FrameData::lanes`).
             ShadingMode::BlinnPhong | ShadingMode::Flat => LaneShading::BlinnPhong,
@@ -522,16 +532,14 @@ impl<'a> ShadeContext<'a> {
             bump: None,
         };
         match kind {
-            LaneShading::BlinnPhong => maps.blinn_phong(m)?,
+            LaneShading::BlinnPhong | LaneShading::Gouraud => maps.blinn_phong(m)?,
             LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m)?,
             LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m)?,
             LaneShading::Normals => maps.normal(&m.normal_map)?,
-            LaneShading::Depth => {}
+            LaneShading::Depth | LaneShading::Wireframe => {}
         }
-        // A blended surface's opacity reads these too (`opacity`); a
-        // transmissive one is the one-fragment path's layer.
-        let layers =
-            m.alpha == AlphaMode::Blend && !(m.pbr.transmission.is_some() && self.shades_pbr(m));
+        // A blended surface's opacity reads these too (`opacity`).
+        let layers = m.alpha == AlphaMode::Blend;
         if layers {
             maps.optional(&m.map_d)?;
             maps.optional(&m.map_kd)?;
@@ -584,15 +592,17 @@ impl<'a> ShadeContext<'a> {
     }
 
     /// The fragments of a blended lane material (`LaneMaterial::layers`)
-    /// as layers: lane by lane `layer`'s colour (`shade`) and opacity
-    /// (before its clamp). `alpha`: the vertex colours' alpha.
+    /// as layers, lane by lane `layer`'s into `out` (from lane 0): what
+    /// it adds, the share of the colour behind that it lets through, its
+    /// opacity. `alpha`: the vertex colours' alpha.
     pub fn layer_lanes<L: Lane>(
         &self,
         lm: &LaneMaterial<'a>,
         f: &Lanes<L>,
         coords: &Coords<'_, L>,
         alpha: L,
-    ) -> (V3<L>, L) {
+        out: &mut [Layer; MAX_LANES],
+    ) {
         let mut fetch = LaneFetch {
             lm,
             lookups: Lookups::new(coords),
@@ -601,8 +611,29 @@ impl<'a> ShadeContext<'a> {
             next: 0,
         };
         fetch.start();
+        let m = lm.material;
         let c = self.shade_fetched(lm, f, &mut fetch);
-        (c, self.opacity_of(lm.material, |t| fetch.rgba(t), alpha))
+        if m.pbr.transmission.is_some() && self.shades_pbr(m) {
+            // Thin transmission: the base colour lets the light through,
+            // less what the surface reflects (`layer`).
+            let pc = self.pbr_color(m, &mut fetch, f);
+            let n = match &m.normal_map {
+                Some(map) => fetch.normal(map),
+                None => f.normal,
+            };
+            let v = self.view_lanes(f.position);
+            for (k, o) in out.iter_mut().enumerate().take(L::WIDTH) {
+                let t = pc.at(k).transmittance(n.lane(k), v.lane(k));
+                let t = t.clamp(Vec3::ZERO, Vec3::ONE);
+                *o = (c.lane(k), t, 1.0 - (t.x + t.y + t.z) / 3.0);
+            }
+            return;
+        }
+        let a = clamp01(self.opacity_of(m, |t| fetch.rgba(t), alpha));
+        let (add, through) = (c.scale(a), L::splat(1.0) - a);
+        for (k, o) in out.iter_mut().enumerate().take(L::WIDTH) {
+            *o = (add.lane(k), Vec3::splat(through.lane(k)), a.lane(k));
+        }
     }
 
     fn shade_fetched<L: Lane>(
@@ -615,6 +646,10 @@ impl<'a> ShadeContext<'a> {
         match lm.kind {
             LaneShading::BlinnPhong => self.shade_blinn_phong(m, fetch, f, None),
             LaneShading::Pbr => self.shade_pbr(m, fetch, f),
+            LaneShading::Gouraud => {
+                let none = (V3::zero(), V3::zero());
+                self.shade_blinn_phong(m, fetch, f, Some(f.vertex_light.unwrap_or(none)))
+            }
             LaneShading::Unlit => self.pbr_color(m, fetch, f).base,
             LaneShading::Emitted if m.native == Native::Pbr => {
                 let c = self.pbr_color(m, fetch, f);
@@ -640,6 +675,18 @@ impl<'a> ShadeContext<'a> {
                 let (lo, hi) = self.depth_range;
                 let d = L::splat(1.0) - clamp01((f.depth - L::splat(lo)) / L::splat(hi - lo));
                 V3 { x: d, y: d, z: d }
+            }
+            LaneShading::Wireframe => {
+                // Lines two output pixels wide centered on the edges
+                // (each triangle draws its half), box-filtered: the
+                // fraction of a pixel at distance d within one pixel of
+                // the edge is clamp(1.5 - d) (`shade`).
+                let d = f.edge / L::splat(self.pixel_scale);
+                let a = clamp01(L::splat(1.5) - d);
+                // 0.04 to 1 by a, as `Vec3::lerp`.
+                let one = L::splat(1.0);
+                let c = L::splat(0.04) * (one - a) + one * a;
+                V3 { x: c, y: c, z: c }
             }
         }
     }
@@ -1100,7 +1147,9 @@ mod tests {
         });
         assert_eq!(kind(&flat, &bumpy), Some((LaneShading::BlinnPhong, 1, 1)));
         let wireframe = context(&shadows, ShadingMode::Wireframe);
-        assert_eq!(kind(&wireframe, &obj), None);
+        assert_eq!(kind(&wireframe, &obj), Some((LaneShading::Wireframe, 0, 0)));
+        let gouraud = context(&shadows, ShadingMode::Gouraud);
+        assert_eq!(kind(&gouraud, &obj), Some((LaneShading::Gouraud, 1, 1)));
 
         let mut coat = gltf.clone();
         coat.pbr.clearcoat = Some(Clearcoat {

@@ -468,7 +468,9 @@ impl Lanes<f32> {
             geo_normal: [s.geo_normal; lanes::MAX_LANES],
             ao: s.ao,
             depth: s.view_depth,
+            edge: s.edge_distance,
             lights: s.lights,
+            vertex_light: s.vertex_light.map(|(d, s)| (V3::from(d), V3::from(s))),
         }
     }
 }
