@@ -100,7 +100,7 @@ impl<'a> FrameData<'a> {
                 let m = &model.materials[d.material];
                 paths
                     .lanes
-                    .then(|| ctx.lane_material(m, uvs, tangents))
+                    .then(|| LaneMaterial::new(&ctx, m, uvs, tangents))
                     .flatten()
             })
             .collect();

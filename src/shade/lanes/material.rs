@@ -1,0 +1,582 @@
+//! A material prepared for the lanes (`LaneMaterial::new`): its shading
+//! kind, the maps its shading reads in reading order, and the slots they
+//! fall in (coordinate set, transform, sampler filters, texture size and
+//! chain), whose filter footprints each fragment carries
+//! (`LaneMaterial::footprints`).
+
+// Loops over the lanes index several per-lane arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+use glam::{Affine2, Vec2};
+use smallvec::SmallVec;
+
+use super::{MAX_SIZES, ShadeContext};
+use crate::assets::texture::{
+    Chain, Filtering, Footprint, Gradients, Texture, TextureFilter as Filter, TextureRef, Wrap,
+};
+use crate::scene::Material;
+use crate::scene::material::{AlphaMode, Native, NormalMap, NormalSpace};
+use crate::scene::settings::ShadingMode;
+use crate::simd::Lane;
+
+/// One map of a lane material, ready for four lookups.
+pub(super) struct Map<'a> {
+    /// The texture with the frame's mip chain.
+    pub chain: Chain<'a>,
+    pub mode: Wrap,
+    /// Which of the fragment's footprints (by texture size and chain) it
+    /// reads, and whose taps.
+    pub slot: usize,
+    /// The material reference it came from.
+    pub source: &'a TextureRef,
+    /// The first map of the material that is the same lookup (glTF's
+    /// packed occlusion, roughness and metallic texture, referred to
+    /// twice): its texels serve this one.
+    pub same: usize,
+    /// Whether other maps are the same lookup as this one.
+    pub shared: bool,
+}
+
+/// The shading model of a lane material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum LaneShading {
+    BlinnPhong,
+    Pbr,
+    /// KHR_materials_unlit: the base colour alone.
+    Unlit,
+    /// The `unlit` mode: the base colour (diffuse) plus the emission.
+    Emitted,
+    /// Blinn-Phong with the lights summed at the vertices.
+    Gouraud,
+    /// The data views: the shading normal, the depth, the edges.
+    Normals,
+    Depth,
+    Wireframe,
+}
+
+/// A material the lanes can shade, prepared for one frame.
+pub struct LaneMaterial<'a> {
+    pub(super) material: &'a Material,
+    pub(super) kind: LaneShading,
+    /// Whether its blended surfaces are layers the lanes shade
+    /// (`layer_lanes`): blended, and not transmissive.
+    pub layers: bool,
+    /// Every map its shading may read, in the order it reads them.
+    pub(super) maps: Vec<Map<'a>>,
+    /// Whether the mesh has tangents (without them a tangent-space
+    /// normal map leaves the normal as it is).
+    pub(super) tangents: bool,
+    /// Where its maps are looked up: the slots of `Map::slot`.
+    slots: SmallVec<[Slot; MAX_SIZES]>,
+    /// Some slot reads set 1; some slot reads set 1 or has a transform.
+    set1: bool,
+    moved_or_set1: bool,
+    /// Some slot's sampler has filters of its own.
+    samplers: bool,
+    /// A bump map's coordinate set and texture size (times its
+    /// transform's scale along u and v).
+    bump: Option<(usize, Vec2)>,
+}
+
+/// Where a lane material's maps of one slot are looked up: the same
+/// coordinates (set and transform) in textures of the same size and
+/// chain, so they share one filter footprint per fragment and where
+/// their lookups fall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Slot {
+    /// Texture-coordinate set (0 or 1).
+    set: usize,
+    /// `TextureRef::transform` (KHR_texture_transform).
+    transform: Affine2,
+    /// Width and height.
+    size: (u32, u32),
+    /// Levels of its chain this frame; 0: level 0 alone, without a chain
+    /// (never minified), looked up bilinearly (`Texture::sample_grad`).
+    levels: usize,
+    /// The transform is not the identity.
+    moved: bool,
+    /// The sampler's filters (`TextureRef::mag_nearest`, `min_limit`).
+    mag_nearest: bool,
+    min_limit: Option<Filter>,
+}
+
+impl Slot {
+    /// The footprint of a lookup in this slot whose coordinates change by
+    /// `g` (transformed) across its quad, as `TextureRef::sample_grad`
+    /// filters it: the sampler's NEAREST magnification where a texel
+    /// covers the pixel, its limit lowering the frame's filter otherwise.
+    #[inline]
+    fn footprint(&self, ctx: &ShadeContext, g: Gradients) -> Footprint {
+        let (w, h) = self.size;
+        let mut filter = ctx.filter;
+        if self.mag_nearest || self.min_limit.is_some() {
+            let size = glam::Vec2::new(w as f32, h as f32);
+            let texels = (g.dx * size).length().max((g.dy * size).length());
+            if texels <= 1.0 {
+                if self.mag_nearest {
+                    return Footprint::Nearest;
+                }
+            } else if let Some(limit) = self.min_limit
+                && limit < filter
+            {
+                filter = limit;
+            }
+        }
+        match filter {
+            Filter::Nearest => Footprint::Nearest,
+            Filter::Bilinear => Footprint::Lod(0.0),
+            _ if self.levels == 0 => Footprint::Lod(0.0),
+            _ => {
+                let f = Filtering {
+                    filter,
+                    max_anisotropy: ctx.max_anisotropy,
+                    mips: None,
+                };
+                Texture::footprint_of_size(w, h, g, &f)
+            }
+        }
+    }
+}
+
+/// What a fragment's lookups of a lane material cover
+/// (`LaneMaterial::footprints`).
+#[derive(Debug, Clone, Copy)]
+pub struct Footprints {
+    /// Per slot of the material.
+    pub slots: [Footprint; MAX_SIZES],
+    /// Where the material has a bump map: the step between its height
+    /// samples, in texture coordinates (one pixel's footprint, at least
+    /// a texel).
+    pub bump: Vec2,
+}
+
+impl Footprints {
+    /// Level 0 in every slot, no bump step.
+    pub const NONE: Footprints = Footprints {
+        slots: [Footprint::Lod(0.0); MAX_SIZES],
+        bump: Vec2::ZERO,
+    };
+}
+
+impl<'a> LaneMaterial<'a> {
+    /// The footprints of a fragment whose texture coordinates (of sets 0
+    /// and 1) change by `g` across its quad: one per slot, in the order
+    /// `Coords::footprints` takes them (as `ShadeContext::sample` derives
+    /// them, the transform applied to the derivatives).
+    pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> Footprints {
+        let mut out = Footprints::NONE;
+        if let Some((set, size)) = self.bump {
+            // As `ShadeContext::apply_normal_map` steps.
+            let g = g[set];
+            let texels = (g.dx * size).length().max((g.dy * size).length());
+            out.bump = texels.max(1.0) / size;
+        }
+        if ctx.filter == Filter::Nearest {
+            out.slots = [Footprint::Nearest; MAX_SIZES];
+            return out;
+        }
+        if !self.samplers && !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
+            return out;
+        }
+        for (k, slot) in self.slots.iter().enumerate() {
+            let mut g = g[slot.set];
+            if slot.moved {
+                let m = slot.transform.matrix2;
+                g = Gradients {
+                    dx: m * g.dx,
+                    dy: m * g.dy,
+                };
+            }
+            out.slots[k] = slot.footprint(ctx, g);
+        }
+        out
+    }
+
+    /// Whether some map reads texture coordinates of set 1.
+    #[inline(always)]
+    pub fn reads_set1(&self) -> bool {
+        self.set1
+    }
+
+    /// Per slot, the lanes' coordinates of its set (`uv`) through its
+    /// transform (as `TextureRef::sample_grad` applies it).
+    #[inline(always)]
+    pub fn coords<L: Lane>(&self, uv: [(L, L); 2]) -> [(L, L); MAX_SIZES] {
+        let mut out = [uv[0]; MAX_SIZES];
+        if !self.moved_or_set1 {
+            return out;
+        }
+        for (o, slot) in out.iter_mut().zip(&self.slots) {
+            let (u, v) = uv[slot.set];
+            *o = if !slot.moved {
+                (u, v)
+            } else {
+                let (m, t) = (slot.transform.matrix2, slot.transform.translation);
+                (
+                    L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(t.x),
+                    L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(t.y),
+                )
+            };
+        }
+        out
+    }
+
+    /// Which of the maps `t` is.
+    #[inline]
+    pub(super) fn index_of(&self, t: &TextureRef) -> Option<usize> {
+        self.maps.iter().position(|m| std::ptr::eq(m.source, t))
+    }
+}
+
+/// Collects a lane material's maps, assigning each a slot by its
+/// coordinates, transform, texture size and chain; None where the lanes
+/// cannot look one up as `ShadeContext::sample` does (a sampler of its
+/// own, a fourth slot, a bump map). A map of a coordinate set the mesh
+/// lacks is left out: it counts as 1.
+struct MapSet<'c, 'a> {
+    ctx: &'c ShadeContext<'a>,
+    /// Whether the mesh has texture coordinates of sets 0 and 1.
+    uvs: [bool; 2],
+    tangents: bool,
+    maps: Vec<Map<'a>>,
+    slots: SmallVec<[Slot; MAX_SIZES]>,
+    bump: Option<(usize, Vec2)>,
+}
+
+impl<'a> MapSet<'_, 'a> {
+    fn map(&mut self, t: &'a TextureRef) -> Option<()> {
+        let set = (t.texcoord as usize).min(1);
+        if !self.uvs[set] {
+            // Without its coordinates a map counts as 1 (`Fetch::rgba`
+            // finds no lookup for it).
+            return Some(());
+        }
+        let tex = &*t.texture;
+        let mips = self.ctx.mips.get(tex.id).copied().flatten();
+        let here = Slot {
+            set,
+            transform: t.transform,
+            size: (tex.width, tex.height),
+            levels: mips.map_or(0, |m| 1 + m.len()),
+            moved: t.transform != Affine2::IDENTITY,
+            mag_nearest: t.mag_nearest,
+            min_limit: t.min_limit,
+        };
+        let slot = match self.slots.iter().position(|s| *s == here) {
+            Some(k) => k,
+            None if self.slots.len() < MAX_SIZES => {
+                self.slots.push(here);
+                self.slots.len() - 1
+            }
+            None => return None,
+        };
+        let mode = t.address.unwrap_or(self.ctx.address.into());
+        let same = self
+            .maps
+            .iter()
+            .position(|m| {
+                std::sync::Arc::ptr_eq(&m.source.texture, &t.texture)
+                    && m.mode == mode
+                    && m.slot == slot
+            })
+            .unwrap_or(self.maps.len());
+        self.maps.push(Map {
+            chain: tex.chain(mips),
+            mode,
+            slot,
+            source: t,
+            same,
+            shared: false,
+        });
+        Some(())
+    }
+
+    fn optional(&mut self, t: &'a Option<TextureRef>) -> Option<()> {
+        match t {
+            Some(t) => self.map(t),
+            None => Some(()),
+        }
+    }
+
+    fn normal(&mut self, m: &'a Option<NormalMap>) -> Option<()> {
+        if self.ctx.mode == ShadingMode::Flat {
+            // Flat shading keeps the triangles' normals: not looked up.
+            return Some(());
+        }
+        let t = match m {
+            None => return Some(()),
+            Some(NormalMap::Normals { map, .. } | NormalMap::Height { map, .. }) => map,
+        };
+        if !self.uvs[(t.texcoord as usize).min(1)] {
+            // Without its coordinates a map leaves the normal as it is.
+            return Some(());
+        }
+        match m {
+            Some(NormalMap::Normals {
+                space: NormalSpace::Tangent,
+                ..
+            }) => {
+                if self.tangents {
+                    self.map(t)?;
+                }
+                Some(())
+            }
+            Some(NormalMap::Normals {
+                space: NormalSpace::Object,
+                ..
+            }) => self.map(t),
+            Some(NormalMap::Height { .. }) => {
+                if self.tangents {
+                    self.map(t)?;
+                    let m = t.transform.matrix2;
+                    let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
+                        * Vec2::new(m.x_axis.length(), m.y_axis.length());
+                    self.bump = Some(((t.texcoord as usize).min(1), size));
+                }
+                Some(())
+            }
+            None => Some(()),
+        }
+    }
+
+    /// The maps a metallic-roughness material's shading reads, in the
+    /// order it reads them (`pbr_color`, then the normal map).
+    fn pbr(&mut self, m: &'a Material) -> Option<()> {
+        let p = &m.pbr;
+        for t in [
+            &p.base_color_map,
+            &p.metallic_roughness_map,
+            &p.roughness_map,
+            &p.metallic_map,
+            &p.occlusion_map,
+            &p.emissive_map,
+        ] {
+            self.optional(t)?;
+        }
+        if let Some(d) = &p.specular {
+            self.optional(&d.color_map)?;
+            self.optional(&d.weight_map)?;
+        }
+        if let Some(k) = &p.clearcoat {
+            self.optional(&k.map)?;
+            self.optional(&k.roughness_map)?;
+            self.normal(&k.normal_map)?;
+        }
+        if let Some(t) = &p.transmission {
+            self.optional(&t.map)?;
+            self.optional(&t.thickness_map)?;
+        }
+        if let Some(k) = &p.sheen {
+            self.optional(&k.color_map)?;
+            self.optional(&k.roughness_map)?;
+        }
+        if let Some(k) = &p.iridescence {
+            self.optional(&k.map)?;
+            self.optional(&k.thickness_map)?;
+        }
+        self.normal(&m.normal_map)
+    }
+
+    /// The maps a Blinn-Phong material's shading reads, in the order it
+    /// reads them (`surface_color`, then the normal map).
+    fn blinn_phong(&mut self, m: &'a Material) -> Option<()> {
+        for t in [&m.map_kd, &m.map_ka, &m.map_ks, &m.map_ke, &m.map_ns] {
+            self.optional(t)?;
+        }
+        self.normal(&m.normal_map)
+    }
+}
+
+impl<'a> LaneMaterial<'a> {
+    /// `m` prepared for the lanes in the frame of `ctx`, or None where it
+    /// needs the one-fragment path. `uvs` and `tangents`: whether the
+    /// mesh drawn with it has texture coordinates and tangents.
+    pub fn new(
+        ctx: &ShadeContext<'a>,
+        m: &'a Material,
+        uvs: [bool; 2],
+        tangents: bool,
+    ) -> Option<LaneMaterial<'a>> {
+        let kind = match ctx.mode {
+            ShadingMode::Normals => LaneShading::Normals,
+            ShadingMode::Depth => LaneShading::Depth,
+            ShadingMode::Wireframe => LaneShading::Wireframe,
+            // KHR_materials_unlit: the base colour in every mode but the
+            // data views.
+            _ if m.unlit => LaneShading::Unlit,
+            ShadingMode::Gouraud => LaneShading::Gouraud,
+            ShadingMode::Unlit => LaneShading::Emitted,
+            // Flat: the triangles' normals (`FrameData::lanes`).
+            ShadingMode::BlinnPhong | ShadingMode::Flat => LaneShading::BlinnPhong,
+            ShadingMode::Pbr => LaneShading::Pbr,
+            ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,
+            ShadingMode::Auto => LaneShading::Pbr,
+        };
+        let mut maps = MapSet {
+            ctx,
+            uvs,
+            tangents,
+            maps: Vec::new(),
+            slots: SmallVec::new(),
+            bump: None,
+        };
+        match kind {
+            LaneShading::BlinnPhong | LaneShading::Gouraud => maps.blinn_phong(m)?,
+            LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m)?,
+            LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m)?,
+            LaneShading::Normals => maps.normal(&m.normal_map)?,
+            LaneShading::Depth | LaneShading::Wireframe => {}
+        }
+        // A blended surface's opacity reads these too (`opacity`).
+        let layers = m.alpha == AlphaMode::Blend;
+        if layers {
+            maps.optional(&m.map_d)?;
+            maps.optional(&m.map_kd)?;
+        }
+        let mut maps_read = maps.maps;
+        for k in 0..maps_read.len() {
+            let same = maps_read[k].same;
+            if same != k {
+                maps_read[same].shared = true;
+                maps_read[k].shared = true;
+            }
+        }
+        Some(LaneMaterial {
+            material: m,
+            kind,
+            layers,
+            maps: maps_read,
+            tangents,
+            set1: maps.slots.iter().any(|s| s.set == 1),
+            moved_or_set1: maps.slots.iter().any(|s| s.set == 1 || s.moved),
+            samplers: maps
+                .slots
+                .iter()
+                .any(|s| s.mag_nearest || s.min_limit.is_some()),
+            bump: maps.bump,
+            slots: maps.slots,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::scene::material::Clearcoat;
+    use crate::shade::shadow::Shadows;
+    use crate::shade::testing::context;
+    use glam::Vec3;
+
+    fn map(size: u32) -> TextureRef {
+        let texels = vec![[200, 100, 50, 255]; (size * size) as usize];
+        TextureRef::new(Arc::new(Texture::from_rgba8(size, size, texels, false)))
+    }
+
+    /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
+    /// maps, the KHR layers with their maps, texture transforms, samplers
+    /// with filters of their own and unlit materials do; a fourth slot
+    /// does not.
+    #[test]
+    fn which_materials_the_lanes_take() {
+        let shadows = Shadows::none();
+        let auto = context(&shadows, ShadingMode::Auto);
+        let orm = map(8);
+        let mut gltf = Material::default_named("helmet");
+        gltf.native = Native::Pbr;
+        gltf.pbr.base_color_map = Some(map(16));
+        gltf.pbr.metallic_roughness_map = Some(orm.clone());
+        gltf.pbr.occlusion_map = Some(orm);
+        gltf.normal_map = Some(NormalMap::Normals {
+            map: map(16),
+            space: NormalSpace::Tangent,
+            scale: 1.0,
+        });
+        let kind = |ctx: &ShadeContext, m| {
+            LaneMaterial::new(ctx, m, [true; 2], true).map(|lm| {
+                let distinct = lm.maps.iter().enumerate().filter(|(i, m)| m.same == *i);
+                (lm.kind, lm.maps.len(), distinct.count())
+            })
+        };
+        // The packed texture is one lookup, read twice.
+        assert_eq!(kind(&auto, &gltf), Some((LaneShading::Pbr, 4, 3)));
+        // Without coordinates its maps count as 1 and its normal map
+        // leaves the normal as it is: nothing to look up.
+        assert_eq!(
+            LaneMaterial::new(&auto, &gltf, [false; 2], true).map(|lm| (lm.kind, lm.maps.len())),
+            Some((LaneShading::Pbr, 0))
+        );
+        let mut obj = Material::default_named("obj");
+        obj.map_kd = Some(map(16));
+        assert_eq!(kind(&auto, &obj), Some((LaneShading::BlinnPhong, 1, 1)));
+        // Forced pbr shading takes the OBJ material's pbr view.
+        let pbr = context(&shadows, ShadingMode::Pbr);
+        assert_eq!(kind(&pbr, &obj), Some((LaneShading::Pbr, 0, 0)));
+        // Flat shading reads no normal map.
+        let flat = context(&shadows, ShadingMode::Flat);
+        let mut bumpy = obj.clone();
+        bumpy.normal_map = Some(NormalMap::Normals {
+            map: map(32),
+            space: NormalSpace::Tangent,
+            scale: 1.0,
+        });
+        assert_eq!(kind(&flat, &bumpy), Some((LaneShading::BlinnPhong, 1, 1)));
+        let wireframe = context(&shadows, ShadingMode::Wireframe);
+        assert_eq!(kind(&wireframe, &obj), Some((LaneShading::Wireframe, 0, 0)));
+        let gouraud = context(&shadows, ShadingMode::Gouraud);
+        assert_eq!(kind(&gouraud, &obj), Some((LaneShading::Gouraud, 1, 1)));
+
+        let mut coat = gltf.clone();
+        coat.pbr.clearcoat = Some(Clearcoat {
+            factor: 1.0,
+            map: None,
+            roughness: 0.1,
+            roughness_map: Some(map(16)),
+            normal_map: None,
+        });
+        assert_eq!(kind(&auto, &coat), Some((LaneShading::Pbr, 5, 4)));
+        let mut unlit = gltf.clone();
+        unlit.unlit = true;
+        assert_eq!(kind(&auto, &unlit), Some((LaneShading::Unlit, 4, 3)));
+        let mut moved = gltf.clone();
+        if let Some(t) = &mut moved.pbr.base_color_map {
+            t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
+        }
+        // A transform is a slot of its own.
+        assert_eq!(kind(&auto, &moved), Some((LaneShading::Pbr, 4, 3)));
+        let mut limited = gltf.clone();
+        if let Some(t) = &mut limited.pbr.base_color_map {
+            t.mag_nearest = true;
+        }
+        // So is a sampler with filters of its own.
+        assert_eq!(kind(&auto, &limited), Some((LaneShading::Pbr, 4, 3)));
+        let mut nearest = context(&shadows, ShadingMode::Auto);
+        nearest.filter = Filter::Nearest;
+        assert_eq!(kind(&nearest, &gltf), Some((LaneShading::Pbr, 4, 3)));
+        let mut sizes = gltf.clone();
+        sizes.pbr.emissive = Vec3::ONE;
+        sizes.pbr.emissive_map = Some(map(32));
+        assert_eq!(kind(&auto, &sizes), Some((LaneShading::Pbr, 5, 4)));
+        let mut four = sizes.clone();
+        four.pbr.base_color_map = Some(map(4));
+        assert_eq!(kind(&auto, &four), None);
+        // An object-space normal map is a map like the others, and so is
+        // a bump map.
+        let mut object = gltf.clone();
+        object.normal_map = Some(NormalMap::Normals {
+            map: map(16),
+            space: NormalSpace::Object,
+            scale: 1.0,
+        });
+        assert_eq!(kind(&auto, &object), Some((LaneShading::Pbr, 4, 3)));
+        let mut bump = gltf.clone();
+        bump.normal_map = Some(NormalMap::Height {
+            map: map(16),
+            scale: 1.0,
+        });
+        assert_eq!(kind(&auto, &bump), Some((LaneShading::Pbr, 4, 3)));
+        let lm = LaneMaterial::new(&auto, &bump, [true; 2], true);
+        assert_eq!(lm.and_then(|lm| lm.bump), Some((0, Vec2::splat(16.0))));
+    }
+}
