@@ -19,6 +19,12 @@ use common::{load_with, same_frames, scene_in, scratch, shared_assets};
 use softraster::render::Renderer;
 use softraster::scene::Scene;
 
+/// The lit scenes of the glTF-cube tests: 64x64, culling off, an ambient
+/// light and a point light; their `[[model]]`s follow.
+const LIT_CUBES: &str = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
+    [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
+    [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
+
 /// Frames `frames` of camera 0 without the lanes and with them at every
 /// lane width; panics at the first pixel that differs in any bit.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
@@ -327,26 +333,21 @@ fn texture_transforms_and_set_1_are_the_same_at_every_width() {
         ("OPAQUE", "c.gltf"),
         ("BLEND", "c.gltf"),
     ] {
-        let (text, _) = common::gltf_text(
+        turned_cube(
+            &dir,
+            file,
             &cube,
-            r#", "material": 0"#,
             &format!(
-                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                r#""images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
                 "extensionsUsed": ["KHR_texture_transform"], "materials": [{{{material}, "alphaMode": "{alpha}"}}]"#
             ),
-            None,
         );
-        std::fs::write(dir.join(file), text).unwrap();
         if file == "o.gltf" {
             continue;
         }
         let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
             [[model]]\npath = \"c.gltf\"\n";
-        let lit = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
-            [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
-            [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
-        let scene = scene_in(&dir, &format!("{lit}{models}"), &[]);
+        let scene = scene_in(&dir, &format!("{LIT_CUBES}{models}"), &[]);
         let file = dir.join("scene.toml");
         same_both_ways(&scene, &[0], &format!("transforms, {alpha}"));
         let aniso = ["render.texture_filter=\"anisotropic\""];
@@ -401,24 +402,22 @@ fn unlit_materials_are_the_same_at_every_width() {
             r#""alphaMode": "OPAQUE", "extensions": {"KHR_materials_unlit": {}}"#,
         ),
     ] {
-        let (text, _) = common::gltf_text(
+        turned_cube(
+            &dir,
+            file,
             &cube,
-            r#", "material": 0"#,
             &format!(
-                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}], "extensionsUsed": ["KHR_materials_unlit"],
+                r#""images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}], "extensionsUsed": ["KHR_materials_unlit"],
                 "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.7, 0.5, 0.8], "baseColorTexture": {{"index": 0}}}}, {extra}}}]"#
             ),
-            None,
         );
-        std::fs::write(dir.join(file), text).unwrap();
     }
-    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
-        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
-        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+    let scene = &format!(
+        "{LIT_CUBES}\
         [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
         [[model]]\npath = \"u.gltf\"\ntranslate = [-0.8, -0.5, -1.0]\nscale = 0.5\n\
-        [[model]]\npath = \"c.gltf\"\n";
+        [[model]]\npath = \"c.gltf\"\n"
+    );
     scene_in(&dir, scene, &[]);
     let file = dir.join("scene.toml");
     for sets in [
@@ -444,25 +443,23 @@ fn maps_without_coordinates_are_the_same_at_every_width() {
     layer_texture(&dir.join("t.png"));
     let set1 = r#"{"index": 0, "texCoord": 1}"#;
     for (file, alpha) in [("o.gltf", "OPAQUE"), ("c.gltf", "BLEND")] {
-        let (text, _) = common::gltf_text(
+        turned_cube(
+            &dir,
+            file,
             &common::cube(),
-            r#", "material": 0"#,
             &format!(
-                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                r#""images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
                 "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.6, 0.4, 0.7], "baseColorTexture": {{"index": 0}},
                     "metallicRoughnessTexture": {set1}, "metallicFactor": 0.7, "roughnessFactor": 0.3}},
                     "normalTexture": {set1}, "emissiveTexture": {set1}, "emissiveFactor": [0.3, 0.1, 0.0], "alphaMode": "{alpha}"}}]"#
             ),
-            None,
         );
-        std::fs::write(dir.join(file), text).unwrap();
     }
-    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
-        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
-        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+    let scene = &format!(
+        "{LIT_CUBES}\
         [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
-        [[model]]\npath = \"c.gltf\"\n";
+        [[model]]\npath = \"c.gltf\"\n"
+    );
     let s = scene_in(&dir, scene, &[]);
     let (mesh, m) = (&s.models[0].mesh, &s.models[0].materials[0]);
     assert!(mesh.uvs1.is_empty() && m.pbr.metallic_roughness_map.is_some());
@@ -683,16 +680,14 @@ fn khr_layers_are_the_same_at_every_width() {
     cases.push(("all", all));
     let used = r#""KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence""#;
     for (name, ext) in cases {
-        let (text, _) = common::gltf_text(
+        turned_cube(
+            &dir,
+            "c.gltf",
             &common::cube(),
-            r#", "material": 0"#,
             &format!(
-                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-                "extensionsUsed": [{used}], "materials": [{{{base}, "extensions": {{{ext}}}}}]"#
+                r#""extensionsUsed": [{used}], "materials": [{{{base}, "extensions": {{{ext}}}}}]"#
             ),
-            None,
         );
-        std::fs::write(dir.join("c.gltf"), text).unwrap();
         let scene = scene_in(
             &dir,
             r#"
@@ -791,17 +786,15 @@ fn khr_layers_with_maps_are_the_same_at_every_width() {
     let used = r#""KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence""#;
     let base = r#""pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.3, 0.2, 1.0], "baseColorTexture": {"index": 0}, "metallicFactor": 0.2, "roughnessFactor": 0.5}"#;
     for (name, ext) in cases {
-        let (text, _) = common::gltf_text(
+        turned_cube(
+            &dir,
+            "c.gltf",
             &common::cube(),
-            r#", "material": 0"#,
             &format!(
-                r#""nodes": [{{"mesh": 0, "rotation": [0.28, 0.36, 0.1, 0.88]}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-                "images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
+                r#""images": [{{"uri": "t.png"}}], "textures": [{{"source": 0}}],
                 "extensionsUsed": [{used}], "materials": [{{{base}, "extensions": {{{ext}}}}}]"#
             ),
-            None,
         );
-        std::fs::write(dir.join("c.gltf"), text).unwrap();
         let lit = dir.join("lit.toml");
         std::fs::write(
             &lit,
@@ -866,13 +859,13 @@ fn samplers_and_the_nearest_filter_are_the_same_at_every_width() {
             ),
         );
     }
-    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
-        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
-        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n\
+    let scene = &format!(
+        "{LIT_CUBES}\
         [[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
         [[model]]\npath = \"o.gltf\"\ntranslate = [-1.5, -0.8, -9.0]\n\
         [[model]]\npath = \"o.gltf\"\ntranslate = [-0.9, 0.5, 0.5]\nscale = 1.6\n\
-        [[model]]\npath = \"c.gltf\"\n";
+        [[model]]\npath = \"c.gltf\"\n"
+    );
     let s = scene_in(&dir, scene, &[]);
     let base = s.models[0].materials[0].pbr.base_color_map.as_ref();
     assert!(base.is_some_and(|t| t.mag_nearest && t.min_limit.is_none()));
@@ -1046,10 +1039,7 @@ fn transmissive_layers_are_the_same_at_every_width() {
     );
     let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
         [[model]]\npath = \"c.gltf\"\n";
-    let lit = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"none\"\n\
-        [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
-        [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
-    let s = scene_in(&dir, &format!("{lit}{models}"), &[]);
+    let s = scene_in(&dir, &format!("{LIT_CUBES}{models}"), &[]);
     assert!(s.models[1].materials[0].pbr.transmission.is_some());
     let file = dir.join("scene.toml");
     let studio = dir.join("studio.toml");
