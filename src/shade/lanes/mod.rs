@@ -142,8 +142,20 @@ impl<'a> ShadeContext<'a> {
         f: &Lanes<L>,
         coords: &Coords<'_, L>,
     ) -> V3<L> {
-        // (Built here, not returned by a function: the fetch is large,
-        // and a returned one was copied at every call.)
+        self.fetching(lm, f, coords, |fetch| self.shade_fetched(lm, f, fetch))
+    }
+
+    /// `body` given the texel fetch of `lm`'s maps at the lanes `f` and
+    /// `coords`, its lookups started. (Built here and lent, not returned:
+    /// the fetch is large, and a returned one was copied at every call.)
+    #[inline(always)]
+    fn fetching<'x, 'p, L: Lane, R>(
+        &self,
+        lm: &'x LaneMaterial<'a>,
+        f: &Lanes<L>,
+        coords: &'x Coords<'p, L>,
+        body: impl FnOnce(&mut LaneFetch<'x, 'a, 'p, L>) -> R,
+    ) -> R {
         let mut fetch = LaneFetch {
             lm,
             lookups: Lookups::new(coords),
@@ -152,7 +164,7 @@ impl<'a> ShadeContext<'a> {
             next: 0,
         };
         fetch.start();
-        self.shade_fetched(lm, f, &mut fetch)
+        body(&mut fetch)
     }
 
     /// The fragments of a blended lane material (`LaneMaterial::layers`)
@@ -167,20 +179,27 @@ impl<'a> ShadeContext<'a> {
         alpha: L,
         out: &mut [Layer; MAX_LANES],
     ) {
-        let mut fetch = LaneFetch {
-            lm,
-            lookups: Lookups::new(coords),
-            normal: f.normal,
-            shared: None,
-            next: 0,
-        };
-        fetch.start();
+        self.fetching(lm, f, coords, |fetch| {
+            self.layers_fetched(lm, f, alpha, fetch, out)
+        });
+    }
+
+    /// `layer_lanes` with its texels from `fetch`.
+    #[inline(always)]
+    fn layers_fetched<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        f: &Lanes<L>,
+        alpha: L,
+        fetch: &mut LaneFetch<'_, 'a, '_, L>,
+        out: &mut [Layer; MAX_LANES],
+    ) {
         let m = lm.material;
-        let c = self.shade_fetched(lm, f, &mut fetch);
+        let c = self.shade_fetched(lm, f, fetch);
         if m.pbr.transmission.is_some() && self.shades_pbr(m) {
             // Thin transmission: the base colour lets the light through,
             // less what the surface reflects (`layer`).
-            let pc = self.pbr_color(m, &mut fetch, f);
+            let pc = self.pbr_color(m, fetch, f);
             let n = match &m.normal_map {
                 Some(map) => fetch.normal(map),
                 None => f.normal,
