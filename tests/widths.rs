@@ -1,17 +1,16 @@
 //! Frames are byte-identical whatever the lane width: the shading code is
-//! written once over the lane type (`shade::lanes`), a lone fragment its
-//! one-lane instance reading texels through `ShadeContext::sample`, and
-//! the renderer gathers fragments into calls of 1, 4 or 8 lanes (every
-//! width this build has: 1, 4 and 8 on x86-64-v3) that read them through
-//! their prepared maps. Each test renders scenes that reach the branches
+//! written once over the lane type (`shade::lanes`), and the renderer
+//! gathers fragments into calls of 1, 4 or 8 lanes (every width this
+//! build has: 1, 4 and 8 on x86-64-v3). Each test renders scenes that
+//! reach the branches
 //! (maps, normal maps, vertex colours, every light kind with ranges and
 //! shadows, the environment, AO, MSAA, anisotropic and trilinear
 //! filtering, address modes, orthographic cameras, illum 0 and 1; pbr
 //! with packed occlusion-roughness-metallic maps, emission, the KHR layers
 //! with and without maps of their own; samplers, bump maps, the sampled
-//! environment, every shading mode, transmissive layers) with lone
-//! fragments and at each width, and compares colour and depth bit for
-//! bit.
+//! environment, every shading mode, transmissive layers, materials with
+//! many slots) at each width, and compares colour and depth bit for bit
+//! with one lane at a time.
 
 mod common;
 
@@ -25,11 +24,12 @@ const LIT_CUBES: &str = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"n
     [ambient]\ncolor = [0.1, 0.1, 0.12]\n\
     [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n";
 
-/// Frames `frames` of camera 0 without the lanes and with them at every
-/// lane width; panics at the first pixel that differs in any bit.
-fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
-    let single = Renderer::new(scene).with_lanes(false);
-    for &width in softraster::simd::widths() {
+/// Frames `frames` of camera 0 at every lane width this build has, each
+/// against one lane at a time; panics at the first pixel that differs in
+/// any bit.
+fn same_at_every_width(scene: &Scene, frames: &[u32], what: &str) {
+    let single = Renderer::new(scene).with_lane_width(1);
+    for &width in &softraster::simd::widths()[1..] {
         let lanes = Renderer::new(scene).with_lane_width(width);
         same_frames(
             scene,
@@ -48,14 +48,14 @@ fn the_showcase_is_the_same_at_every_width() {
     // Studio environment, ray-traced shadows, SSAO, MSAA 4, MTL maps.
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
     let small = ["output.width=160", "output.height=120"];
-    same_both_ways(&load_with(&scene, &small), &[0, 5], "showcase");
+    same_at_every_width(&load_with(&scene, &small), &[0, 5], "showcase");
     let mut sets = small.to_vec();
     sets.extend([
         "render.msaa=1",
         "render.shadows=\"pcf\"",
         "render.ao.method=\"off\"",
     ]);
-    same_both_ways(&load_with(&scene, &sets), &[3], "showcase, pcf, one sample");
+    same_at_every_width(&load_with(&scene, &sets), &[3], "showcase, pcf, one sample");
 }
 
 #[test]
@@ -127,12 +127,12 @@ fov = 45.0
     );
     let scene_file = dir.join("d3.toml");
     std::fs::write(&scene_file, &scene).unwrap();
-    same_both_ways(
+    same_at_every_width(
         &load_with(&scene_file, &[]),
         &[0, 9, 40],
         "diablo3, trilinear",
     );
-    same_both_ways(
+    same_at_every_width(
         &load_with(
             &scene_file,
             &[
@@ -146,7 +146,7 @@ fov = 45.0
         &[0, 20],
         "diablo3, anisotropic, MSAA 4, shadow maps",
     );
-    same_both_ways(
+    same_at_every_width(
         &load_with(
             &scene_file,
             &[
@@ -160,7 +160,7 @@ fov = 45.0
         &[30],
         "diablo3, environment, ray-traced shadows, SSAO, clamp",
     );
-    same_both_ways(
+    same_at_every_width(
         &load_with(
             &scene_file,
             &[
@@ -234,7 +234,7 @@ fn vertex_colours_illum_and_repeat_are_the_same_at_every_width() {
              newmtl plain\nKd 0.3 0.6 0.3\nKe 0.05 0 0\nillum {illum}\n"
         );
         let scene = scene_in(&dir, QUAD_SCENE, &[("quad.obj", obj), ("m.mtl", &mtl)]);
-        same_both_ways(&scene, &[0], &format!("quad, illum {illum}"));
+        same_at_every_width(&scene, &[0], &format!("quad, illum {illum}"));
     }
 }
 
@@ -296,7 +296,7 @@ fn blended_layers_are_the_same_at_every_width() {
         ],
     ] {
         let file = dir.join("scene.toml");
-        same_both_ways(
+        same_at_every_width(
             &load_with(&file, &sets),
             &[0],
             &format!("blended, {sets:?}"),
@@ -349,9 +349,9 @@ fn texture_transforms_and_set_1_are_the_same_at_every_width() {
             [[model]]\npath = \"c.gltf\"\n";
         let scene = scene_in(&dir, &format!("{LIT_CUBES}{models}"), &[]);
         let file = dir.join("scene.toml");
-        same_both_ways(&scene, &[0], &format!("transforms, {alpha}"));
+        same_at_every_width(&scene, &[0], &format!("transforms, {alpha}"));
         let aniso = ["render.texture_filter=\"anisotropic\""];
-        same_both_ways(
+        same_at_every_width(
             &load_with(&file, &aniso),
             &[0],
             &format!("transforms, {alpha}, anisotropic"),
@@ -365,7 +365,7 @@ fn texture_transforms_and_set_1_are_the_same_at_every_width() {
             ),
         )
         .unwrap();
-        same_both_ways(
+        same_at_every_width(
             &load_with(&studio, &[]),
             &[0],
             &format!("transforms, {alpha}, studio"),
@@ -429,7 +429,7 @@ fn unlit_materials_are_the_same_at_every_width() {
         vec!["render.shading=\"normals\""],
         vec!["render.shading=\"depth\"", "render.msaa=4"],
     ] {
-        same_both_ways(&load_with(&file, &sets), &[0], &format!("unlit, {sets:?}"));
+        same_at_every_width(&load_with(&file, &sets), &[0], &format!("unlit, {sets:?}"));
     }
 }
 
@@ -465,7 +465,7 @@ fn maps_without_coordinates_are_the_same_at_every_width() {
     assert!(mesh.uvs1.is_empty() && m.pbr.metallic_roughness_map.is_some());
     let file = dir.join("scene.toml");
     for sets in [vec![], vec!["render.msaa=4"]] {
-        same_both_ways(
+        same_at_every_width(
             &load_with(&file, &sets),
             &[0],
             &format!("set 1 missing, {sets:?}"),
@@ -514,7 +514,7 @@ fn object_space_normal_maps_are_the_same_at_every_width() {
         assert_eq!(object_maps.count(), 2);
         let file = dir.join("scene.toml");
         for sets in [vec![], vec!["render.shading=\"pbr\"", "render.msaa=4"]] {
-            same_both_ways(
+            same_at_every_width(
                 &load_with(&file, &sets),
                 &[0],
                 &format!("object space, {what}, {sets:?}"),
@@ -529,7 +529,7 @@ fn pbr_models_are_the_same_at_every_width() {
     // environment, its ground shadow), MSAA 4.
     let walker = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/walker.toml");
     let small = ["output.width=120", "output.height=120"];
-    same_both_ways(&load_with(&walker, &small), &[0, 30], "walker");
+    same_at_every_width(&load_with(&walker, &small), &[0, 30], "walker");
     // The showcase's OBJ materials shaded as pbr (map_Kd as the base
     // colour, its normal maps), with lights, shadows, SSAO and ambient.
     let showcase = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
@@ -540,7 +540,7 @@ fn pbr_models_are_the_same_at_every_width() {
         "render.shadows=\"pcf\"",
         "ambient.color=[0.2, 0.15, 0.1]",
     ]);
-    same_both_ways(&load_with(&showcase, &sets), &[2], "showcase as pbr");
+    same_at_every_width(&load_with(&showcase, &sets), &[2], "showcase as pbr");
 
     let Some(assets) = shared_assets() else {
         return;
@@ -582,12 +582,12 @@ outer_angle = 30
     );
     let file = dir.join("helmet.toml");
     std::fs::write(&file, scene).unwrap();
-    same_both_ways(
+    same_at_every_width(
         &load_with(&file, &[]),
         &[0, 25],
         "FlightHelmet, three lights",
     );
-    same_both_ways(
+    same_at_every_width(
         &load_with(
             &file,
             &[
@@ -630,7 +630,7 @@ fn clearcoats_are_the_same_at_every_width() {
             &[("quad.obj", obj), ("m.mtl", &mtl)],
         );
         let scene = load_with(&dir.join("scene.toml"), &["render.msaa=4"]);
-        same_both_ways(&scene, &[0], &format!("clearcoat {pc}, {pcr}"));
+        same_at_every_width(&scene, &[0], &format!("clearcoat {pc}, {pcr}"));
         let file = dir.join("lit.toml");
         std::fs::write(
             &file,
@@ -640,7 +640,7 @@ fn clearcoats_are_the_same_at_every_width() {
         )
         .unwrap();
         for sets in [vec![], vec!["render.ao={method=\"ssao\"}", "render.msaa=4"]] {
-            same_both_ways(
+            same_at_every_width(
                 &load_with(&file, &sets),
                 &[0],
                 &format!("clearcoat {pc}, {pcr}, studio {sets:?}"),
@@ -709,7 +709,7 @@ irradiance = 0.8
 "#,
             &[],
         );
-        same_both_ways(&scene, &[0], &format!("cube, {name}"));
+        same_at_every_width(&scene, &[0], &format!("cube, {name}"));
         let file = dir.join("studio.toml");
         std::fs::write(
             &file,
@@ -717,7 +717,7 @@ irradiance = 0.8
              [[model]]\npath = \"c.gltf\"\n[environment]\npreset = \"studio\"\n",
         )
         .unwrap();
-        same_both_ways(
+        same_at_every_width(
             &load_with(&file, &[]),
             &[0],
             &format!("cube, {name}, studio"),
@@ -803,14 +803,14 @@ fn khr_layers_with_maps_are_the_same_at_every_width() {
              [[light]]\nkind = \"point\"\nposition = [1.0, 1.5, 2.0]\nintensity = 4.0\n",
         )
         .unwrap();
-        same_both_ways(&load_with(&lit, &[]), &[0], &format!("maps, {name}"));
+        same_at_every_width(&load_with(&lit, &[]), &[0], &format!("maps, {name}"));
         let studio = dir.join("studio.toml");
         std::fs::write(
             &studio,
             "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 4\n[[model]]\npath = \"c.gltf\"\n",
         )
         .unwrap();
-        same_both_ways(
+        same_at_every_width(
             &load_with(&studio, &[]),
             &[0],
             &format!("maps, {name}, studio"),
@@ -877,7 +877,7 @@ fn samplers_and_the_nearest_filter_are_the_same_at_every_width() {
                 format!("render.msaa={msaa}"),
             ];
             let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-            same_both_ways(
+            same_at_every_width(
                 &load_with(&file, &sets),
                 &[0],
                 &format!("samplers, {sets:?}"),
@@ -930,7 +930,7 @@ fn bump_maps_are_the_same_at_every_width() {
             vec!["render.shading=\"normals\""],
             vec!["render.shading=\"flat\""],
         ] {
-            same_both_ways(
+            same_at_every_width(
                 &load_with(&file, &sets),
                 &[0],
                 &format!("bump, {what}, {sets:?}"),
@@ -956,10 +956,10 @@ fn the_sampled_environment_is_the_same_at_every_width() {
         let env = scene.environment.as_ref().map(|e| e.method);
         let reference = softraster::scene::environment::EnvMethod::Sampled { samples: 4 };
         assert_eq!(env, Some(reference));
-        same_both_ways(&scene, &[frame], &format!("{file} sampled"));
+        same_at_every_width(&scene, &[frame], &format!("{file} sampled"));
         let mut one = sampled.to_vec();
         one.push("render.msaa=1");
-        same_both_ways(
+        same_at_every_width(
             &load_with(&scenes.join(file), &one),
             &[frame],
             &format!("{file} sampled, one sample"),
@@ -992,7 +992,7 @@ fn shading_modes_are_the_same_at_every_width() {
                     format!("render.msaa={msaa}"),
                 ];
                 let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-                same_both_ways(
+                same_at_every_width(
                     &load_with(&scenes.join(file), &sets),
                     &[frame],
                     &format!("{file}, {mode}, MSAA {msaa}"),
@@ -1057,10 +1057,75 @@ fn transmissive_layers_are_the_same_at_every_width() {
         (&file, vec!["render.shading=\"blinn-phong\""]),
         (&studio, vec!["render.msaa=4"]),
     ] {
-        same_both_ways(
+        same_at_every_width(
             &load_with(scene, &sets),
             &[0],
             &format!("transmission, {scene:?}, {sets:?}"),
         );
+    }
+}
+
+#[test]
+fn materials_with_many_slots_are_the_same_at_every_width() {
+    // A material whose maps fall in five slots (two texture sizes, two
+    // transforms, both coordinate sets): past the three footprints a
+    // fragment carries, the others are computed per lane call. Opaque
+    // and blended, under trilinear, anisotropic, bilinear and nearest
+    // filtering, with one sample and MSAA 4 (fragments along the edges
+    // and whole quads).
+    let dir = scratch("lanes_many_slots");
+    layer_texture(&dir.join("t.png"));
+    image::RgbaImage::from_fn(8, 8, |x, y| {
+        image::Rgba([(x * 30) as u8, 90, (y * 30) as u8, 255])
+    })
+    .save(dir.join("s.png"))
+    .unwrap();
+    let mut cube = common::cube();
+    cube.uv1 = cube
+        .uv0
+        .iter()
+        .map(|t| [t[1] * 1.3, t[0] * 0.7 + 0.1])
+        .collect();
+    let a = r#", "extensions": {"KHR_texture_transform": {"offset": [0.3, -0.1], "rotation": 0.4, "scale": [2.0, 1.5]}}"#;
+    let b = r#", "extensions": {"KHR_texture_transform": {"offset": [-0.2, 0.5], "scale": [0.5, 3.0]}}"#;
+    for alpha in ["OPAQUE", "BLEND"] {
+        let material = format!(
+            r#""pbrMetallicRoughness": {{"baseColorFactor": [0.9, 0.7, 0.5, 0.6], "baseColorTexture": {{"index": 0{a}}},
+                "metallicRoughnessTexture": {{"index": 1}}, "metallicFactor": 0.7, "roughnessFactor": 0.6}},
+                "normalTexture": {{"index": 0{b}}}, "occlusionTexture": {{"index": 0}},
+                "emissiveTexture": {{"index": 1, "texCoord": 1}}, "emissiveFactor": [0.3, 0.2, 0.1],
+                "alphaMode": "{alpha}""#
+        );
+        turned_cube(
+            &dir,
+            "c.gltf",
+            &cube,
+            &format!(
+                r#""images": [{{"uri": "t.png"}}, {{"uri": "s.png"}}], "textures": [{{"source": 0}}, {{"source": 1}}],
+                "extensionsUsed": ["KHR_texture_transform"], "materials": [{{{material}}}]"#
+            ),
+        );
+        if alpha == "OPAQUE" {
+            // Behind the blended cube, the opaque one.
+            std::fs::copy(dir.join("c.gltf"), dir.join("o.gltf")).unwrap();
+        }
+        let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
+            [[model]]\npath = \"c.gltf\"\n";
+        scene_in(&dir, &format!("{LIT_CUBES}{models}"), &[]);
+        let file = dir.join("scene.toml");
+        for filter in ["trilinear", "anisotropic", "bilinear", "nearest"] {
+            for msaa in [1, 4] {
+                let sets = [
+                    format!("render.texture_filter=\"{filter}\""),
+                    format!("render.msaa={msaa}"),
+                ];
+                let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+                same_at_every_width(
+                    &load_with(&file, &sets),
+                    &[0],
+                    &format!("five slots, {alpha}, {filter}, msaa {msaa}"),
+                );
+            }
+        }
     }
 }

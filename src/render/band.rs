@@ -18,7 +18,6 @@ use glam::{Vec3, Vec4};
 
 use super::display::PlainBackground;
 use super::fragment::{FrameData, LANE_SLOT, PixelShare, Sink, resolve};
-use super::frame::AovPixel;
 use super::lanes::{LaneBatches, Pending, QuadAt};
 use super::surface::FragmentLighting;
 use crate::assets::texture::Gradients;
@@ -32,7 +31,6 @@ use crate::scene::material::AlphaMode;
 use crate::shade::ao::GPixel;
 use crate::shade::lanes::{Footprints, LaneMaterial};
 use crate::shade::light::LightMask;
-use crate::shade::{SizedFootprint, TexCoords};
 
 impl<'a> FrameData<'a> {
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
@@ -65,8 +63,7 @@ impl<'a> FrameData<'a> {
                                 )
                             };
                             let (m, uv, color) = self.material_uv(t, f.lambda);
-                            let tc = TexCoords::new(uv, Default::default());
-                            self.ctx.opacity(m, &tc, color) >= cutoff
+                            self.ctx.opacity_at(m, uv, color) >= cutoff
                         };
                         if self.reverse {
                             vis.draw_if::<true>(t, id, keep);
@@ -151,76 +148,6 @@ impl<'a> FrameData<'a> {
         }
     }
 
-    /// The data passes of a band: per pixel, of its nearest fragment (the
-    /// one the depth comes from), at that fragment's shading point; the
-    /// background and the ground shadow catcher are `AovPixel::EMPTY`.
-    pub fn aovs(&self, vis: &Visibility, out: &mut [AovPixel]) {
-        let rect = vis.rect;
-        let tw = rect.width();
-        let n = vis.samples();
-        let mut cache = InterpolatorCache::default();
-        let models = &self.setup.scene.models;
-        let base = |count: fn(&crate::scene::Model) -> u32| -> Vec<u32> {
-            models
-                .iter()
-                .scan(0u32, |acc, m| {
-                    let base = *acc;
-                    *acc += count(m);
-                    Some(base)
-                })
-                .collect()
-        };
-        let material_base = base(|m| m.materials.len() as u32);
-        let object_base = base(crate::scene::Model::object_count);
-        for (i, a) in out.iter_mut().enumerate() {
-            let (px, py) = (rect.x0 + (i % tw) as i32, rect.y0 + (i / tw) as i32);
-            let frags = if n == 1 {
-                smallvec::smallvec![(vis.id()[i], 1)]
-            } else {
-                fragments(&vis.id()[i * n..(i + 1) * n])
-            };
-            let mut best: Option<(f32, u32, Fragment)> = None;
-            for (id, mask) in frags {
-                if id == NO_TRIANGLE {
-                    continue;
-                }
-                let it = cache.get(id, &self.tris[id as usize]);
-                let frag = self.shading_point(it, px, py, mask);
-                let d = self.point(&self.tris[id as usize], frag).view_depth;
-                if best.is_none_or(|b| d < b.0) {
-                    best = Some((d, id, frag));
-                }
-            }
-            let Some((_, id, frag)) = best else {
-                *a = AovPixel::EMPTY;
-                continue;
-            };
-            let t = &self.tris[id as usize];
-            let it = cache.get(id, t);
-            let grads = if self.grads {
-                self.gradients(t, it, (px & !1, py & !1))
-            } else {
-                [Gradients::default(); 2]
-            };
-            let s = self.surface(
-                (t, it),
-                frag,
-                (px, py),
-                (grads, [None; 2]),
-                FragmentLighting::FULL,
-            );
-            let (normal, albedo) = self.ctx.aov(&s);
-            let d = self.draws[t.draw as usize];
-            *a = AovPixel {
-                normal,
-                albedo,
-                position: s.position,
-                object: object_base[d.model] + d.part + 1,
-                material: material_base[d.model] + d.material as u32 + 1,
-            };
-        }
-    }
-
     #[inline]
     fn draw_opaque(&self, vis: &mut Visibility, t: &Tri, id: u32) {
         if self.reverse {
@@ -248,23 +175,17 @@ impl<'a> FrameData<'a> {
         for id in ids {
             let t = &self.tris[id as usize];
             let it = Interpolator::new(t);
-            let lane = self.lane_material(t.draw as usize).filter(|lm| lm.layers);
+            let lm = self.lane_material(t.draw as usize);
             frags.clear();
-            self.layer_fragments(vis, (t, &it, id), lane, &mut frags);
+            self.layer_fragments(vis, (t, &it, id), lm, &mut frags);
             layers.clear();
-            if lane.is_some() {
-                self.layers(t, &frags, &mut layers);
-            }
-            for (k, f) in frags.iter().enumerate() {
-                let layer = match layers.get(k) {
-                    Some(&(add, through, a)) => {
-                        (add.is_finite() && through.is_finite()).then_some((add, through, a))
-                    }
-                    None => self.layer(vis, (t, &it), f),
-                };
-                let Some((add, through, a)) = layer else {
+            self.layers(t, &frags, &mut layers);
+            for (f, &(add, through, a)) in frags.iter().zip(&layers) {
+                // A layer whose shading is not finite (degenerate input)
+                // is skipped.
+                if !(add.is_finite() && through.is_finite()) {
                     continue;
-                };
+                }
                 let (add, through, a) = if vis.samples() > 1 {
                     // Over the fraction of samples it covers.
                     let k = f.count;
@@ -281,32 +202,30 @@ impl<'a> FrameData<'a> {
 
     /// The fragments of the blended triangle `t` (id `id`) in front of the
     /// opaque surface, in raster order: per pixel its shading point, the
-    /// fraction of the pixel's samples it covers there (`count`) and, for
-    /// the lanes (`lane`), its filter footprints.
+    /// fraction of the pixel's samples it covers there (`count`) and its
+    /// filter footprints for its material `lm`.
     fn layer_fragments(
         &self,
         vis: &Visibility,
         (t, it, id): (&Tri, &Interpolator, u32),
-        lane: Option<&LaneMaterial>,
+        lm: &LaneMaterial,
         out: &mut Vec<Pending>,
     ) {
         let rect = vis.rect;
         let tw = rect.width();
         let n = vis.samples();
-        let mut quad: Option<((i32, i32), Footprints)> = None;
+        let mut quad: Option<((i32, i32), Footprints, [Gradients; 2])> = None;
         let mut push = |px: i32, py: i32, frag: Fragment, count: f32| {
-            let mut footprints = Footprints::NONE;
-            if let Some(lm) = lane {
-                let q0 = (px & !1, py & !1);
-                footprints = match quad {
-                    Some((q, f)) if q == q0 => f,
-                    _ => {
-                        let f = lm.footprints(&self.ctx, self.lane_gradients(lm, t, it, q0));
-                        quad = Some((q0, f));
-                        f
-                    }
-                };
-            }
+            let q0 = (px & !1, py & !1);
+            let (footprints, grads) = match quad {
+                Some((q, f, g)) if q == q0 => (f, g),
+                _ => {
+                    let g = self.lane_gradients(lm, t, it, q0);
+                    let f = lm.footprints(&self.ctx, g);
+                    quad = Some((q0, f, g));
+                    (f, g)
+                }
+            };
             out.push(Pending {
                 id,
                 pixel: ((py - rect.y0) as usize * tw + (px - rect.x0) as usize) as u32,
@@ -314,6 +233,7 @@ impl<'a> FrameData<'a> {
                 lambda: frag.lambda,
                 w: frag.w,
                 footprints,
+                grads,
                 ao: 1.0,
                 // Blended fragments may lie in front of the tile's visible
                 // depths: every light.
@@ -343,39 +263,6 @@ impl<'a> FrameData<'a> {
                 push(px, py, frag, m.count_ones() as f32 / n as f32);
             }
         });
-    }
-
-    /// A blended fragment `f` of `t` as a layer, one fragment at a time
-    /// (`ShadeContext::layer`): the light it adds, what it lets through
-    /// and its alpha; None where shading is not finite (degenerate input),
-    /// so the fragment is skipped.
-    fn layer(
-        &self,
-        vis: &Visibility,
-        (t, it): (&Tri, &Interpolator),
-        f: &Pending,
-    ) -> Option<(Vec3, Vec3, f32)> {
-        let tw = vis.rect.width();
-        let (x, y) = (f.pixel as usize % tw, f.pixel as usize / tw);
-        let (px, py) = (vis.rect.x0 + x as i32, vis.rect.y0 + y as i32);
-        let grads = if self.grads {
-            self.gradients(t, it, (px & !1, py & !1))
-        } else {
-            [Gradients::default(); 2]
-        };
-        let frag = Fragment {
-            lambda: f.lambda,
-            w: f.w,
-        };
-        let surface = self.surface(
-            (t, it),
-            frag,
-            (px, py),
-            (grads, [None; 2]),
-            FragmentLighting::FULL,
-        );
-        let (add, through, a) = self.ctx.layer(&surface);
-        (add.is_finite() && through.is_finite()).then_some((add, through, a))
     }
 
     /// Shades each triangle visible in a pixel once (one per pixel without
@@ -409,11 +296,7 @@ impl<'a> FrameData<'a> {
         let filled = flat_bg.is_some();
         let empty_at = |i: usize| empty(vis, i);
         let (spans, drawn) = self.fill_background(vis, filled, known, color, depth);
-        let mut lanes = self
-            .lanes
-            .iter()
-            .any(|l| l.is_some())
-            .then(|| LaneBatches::new(self.draws.len(), self.lane_width));
+        let lanes = &mut LaneBatches::new(self.draws.len(), self.lane_width);
         let mut shaded = Vec::new();
         let sink = &mut Sink {
             color: &mut *color,
@@ -435,15 +318,11 @@ impl<'a> FrameData<'a> {
                         continue;
                     }
                 }
-                // A quad of one lane-shaded triangle: its four pixels are
-                // lanes.
-                if let Some(b) = lanes.as_mut()
-                    && qx + 1 < tw
-                    && qy + 1 < th
-                {
+                // A quad of one triangle: its four pixels are lanes.
+                if qx + 1 < tw && qy + 1 < th {
                     let lights = lights_at(qx);
                     let out = (&mut *sink.color, &mut *sink.depth);
-                    if self.lane_quad(vis, (qx, qy), b, &mut cache, (ao, lights), out) {
+                    if self.lane_quad(vis, (qx, qy), lanes, &mut cache, (ao, lights), out) {
                         continue;
                     }
                 }
@@ -483,40 +362,25 @@ impl<'a> FrameData<'a> {
                             ao: occlusion,
                             lights: lights_at(x),
                         },
-                        lanes: lanes.is_some(),
                         cache: &mut cache,
                         quad: &mut quad,
                     };
                     if ids[1..].iter().all(|&s| s == ids[0]) {
-                        // One fragment over every sample, shaded now or
-                        // by the lanes (which write it).
+                        // One fragment over every sample: the lanes write
+                        // it.
                         let all = (1u32 << n) - 1;
-                        match self.fragment(&mut at, ids[0], all) {
-                            Shaded::Now(part) => {
-                                (sink.color[i], sink.depth[i]) = resolve(&[part], &[], inv_n);
-                            }
-                            Shaded::Later(draw, mut p) => {
-                                p.pixel = i as u32;
-                                if let Some(b) = lanes.as_mut() {
-                                    b.push(self, draw, p, sink);
-                                }
-                            }
-                        }
+                        let (draw, mut p) = self.fragment(&mut at, ids[0], all);
+                        p.pixel = i as u32;
+                        lanes.push(self, draw, p, sink);
                         continue;
                     }
-                    let (parts, queued) = self.pixel_parts(&mut at, ids, bg, lanes.as_mut(), sink);
-                    if queued {
-                        deferred.push((i, parts));
-                    } else {
-                        (sink.color[i], sink.depth[i]) = resolve(&parts, &[], inv_n);
-                    }
+                    let parts = self.pixel_parts(&mut at, ids, bg, lanes, sink);
+                    deferred.push((i, parts));
                 }
             }
         }
         // The lanes' last groups, then the pixels that wait for them.
-        if let Some(b) = lanes.as_mut() {
-            b.finish(self, sink);
-        }
+        lanes.finish(self, sink);
         for (i, parts) in deferred {
             (sink.color[i], sink.depth[i]) = resolve(&parts, sink.shaded, inv_n);
         }
@@ -529,8 +393,8 @@ impl<'a> FrameData<'a> {
     }
 
     /// Shades the quad whose top-left band pixel is (qx, qy) with the
-    /// lanes where one lane-material triangle covers all its samples (and
-    /// says so), into `color` and `depth`.
+    /// lanes where one triangle covers all its samples (and says so),
+    /// into `color` and `depth`.
     fn lane_quad(
         &self,
         vis: &Visibility,
@@ -550,9 +414,12 @@ impl<'a> FrameData<'a> {
             return false;
         }
         let t = &self.tris[id as usize];
-        let Some(lm) = self.lane_material(t.draw as usize) else {
+        let lm = self.lane_material(t.draw as usize);
+        if lm.extra_slots() > 0 {
+            // Its slots past the footprints a quad carries are computed
+            // per fragment (`extra_footprints`).
             return false;
-        };
+        }
         let q = QuadAt {
             t,
             id,
@@ -567,37 +434,29 @@ impl<'a> FrameData<'a> {
     }
 
     /// The parts of a pixel whose samples hold several fragments `ids`
-    /// (the background `bg` where none): each shaded now, or queued for
-    /// the lanes (then also `true`: the pixel waits for them).
+    /// (the background `bg` where none), the fragments queued for the
+    /// lanes (the pixel waits for them).
     fn pixel_parts(
         &self,
         at: &mut FragmentAt,
         ids: &[u32],
         bg: Vec4,
-        mut lanes: Option<&mut LaneBatches>,
+        lanes: &mut LaneBatches,
         sink: &mut Sink,
-    ) -> (smallvec::SmallVec<[PixelShare; 4]>, bool) {
+    ) -> smallvec::SmallVec<[PixelShare; 4]> {
         let mut parts: smallvec::SmallVec<[PixelShare; 4]> = smallvec::SmallVec::new();
-        let mut queued = false;
         for (id, mask) in fragments(ids) {
             let count = mask.count_ones() as f32;
             if id == NO_TRIANGLE {
                 parts.push(PixelShare::Shaded(bg, f32::INFINITY, count));
                 continue;
             }
-            match self.fragment(at, id, mask) {
-                Shaded::Now(part) => parts.push(part),
-                Shaded::Later(draw, mut p) => {
-                    if let Some(b) = lanes.as_deref_mut() {
-                        queued = true;
-                        p.pixel = LANE_SLOT;
-                        let slot = b.push(self, draw, p, sink);
-                        parts.push(PixelShare::Queued(slot, count));
-                    }
-                }
-            }
+            let (draw, mut p) = self.fragment(at, id, mask);
+            p.pixel = LANE_SLOT;
+            let slot = lanes.push(self, draw, p, sink);
+            parts.push(PixelShare::Queued(slot, count));
         }
-        (parts, queued)
+        parts
     }
 
     /// The background at band pixel (px, py): the environment or the
@@ -670,69 +529,49 @@ impl<'a> FrameData<'a> {
         (spans, drawn)
     }
 
-    /// Shades the fragment of triangle `id` covering samples `mask` of
-    /// the pixel `at` describes: its part of the pixel now, or, for a
-    /// lane material, the fragment for the lanes.
-    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> Shaded {
-        let count = mask.count_ones() as f32;
+    /// The fragment of triangle `id` covering samples `mask` of the pixel
+    /// `at` describes, for the lanes: its draw, and the fragment.
+    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> (u32, Pending) {
         let t = &self.tris[id as usize];
         let it = at.cache.get(id, t);
-        let lane = self.lane_material(t.draw as usize).filter(|_| at.lanes);
+        let lm = self.lane_material(t.draw as usize);
         let quad = &mut *at.quad;
         let k = match quad.iter().position(|q| q.id == id) {
             Some(k) => k,
             None => {
-                let grads = match lane {
-                    Some(lm) => self.lane_gradients(lm, t, it, at.q0),
-                    None if self.grads => self.gradients(t, it, at.q0),
-                    None => [Gradients::default(); 2],
-                };
+                let grads = self.lane_gradients(lm, t, it, at.q0);
+                let footprints = lm.footprints(&self.ctx, grads);
                 quad.push(QuadEntry {
                     id,
                     grads,
-                    footprints: [None; 2],
-                    lane_footprints: None,
+                    footprints,
                 });
                 quad.len() - 1
             }
         };
         let (px, py) = at.px;
         let frag = self.shading_point(it, px, py, mask);
-        if let Some(lm) = lane {
-            let q = &mut quad[k];
-            let footprints = *q
-                .lane_footprints
-                .get_or_insert_with(|| lm.footprints(&self.ctx, q.grads));
-            return Shaded::Later(
-                t.draw,
-                Pending {
-                    id,
-                    pixel: 0,
-                    count,
-                    lambda: frag.lambda,
-                    w: frag.w,
-                    footprints,
-                    ao: at.reach.ao,
-                    lights: at.reach.lights,
-                    edge: self.edge_distance(it, px, py, frag.lambda),
-                },
-            );
-        }
         let q = &quad[k];
-        let (grads, fps) = (q.grads, q.footprints);
-        let (c, d, fps) = self.shade_with((t, it), frag, (px, py), (grads, fps), at.reach);
-        quad[k].footprints = fps;
-        // A NaN from degenerate input must not poison the frame: such a
-        // fragment is black.
-        let c = if c.is_finite() { c } else { Vec3::ZERO };
-        Shaded::Now(PixelShare::Shaded(c.extend(1.0), d, count))
+        let p = Pending {
+            id,
+            pixel: 0,
+            count: mask.count_ones() as f32,
+            lambda: frag.lambda,
+            w: frag.w,
+            footprints: q.footprints,
+            grads: q.grads,
+            ao: at.reach.ao,
+            lights: at.reach.lights,
+            edge: self.edge_distance(it, px, py, frag.lambda),
+        };
+        (t.draw, p)
     }
 }
 
 /// The interpolators of the band's last triangles, one slot per id mod
 /// `SLOTS`: consecutive pixels mostly belong to one triangle, and the
 /// quads along an edge alternate between two or three.
-struct InterpolatorCache {
+pub(super) struct InterpolatorCache {
     slots: [Option<(u32, Interpolator)>; InterpolatorCache::SLOTS],
 }
 
@@ -748,7 +587,7 @@ impl InterpolatorCache {
     const SLOTS: usize = 16;
 
     #[inline]
-    fn get(&mut self, id: u32, t: &Tri) -> &Interpolator {
+    pub(super) fn get(&mut self, id: u32, t: &Tri) -> &Interpolator {
         let slot = &mut self.slots[id as usize % Self::SLOTS];
         if !matches!(slot, Some((k, _)) if *k == id) {
             *slot = None;
@@ -759,36 +598,26 @@ impl InterpolatorCache {
 
 /// A triangle present in a 2x2 quad: its texture-coordinate derivatives
 /// (one pair for the quad, as a GPU takes them) and the filter footprints
-/// derived from them, shared by the quad's pixels.
+/// of its material derived from them, shared by the quad's pixels.
 struct QuadEntry {
     id: u32,
     grads: [Gradients; 2],
-    footprints: [Option<SizedFootprint>; 2],
-    /// Lane-shaded materials: the footprints per texture size.
-    lane_footprints: Option<Footprints>,
+    footprints: Footprints,
 }
 
 /// Where `FrameData::fragment` shades: the pixel's position and its
-/// quad's top-left pixel, its AO and lights, whether lane materials go to
-/// the lanes, and the band's state.
+/// quad's top-left pixel, its AO and lights, and the band's state.
 struct FragmentAt<'c> {
     px: (i32, i32),
     q0: (i32, i32),
     reach: FragmentLighting,
-    lanes: bool,
     cache: &'c mut InterpolatorCache,
     quad: &'c mut smallvec::SmallVec<[QuadEntry; 4]>,
 }
 
-/// A fragment shaded now, or waiting for the lanes (its draw and data).
-enum Shaded {
-    Now(PixelShare),
-    Later(u32, Pending),
-}
-
 /// The distinct triangle ids among one pixel's samples, each with the mask
 /// of the samples it holds, in order of first sample.
-fn fragments(ids: &[u32]) -> smallvec::SmallVec<[(u32, u32); 4]> {
+pub(super) fn fragments(ids: &[u32]) -> smallvec::SmallVec<[(u32, u32); 4]> {
     let mut out: smallvec::SmallVec<[(u32, u32); 4]> = smallvec::SmallVec::new();
     debug_assert!(ids.len() <= MAX_SAMPLES);
     for (s, &id) in ids.iter().enumerate() {

@@ -46,20 +46,18 @@ pub(super) struct FrameData<'a> {
     /// AO); otherwise it is not computed.
     pub geo_normal: bool,
     /// Per draw: its material prepared for shading a lane group at a
-    /// time, or None (the one-fragment path).
-    pub lanes: Vec<Option<LaneMaterial<'a>>>,
+    /// time.
+    pub lanes: Vec<LaneMaterial<'a>>,
     /// Per-tile light culling, where some light can be culled.
     pub culling: Option<Culling>,
     /// Lanes per lane call: 1, 4 or 8 (the same pixels at every width).
     pub lane_width: usize,
 }
 
-/// Which of the equivalent shading paths a frame takes (both default on;
-/// off only to compare).
+/// How a frame shades (the same pixels either way; the switches are for
+/// tests that compare them).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Paths {
-    /// Shade the materials that allow it a lane group at a time.
-    pub lanes: bool,
     /// Skip per tile the lights that cannot reach it.
     pub light_culling: bool,
     /// Lanes per lane call (1, 4 or 8).
@@ -69,9 +67,8 @@ pub(super) struct Paths {
 impl<'a> FrameData<'a> {
     /// `verts` and `geo`: the frame's vertex and geometry passes.
     /// `pattern`: the sample offsets; `grads`: the texture filter reads
-    /// derivatives (trilinear, anisotropic). `paths`: shade the materials that allow it four
-    /// fragments at a time (`shade::lanes`), skip lights per tile
-    /// (`light_tiles`); the same pixels either way.
+    /// derivatives (trilinear, anisotropic). `paths`: the lane width,
+    /// and whether to skip lights per tile (`light_tiles`).
     pub fn new(
         setup: &'a FrameSetup<'a>,
         ctx: ShadeContext<'a>,
@@ -95,13 +92,8 @@ impl<'a> FrameData<'a> {
             .iter()
             .map(|d| {
                 let model = &setup.scene.models[d.model];
-                let uvs = [!model.mesh.uvs.is_empty(), !model.mesh.uvs1.is_empty()];
-                let tangents = !geo.tangents[d.model].is_empty();
-                let m = &model.materials[d.material];
-                paths
-                    .lanes
-                    .then(|| LaneMaterial::new(&ctx, m, uvs, tangents))
-                    .flatten()
+                let (uvs, tangents) = mesh_inputs(model, &geo.tangents[d.model]);
+                LaneMaterial::new(&ctx, &model.materials[d.material], uvs, tangents)
             })
             .collect();
         let culling = paths
@@ -138,9 +130,26 @@ impl<'a> FrameData<'a> {
 
     /// Draw `draw`'s material prepared for the lanes, if it is.
     #[inline]
-    pub(super) fn lane_material(&self, draw: usize) -> Option<&LaneMaterial<'a>> {
-        self.lanes.get(draw).and_then(|l| l.as_ref())
+    pub(super) fn lane_material(&self, draw: usize) -> &LaneMaterial<'a> {
+        &self.lanes[draw]
     }
+
+    /// Whether draw `draw`'s mesh has texture coordinates of sets 0 and
+    /// 1, and tangents.
+    pub(super) fn mesh_inputs(&self, draw: usize) -> ([bool; 2], bool) {
+        let model = self.draws[draw].model;
+        mesh_inputs(&self.setup.scene.models[model], &self.tangents[model])
+    }
+}
+
+/// Whether `model`'s mesh has texture coordinates of sets 0 and 1, and
+/// tangents (`tangents`: its tangents this frame).
+fn mesh_inputs(model: &crate::scene::Model, tangents: &[Vec4]) -> ([bool; 2], bool) {
+    let mesh = &model.mesh;
+    (
+        [!mesh.uvs.is_empty(), !mesh.uvs1.is_empty()],
+        !tangents.is_empty(),
+    )
 }
 
 /// The pixel of a lane result that is resolved from its slot, after the
@@ -200,10 +209,10 @@ pub(super) fn resolve(parts: &[PixelShare], shaded: &[(Vec3, f32)], inv_n: f32) 
     }
     (acc * inv_n, nearest)
 }
+
 /// A surface point as the rasterizer sees it.
 pub(super) struct Point {
     pub position: Vec3,
-    pub raw_normal: Vec3,
     /// Interpolated unit normal, on the side the camera sees.
     pub normal: Vec3,
     /// The triangle's plane normal, on the side the camera sees.

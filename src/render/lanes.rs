@@ -39,6 +39,9 @@ pub(super) struct Pending {
     /// Filter footprints per slot, and the bump map's step
     /// (`LaneMaterial::footprints`).
     pub footprints: Footprints,
+    /// Texture-coordinate derivatives of its quad (sets 0 and 1): the
+    /// footprints of a material's slots past `MAX_SIZES` come from them.
+    pub grads: [Gradients; 2],
     pub ao: f32,
     /// The lights that may reach its tile.
     pub lights: LightMask,
@@ -132,6 +135,7 @@ impl Pending {
         lambda: Vec3::ZERO,
         w: 0.0,
         footprints: Footprints::NONE,
+        grads: [Gradients::ZERO; 2],
         ao: 1.0,
         lights: LightMask::NONE,
         edge: f32::INFINITY,
@@ -206,7 +210,7 @@ impl LaneBatches {
         if self.width != 8 {
             let c = self.corners.get(data, draw, id, q.t);
             let p = data.prepare_quad(&q, c);
-            let out = data.shade_prepared(&p, &[c; MAX_LANES], self.width);
+            let out = data.shade_prepared(&p, &[c; MAX_LANES], &[], self.width);
             put_quad(&out[..4], pixels, color, depth, n);
             return;
         }
@@ -217,7 +221,7 @@ impl LaneBatches {
                 first.prepared.append(&p);
                 let a = &first.corners;
                 let refs = [a, a, a, a, c, c, c, c];
-                let out = data.shade_prepared(&first.prepared, &refs, 8);
+                let out = data.shade_prepared(&first.prepared, &refs, &[], 8);
                 put_quad(&out[..4], first.pixels, color, depth, first.samples);
                 put_quad(&out[4..], pixels, color, depth, n);
             }
@@ -257,7 +261,7 @@ impl WaitingQuad {
     /// Shades it alone.
     fn shade(&self, data: &FrameData, color: &mut [glam::Vec4], depth: &mut [f32]) {
         let c = &self.corners;
-        let out = data.shade_prepared(&self.prepared, &[c; MAX_LANES], 8);
+        let out = data.shade_prepared(&self.prepared, &[c; MAX_LANES], &[], 8);
         put_quad(&out[..4], self.pixels, color, depth, self.samples);
     }
 }
@@ -304,11 +308,10 @@ fn shade_group(
     sink: &mut Sink,
     width: usize,
 ) {
-    if data.lane_material(draw).is_none() {
-        return;
-    }
+    let lm = data.lane_material(draw);
     let mut p = data.prepare_group(&w.group, width);
     p.draw = draw;
+    let extra = data.extra_footprints(lm, &w.group, width);
     let id = |k: usize| w.group[k].id;
     let tri = |k: usize| &data.tris[id(k) as usize];
     for k in 0..width {
@@ -331,7 +334,7 @@ fn shade_group(
         for k in width..MAX_LANES {
             refs[k] = refs[width - 1];
         }
-        data.shade_prepared(&p, &refs, width)
+        data.shade_prepared(&p, &refs, &extra, width)
     } else {
         let mut own = [Corners::NONE; MAX_LANES];
         for k in 0..width {
@@ -344,7 +347,7 @@ fn shade_group(
         }
         let own = &own;
         let refs = std::array::from_fn(|k| &own[k.min(width - 1)]);
-        data.shade_prepared(&p, &refs, width)
+        data.shade_prepared(&p, &refs, &extra, width)
     };
     for (k, &(c, d)) in out.iter().enumerate().take(w.len) {
         sink.put(w.slots[k], w.group[k].pixel, w.group[k].count, c, d);
@@ -384,6 +387,14 @@ impl Prepared {
         self.lights = self.lights.union(other.lights);
     }
 }
+
+/// A lane call's fragments, their triangles' corners, and the footprints
+/// of their material's slots past `MAX_SIZES` (`extra_footprints`).
+type Group<'p> = (
+    &'p Prepared,
+    &'p [&'p Corners; MAX_LANES],
+    &'p [[Footprint; MAX_LANES]],
+);
 
 /// One triangle's corners as the lanes interpolate them.
 #[derive(Clone, Copy)]
@@ -458,8 +469,7 @@ impl<'a> FrameData<'a> {
     fn lanes<'p, L: Lane>(
         &self,
         lm: &LaneMaterial,
-        p: &'p Prepared,
-        corners: &[&Corners; MAX_LANES],
+        (p, corners, extra): Group<'p>,
         at: usize,
     ) -> (Lanes<L>, Coords<'p, L>, L) {
         let d = self.draws[p.draw];
@@ -536,6 +546,12 @@ impl<'a> FrameData<'a> {
             back: normal.dot(raw).cmplt(L::splat(0.0)),
             footprints: &p.footprints,
             first: at,
+            extra_uv: if extra.is_empty() {
+                Vec::new()
+            } else {
+                lm.extra_coords([uv0, uv1])
+            },
+            extra,
             sets: [uv0, uv1],
             bump: &p.bump,
         };
@@ -575,18 +591,17 @@ impl<'a> FrameData<'a> {
         &self,
         p: &Prepared,
         corners: &[&Corners; MAX_LANES],
+        extra: &[[Footprint; MAX_LANES]],
         width: usize,
     ) -> [(Vec3, f32); MAX_LANES] {
         let mut out = [(Vec3::ZERO, 0.0); MAX_LANES];
-        let Some(lm) = self.lane_material(p.draw) else {
-            return out;
-        };
+        let lm = self.lane_material(p.draw);
         let mut at = 0;
         while at < p.len {
             match width {
-                8 => self.shade_at::<F8>(lm, (p, corners), at, &mut out),
-                4 => self.shade_at::<Vec4>(lm, (p, corners), at, &mut out),
-                _ => self.shade_at::<f32>(lm, (p, corners), at, &mut out),
+                8 => self.shade_at::<F8>(lm, (p, corners, extra), at, &mut out),
+                4 => self.shade_at::<Vec4>(lm, (p, corners, extra), at, &mut out),
+                _ => self.shade_at::<f32>(lm, (p, corners, extra), at, &mut out),
             }
             at += width;
         }
@@ -598,11 +613,11 @@ impl<'a> FrameData<'a> {
     fn shade_at<L: Lane>(
         &self,
         lm: &LaneMaterial<'a>,
-        (p, corners): (&Prepared, &[&Corners; MAX_LANES]),
+        group: Group,
         at: usize,
         out: &mut [(Vec3, f32); MAX_LANES],
     ) {
-        let (lanes, coords, depth) = self.lanes::<L>(lm, p, corners, at);
+        let (lanes, coords, depth) = self.lanes::<L>(lm, group, at);
         let c = self.ctx.shade_lanes(lm, &lanes, &coords);
         for (k, o) in out[at..at + L::WIDTH].iter_mut().enumerate() {
             let c = c.lane(k);
@@ -617,9 +632,7 @@ impl<'a> FrameData<'a> {
     /// (`ShadeContext::layer_lanes`) into `out`.
     pub(super) fn layers(&self, t: &Tri, frags: &[Pending], out: &mut Vec<Layer>) {
         let draw = t.draw as usize;
-        let Some(lm) = self.lane_material(draw) else {
-            return;
-        };
+        let lm = self.lane_material(draw);
         let c = self.corners(draw, t);
         let corners = [&c; MAX_LANES];
         let width = self.lane_width;
@@ -629,11 +642,12 @@ impl<'a> FrameData<'a> {
             group[..chunk.len()].copy_from_slice(chunk);
             let mut p = self.prepare_group(&group, width);
             p.draw = draw;
-            let (p, corners) = (&p, &corners);
+            let extra = self.extra_footprints(lm, &group, width);
+            let g = (&p, &corners, &extra[..]);
             match width {
-                8 => self.layer_at::<F8>(lm, (p, corners), &mut res),
-                4 => self.layer_at::<Vec4>(lm, (p, corners), &mut res),
-                _ => self.layer_at::<f32>(lm, (p, corners), &mut res),
+                8 => self.layer_at::<F8>(lm, g, &mut res),
+                4 => self.layer_at::<Vec4>(lm, g, &mut res),
+                _ => self.layer_at::<f32>(lm, g, &mut res),
             }
             out.extend_from_slice(&res[..chunk.len()]);
         }
@@ -641,13 +655,9 @@ impl<'a> FrameData<'a> {
 
     /// `layers` of the lanes of `p`.
     #[inline(never)]
-    fn layer_at<L: Lane>(
-        &self,
-        lm: &LaneMaterial<'a>,
-        (p, corners): (&Prepared, &[&Corners; MAX_LANES]),
-        out: &mut [Layer; MAX_LANES],
-    ) {
-        let (lanes, coords, _) = self.lanes::<L>(lm, p, corners, 0);
+    fn layer_at<L: Lane>(&self, lm: &LaneMaterial<'a>, group: Group, out: &mut [Layer; MAX_LANES]) {
+        let (p, corners, _) = group;
+        let (lanes, coords, _) = self.lanes::<L>(lm, group, 0);
         // The vertex colours' alpha (exactly 1 without them).
         let mesh = &self.setup.scene.models[self.draws[p.draw].model].mesh;
         let alpha = if mesh.colors.is_empty() {
@@ -658,6 +668,52 @@ impl<'a> FrameData<'a> {
             a(0) * l.x + a(1) * l.y + a(2) * l.z
         };
         self.ctx.layer_lanes(lm, &lanes, &coords, alpha, out);
+    }
+
+    /// The data passes of the fragments `frags` (`width` of them, the
+    /// last repeated where fewer wait; of draw `draw`, whose material
+    /// `LaneMaterial::for_aovs` prepared as `lm`), per lane into `out`:
+    /// shading normal, albedo, position (`ShadeContext::aov_lanes`).
+    pub(super) fn aov_group(
+        &self,
+        (draw, lm): (usize, &LaneMaterial<'a>),
+        frags: &[Pending; MAX_LANES],
+        width: usize,
+        out: &mut [[Vec3; 3]; MAX_LANES],
+    ) {
+        let mut p = self.prepare_group(frags, width);
+        p.draw = draw;
+        let extra = self.extra_footprints(lm, frags, width);
+        let mut own = [Corners::NONE; MAX_LANES];
+        for k in 0..width {
+            own[k] = if k > 0 && frags[k].id == frags[k - 1].id {
+                own[k - 1]
+            } else {
+                self.corners(draw, &self.tris[frags[k].id as usize])
+            };
+        }
+        let refs = std::array::from_fn(|k| &own[k.min(width - 1)]);
+        let g = (&p, &refs, &extra[..]);
+        match width {
+            8 => self.aov_at::<F8>(lm, g, out),
+            4 => self.aov_at::<Vec4>(lm, g, out),
+            _ => self.aov_at::<f32>(lm, g, out),
+        }
+    }
+
+    /// `aov_group` of the lanes of `group`.
+    #[inline(never)]
+    fn aov_at<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        group: Group,
+        out: &mut [[Vec3; 3]; MAX_LANES],
+    ) {
+        let (lanes, coords, _) = self.lanes::<L>(lm, group, 0);
+        let (n, albedo) = self.ctx.aov_lanes(lm, &lanes, &coords);
+        for (k, o) in out.iter_mut().enumerate().take(L::WIDTH) {
+            *o = [n.lane(k), albedo.lane(k), lanes.position.lane(k)];
+        }
     }
 
     /// The four pixels of the quad `q`, all of one triangle, one sample
@@ -748,5 +804,25 @@ impl<'a> FrameData<'a> {
             p.lights = p.lights.union(f.lights);
         }
         p
+    }
+
+    /// The footprints of `lm`'s slots past `MAX_SIZES`
+    /// (`LaneMaterial::extra_slots`) for the queued fragments `frags`
+    /// (`width` of them): per slot, per lane; empty without such slots.
+    fn extra_footprints(
+        &self,
+        lm: &LaneMaterial,
+        frags: &[Pending; MAX_LANES],
+        width: usize,
+    ) -> Vec<[Footprint; MAX_LANES]> {
+        (MAX_SIZES..MAX_SIZES + lm.extra_slots())
+            .map(|s| {
+                let mut fp = [Footprint::Lod(0.0); MAX_LANES];
+                for (k, f) in frags.iter().enumerate().take(width) {
+                    fp[k] = lm.slot_footprint(&self.ctx, s, f.grads);
+                }
+                fp
+            })
+            .collect()
     }
 }

@@ -9,9 +9,10 @@
 //! 5. textures: the mip chains of the textures this frame minifies;
 //! 6. per band of rows (`band`): visibility with the depth test, then
 //!    (with AO on) the geometry buffer of every band, `ao_pass` over the
-//!    whole frame, and shading of each visible pixel once (`lanes`: four
-//!    fragments at a time; `fragment`: the data every band reads and the
-//!    sink that takes shaded fragments to their pixels);
+//!    whole frame, and shading of each visible pixel once (`lanes`: 1, 4
+//!    or 8 fragments at a time; `fragment`: the data every band reads and
+//!    the sink that takes shaded fragments to their pixels; `aovs`: the
+//!    data passes);
 //! 7. `frame`: with supersampling, the box filter down to the output size.
 //!
 //! Each band owns its rows: no locks, no shared writes, and the same frame
@@ -23,6 +24,7 @@
 //! `Renderer::render` is the one entry for a frame.
 
 mod ao_pass;
+mod aovs;
 mod backdrop;
 mod band;
 pub mod display;
@@ -100,9 +102,6 @@ pub struct Renderer {
     /// The last camera's environment backdrop (reused while the view
     /// stays).
     backdrops: backdrop::BackdropCache,
-    /// Shade the materials that allow it a lane group at a time
-    /// (`shade::lanes`); off only to compare the two paths.
-    lanes: bool,
     /// Skip, per tile, the lights that cannot reach it (`light_tiles`);
     /// off only to compare.
     light_culling: bool,
@@ -141,21 +140,12 @@ impl Renderer {
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
             backdrops: Default::default(),
-            lanes: true,
             light_culling: true,
             lane_width: crate::simd::lane_width()
                 .ok()
                 .flatten()
                 .unwrap_or(crate::simd::widest()),
         }
-    }
-
-    /// With `on = false`, every fragment takes the one-fragment shading
-    /// path. The frames are the same either way (tests compare them
-    /// byte for byte); the switch is for those tests and for measuring.
-    pub fn with_lanes(mut self, on: bool) -> Renderer {
-        self.lanes = on;
-        self
     }
 
     /// Shades `width` lanes at a time (1, 4 or 8; a width this build
@@ -217,7 +207,6 @@ impl Renderer {
     ) {
         if !self.serves(scene) {
             return Renderer::new(scene)
-                .with_lanes(self.lanes)
                 .with_light_culling(self.light_culling)
                 .with_lane_width(self.lane_width)
                 .render_frame(scene, camera, frame, out, display);
@@ -456,7 +445,6 @@ impl Renderer {
             (pattern, filtered),
             tracer.as_ref(),
             fragment::Paths {
-                lanes: self.lanes,
                 light_culling: self.light_culling,
                 lane_width: self.lane_width,
             },

@@ -1,9 +1,9 @@
-//! The surface of a triangle at a fragment, as shading sees it: where a
-//! fragment is interpolated (the pixel center or the covered samples'
-//! centroid), its position and normals (`point`), texture coordinates in
-//! both sets with their quad derivatives (`material_uv`, `gradients`), and
-//! the `Surface` handed to `ShadeContext`. The band (`band`) shades what
-//! these give.
+//! The surface of a triangle at a fragment: where a fragment is
+//! interpolated (the pixel center or the covered samples' centroid), its
+//! position and normals (`point`: the geometry buffer, the data passes'
+//! depth), texture coordinates in both sets (`material_uv`: the alpha
+//! test) with their quad derivatives (`gradients`: the footprints the
+//! lanes filter over), and the wireframe's edge distance.
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -14,7 +14,6 @@ use crate::raster::setup::Tri;
 use crate::scene::settings::ShadingMode;
 use crate::shade::lanes::LaneMaterial;
 use crate::shade::light::LightMask;
-use crate::shade::{SizedFootprint, Surface, TexCoords};
 
 impl<'a> FrameData<'a> {
     /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
@@ -120,90 +119,6 @@ impl<'a> FrameData<'a> {
         }
     }
 
-    /// Color (linear, or the data view's value) and view depth of triangle
-    /// `t` at pixel (px, py), given the filter footprints already known for
-    /// `grads`; also returns the footprints known afterwards.
-    pub(super) fn shade_with(
-        &self,
-        tri: (&Tri, &Interpolator),
-        frag: Fragment,
-        px: (i32, i32),
-        texture: ([Gradients; 2], [Option<SizedFootprint>; 2]),
-        reach: FragmentLighting,
-    ) -> (Vec3, f32, [Option<SizedFootprint>; 2]) {
-        let surface = self.surface(tri, frag, px, texture, reach);
-        (
-            self.ctx.shade(&surface),
-            surface.view_depth,
-            surface.tc.footprints(),
-        )
-    }
-
-    /// The surface of triangle `t` (interpolated by `it`) at a fragment,
-    /// as shading sees it, with the texture derivatives `grads` and the
-    /// filter footprints already known for them.
-    pub(super) fn surface(
-        &self,
-        (t, it): (&Tri, &Interpolator),
-        frag: Fragment,
-        (px, py): (i32, i32),
-        (grads, footprints): ([Gradients; 2], [Option<SizedFootprint>; 2]),
-        reach: FragmentLighting,
-    ) -> Surface<'_> {
-        let ctx = &self.ctx;
-        let mode = ctx.mode;
-        let d = self.draws[t.draw as usize];
-        let model = &self.setup.scene.models[d.model];
-        let mv = &self.verts[d.model];
-        let idx = model.mesh.triangles[t.prim as usize].map(|v| v as usize);
-        let l = frag.lambda;
-        let Point {
-            position,
-            raw_normal,
-            normal,
-            geo_normal,
-            view_depth,
-        } = self.point(t, frag);
-        let normal = if mode == ShadingMode::Flat {
-            geo_normal
-        } else {
-            normal
-        };
-        let (_, uv, color) = self.material_uv(t, l);
-        let tt = &self.tangents[d.model];
-        let tangent = (!tt.is_empty()).then(|| {
-            let c = t.prim as usize * 3;
-            let v = tt[c] * l.x + tt[c + 1] * l.y + tt[c + 2] * l.z;
-            // The sign is per triangle (MikkTSpace keeps it constant).
-            v.truncate().extend(tt[c].w)
-        });
-        let vertex_light = (!mv.light.is_empty()).then(|| {
-            let g = |k: usize| mv.light[idx[k]];
-            let (a, b, c) = (g(0), g(1), g(2));
-            (
-                a.0 * l.x + b.0 * l.y + c.0 * l.z,
-                a.1 * l.x + b.1 * l.y + c.1 * l.z,
-            )
-        });
-        let edge_distance = self.edge_distance(it, px, py, l);
-        Surface {
-            material: &model.materials[d.material],
-            position,
-            normal,
-            raw_normal,
-            tc: TexCoords::with_footprints(uv, grads, footprints),
-            color,
-            tangent,
-            normal_from_object: mv.normal_from_object,
-            view_depth,
-            vertex_light,
-            edge_distance,
-            geo_normal,
-            ao: reach.ao,
-            lights: reach.lights,
-        }
-    }
-
     /// Position, normals and view depth of triangle `t` at a fragment.
     #[inline]
     pub(super) fn point(&self, t: &Tri, frag: Fragment) -> Point {
@@ -237,7 +152,6 @@ impl<'a> FrameData<'a> {
         };
         Point {
             position,
-            raw_normal,
             normal,
             geo_normal,
             view_depth,
@@ -251,14 +165,6 @@ impl<'a> FrameData<'a> {
 pub(super) struct FragmentLighting {
     pub ao: f32,
     pub lights: LightMask,
-}
-
-impl FragmentLighting {
-    /// No occlusion, every light.
-    pub const FULL: FragmentLighting = FragmentLighting {
-        ao: 1.0,
-        lights: LightMask::ALL,
-    };
 }
 
 impl FrameData<'_> {

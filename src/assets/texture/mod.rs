@@ -181,6 +181,22 @@ pub struct Gradients {
     pub dy: Vec2,
 }
 
+impl Gradients {
+    /// No change across the quad.
+    pub const ZERO: Gradients = Gradients {
+        dx: Vec2::ZERO,
+        dy: Vec2::ZERO,
+    };
+
+    /// The same bits as `other` (+0 and -0 differ: a footprint's axis
+    /// keeps the sign).
+    #[inline(always)]
+    pub fn same_bits(&self, other: &Gradients) -> bool {
+        let bits = |g: &Gradients| [g.dx.x, g.dx.y, g.dy.x, g.dy.y].map(f32::to_bits);
+        bits(self) == bits(other)
+    }
+}
+
 /// A filtered lookup's footprint in texels (`Texture::footprint`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Footprint {

@@ -121,8 +121,8 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         for (q, out) in rgba.iter_mut().enumerate().take(L::QUADS) {
             let fps = f.footprints4(map.slot, q);
             *out = map.chain.sample4_rgba(
-                f.uv[map.slot].0.quad(q),
-                f.uv[map.slot].1.quad(q),
+                f.uv(map.slot).0.quad(q),
+                f.uv(map.slot).1.quad(q),
                 &fps,
                 map.mode,
             );
@@ -237,7 +237,8 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     #[inline(always)]
     fn find(&mut self, map: &Map) {
         let (f, s) = (self.coords, map.slot);
-        if self.found & (1 << s) == 0 {
+        // Past `MAX_SIZES` a slot's lookups are not kept: `read` samples.
+        if s < MAX_SIZES && self.found & (1 << s) == 0 {
             self.found |= 1 << s;
             for q in 0..L::QUADS {
                 map.chain.taps4_into(
@@ -255,7 +256,7 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     pub fn prefetch(&mut self, map: &Map) {
         self.find(map);
         for q in 0..L::QUADS {
-            if let Some(t) = &self.taps[q][map.slot] {
+            if let Some(Some(t)) = self.taps[q].get(map.slot) {
                 map.chain.prefetch(t);
             }
         }
@@ -268,11 +269,11 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
         let f = self.coords;
         let mut rgb = [[Vec4::ZERO; 3]; 2];
         for (q, out) in rgb.iter_mut().enumerate().take(L::QUADS) {
-            *out = match &self.taps[q][map.slot] {
-                Some(t) => map.chain.read4(t, map.mode),
-                None => map.chain.sample4(
-                    f.uv[map.slot].0.quad(q),
-                    f.uv[map.slot].1.quad(q),
+            *out = match self.taps[q].get(map.slot) {
+                Some(Some(t)) => map.chain.read4(t, map.mode),
+                _ => map.chain.sample4(
+                    f.uv(map.slot).0.quad(q),
+                    f.uv(map.slot).1.quad(q),
                     &f.footprints4(map.slot, q),
                     map.mode,
                 ),

@@ -52,6 +52,11 @@ pub(super) enum LaneShading {
     Normals,
     Depth,
     Wireframe,
+    /// The data passes' albedo (`ShadeContext::aov_lanes`): the base
+    /// colour of metallic-roughness, or Kd.
+    Albedo {
+        pbr: bool,
+    },
 }
 
 /// A material the lanes can shade, prepared for one frame.
@@ -101,6 +106,35 @@ struct Slot {
 }
 
 impl Slot {
+    /// `footprint` of a lookup whose coordinates of sets 0 and 1 change
+    /// by `g` across its quad, before the transform.
+    #[inline(always)]
+    fn transformed_footprint(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> Footprint {
+        let mut g = g[self.set];
+        if self.moved {
+            let m = self.transform.matrix2;
+            g = Gradients {
+                dx: m * g.dx,
+                dy: m * g.dy,
+            };
+        }
+        self.footprint(ctx, g)
+    }
+
+    /// The lanes' coordinates of its set (`uv`) through its transform.
+    #[inline(always)]
+    fn coords<L: Lane>(&self, uv: [(L, L); 2]) -> (L, L) {
+        let (u, v) = uv[self.set];
+        if !self.moved {
+            return (u, v);
+        }
+        let (m, t) = (self.transform.matrix2, self.transform.translation);
+        (
+            L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(t.x),
+            L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(t.y),
+        )
+    }
+
     /// The footprint of a lookup in this slot whose coordinates change by
     /// `g` (transformed) across its quad, as `TextureRef::sample_grad`
     /// filters it: the sampler's NEAREST magnification where a texel
@@ -178,18 +212,30 @@ impl<'a> LaneMaterial<'a> {
         if !self.samplers && !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
             return out;
         }
-        for (k, slot) in self.slots.iter().enumerate() {
-            let mut g = g[slot.set];
-            if slot.moved {
-                let m = slot.transform.matrix2;
-                g = Gradients {
-                    dx: m * g.dx,
-                    dy: m * g.dy,
-                };
-            }
-            out.slots[k] = slot.footprint(ctx, g);
+        for (o, slot) in out.slots.iter_mut().zip(&self.slots) {
+            *o = slot.transformed_footprint(ctx, g);
         }
         out
+    }
+
+    /// The footprint in slot `k` of a fragment whose texture coordinates
+    /// change by `g` across its quad (`footprints`).
+    #[inline]
+    pub fn slot_footprint(&self, ctx: &ShadeContext, k: usize, g: [Gradients; 2]) -> Footprint {
+        if ctx.filter == Filter::Nearest {
+            return Footprint::Nearest;
+        }
+        if !self.samplers && !matches!(ctx.filter, Filter::Trilinear | Filter::Anisotropic) {
+            return Footprint::Lod(0.0);
+        }
+        self.slots[k].transformed_footprint(ctx, g)
+    }
+
+    /// How many slots past `MAX_SIZES` it has: their footprints are not
+    /// in `Footprints` but computed per lane call (`Coords::extra`).
+    #[inline(always)]
+    pub fn extra_slots(&self) -> usize {
+        self.slots.len().saturating_sub(MAX_SIZES)
     }
 
     /// Whether some map reads texture coordinates of set 1.
@@ -207,18 +253,17 @@ impl<'a> LaneMaterial<'a> {
             return out;
         }
         for (o, slot) in out.iter_mut().zip(&self.slots) {
-            let (u, v) = uv[slot.set];
-            *o = if !slot.moved {
-                (u, v)
-            } else {
-                let (m, t) = (slot.transform.matrix2, slot.transform.translation);
-                (
-                    L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(t.x),
-                    L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(t.y),
-                )
-            };
+            *o = slot.coords(uv);
         }
         out
+    }
+
+    /// `coords` of the slots past `MAX_SIZES`.
+    pub fn extra_coords<L: Lane>(&self, uv: [(L, L); 2]) -> Vec<(L, L)> {
+        self.slots[MAX_SIZES.min(self.slots.len())..]
+            .iter()
+            .map(|s| s.coords(uv))
+            .collect()
     }
 
     /// Which of the maps `t` is.
@@ -229,9 +274,7 @@ impl<'a> LaneMaterial<'a> {
 }
 
 /// Collects a lane material's maps, assigning each a slot by its
-/// coordinates, transform, texture size and chain; None where the lanes
-/// cannot look one up as `ShadeContext::sample` does (a sampler of its
-/// own, a fourth slot, a bump map). A map of a coordinate set the mesh
+/// coordinates, transform, texture size and chain. A map of a coordinate set the mesh
 /// lacks is left out: it counts as 1.
 struct MapSet<'c, 'a> {
     ctx: &'c ShadeContext<'a>,
@@ -244,12 +287,12 @@ struct MapSet<'c, 'a> {
 }
 
 impl<'a> MapSet<'_, 'a> {
-    fn map(&mut self, t: &'a TextureRef) -> Option<()> {
+    fn map(&mut self, t: &'a TextureRef) {
         let set = (t.texcoord as usize).min(1);
         if !self.uvs[set] {
             // Without its coordinates a map counts as 1 (`Fetch::rgba`
             // finds no lookup for it).
-            return Some(());
+            return;
         }
         let tex = &*t.texture;
         let mips = self.ctx.mips.get(tex.id).copied().flatten();
@@ -264,11 +307,10 @@ impl<'a> MapSet<'_, 'a> {
         };
         let slot = match self.slots.iter().position(|s| *s == here) {
             Some(k) => k,
-            None if self.slots.len() < MAX_SIZES => {
+            None => {
                 self.slots.push(here);
                 self.slots.len() - 1
             }
-            None => return None,
         };
         let mode = t.address.unwrap_or(self.ctx.address.into());
         let same = self
@@ -288,28 +330,27 @@ impl<'a> MapSet<'_, 'a> {
             same,
             shared: false,
         });
-        Some(())
     }
 
-    fn optional(&mut self, t: &'a Option<TextureRef>) -> Option<()> {
+    fn optional(&mut self, t: &'a Option<TextureRef>) {
         match t {
             Some(t) => self.map(t),
-            None => Some(()),
+            None => {}
         }
     }
 
-    fn normal(&mut self, m: &'a Option<NormalMap>) -> Option<()> {
+    fn normal(&mut self, m: &'a Option<NormalMap>) {
         if self.ctx.mode == ShadingMode::Flat {
             // Flat shading keeps the triangles' normals: not looked up.
-            return Some(());
+            return;
         }
         let t = match m {
-            None => return Some(()),
+            None => return,
             Some(NormalMap::Normals { map, .. } | NormalMap::Height { map, .. }) => map,
         };
         if !self.uvs[(t.texcoord as usize).min(1)] {
             // Without its coordinates a map leaves the normal as it is.
-            return Some(());
+            return;
         }
         match m {
             Some(NormalMap::Normals {
@@ -317,9 +358,8 @@ impl<'a> MapSet<'_, 'a> {
                 ..
             }) => {
                 if self.tangents {
-                    self.map(t)?;
+                    self.map(t);
                 }
-                Some(())
             }
             Some(NormalMap::Normals {
                 space: NormalSpace::Object,
@@ -327,21 +367,20 @@ impl<'a> MapSet<'_, 'a> {
             }) => self.map(t),
             Some(NormalMap::Height { .. }) => {
                 if self.tangents {
-                    self.map(t)?;
+                    self.map(t);
                     let m = t.transform.matrix2;
                     let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
                         * Vec2::new(m.x_axis.length(), m.y_axis.length());
                     self.bump = Some(((t.texcoord as usize).min(1), size));
                 }
-                Some(())
             }
-            None => Some(()),
+            None => {}
         }
     }
 
     /// The maps a metallic-roughness material's shading reads, in the
     /// order it reads them (`pbr_color`, then the normal map).
-    fn pbr(&mut self, m: &'a Material) -> Option<()> {
+    fn pbr(&mut self, m: &'a Material) {
         let p = &m.pbr;
         for t in [
             &p.base_color_map,
@@ -351,52 +390,52 @@ impl<'a> MapSet<'_, 'a> {
             &p.occlusion_map,
             &p.emissive_map,
         ] {
-            self.optional(t)?;
+            self.optional(t);
         }
         if let Some(d) = &p.specular {
-            self.optional(&d.color_map)?;
-            self.optional(&d.weight_map)?;
+            self.optional(&d.color_map);
+            self.optional(&d.weight_map);
         }
         if let Some(k) = &p.clearcoat {
-            self.optional(&k.map)?;
-            self.optional(&k.roughness_map)?;
-            self.normal(&k.normal_map)?;
+            self.optional(&k.map);
+            self.optional(&k.roughness_map);
+            self.normal(&k.normal_map);
         }
         if let Some(t) = &p.transmission {
-            self.optional(&t.map)?;
-            self.optional(&t.thickness_map)?;
+            self.optional(&t.map);
+            self.optional(&t.thickness_map);
         }
         if let Some(k) = &p.sheen {
-            self.optional(&k.color_map)?;
-            self.optional(&k.roughness_map)?;
+            self.optional(&k.color_map);
+            self.optional(&k.roughness_map);
         }
         if let Some(k) = &p.iridescence {
-            self.optional(&k.map)?;
-            self.optional(&k.thickness_map)?;
+            self.optional(&k.map);
+            self.optional(&k.thickness_map);
         }
         self.normal(&m.normal_map)
     }
 
     /// The maps a Blinn-Phong material's shading reads, in the order it
     /// reads them (`surface_color`, then the normal map).
-    fn blinn_phong(&mut self, m: &'a Material) -> Option<()> {
+    fn blinn_phong(&mut self, m: &'a Material) {
         for t in [&m.map_kd, &m.map_ka, &m.map_ks, &m.map_ke, &m.map_ns] {
-            self.optional(t)?;
+            self.optional(t);
         }
         self.normal(&m.normal_map)
     }
 }
 
 impl<'a> LaneMaterial<'a> {
-    /// `m` prepared for the lanes in the frame of `ctx`, or None where it
-    /// needs the one-fragment path. `uvs` and `tangents`: whether the
-    /// mesh drawn with it has texture coordinates and tangents.
+    /// `m` prepared for the lanes in the frame of `ctx`. `uvs` and
+    /// `tangents`: whether the mesh drawn with it has texture coordinates
+    /// and tangents.
     pub fn new(
         ctx: &ShadeContext<'a>,
         m: &'a Material,
         uvs: [bool; 2],
         tangents: bool,
-    ) -> Option<LaneMaterial<'a>> {
+    ) -> LaneMaterial<'a> {
         let kind = match ctx.mode {
             ShadingMode::Normals => LaneShading::Normals,
             ShadingMode::Depth => LaneShading::Depth,
@@ -412,6 +451,33 @@ impl<'a> LaneMaterial<'a> {
             ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,
             ShadingMode::Auto => LaneShading::Pbr,
         };
+        LaneMaterial::of_kind(ctx, m, kind, (uvs, tangents))
+    }
+
+    /// `m` prepared for the data passes (`ShadeContext::aov_lanes`): its
+    /// albedo, as metallic-roughness in the `pbr` mode and for glTF
+    /// materials in the others but `blinn-phong`, `flat` and `gouraud`,
+    /// and its normal map.
+    pub fn for_aovs(
+        ctx: &ShadeContext<'a>,
+        m: &'a Material,
+        uvs: [bool; 2],
+        tangents: bool,
+    ) -> LaneMaterial<'a> {
+        let pbr = match ctx.mode {
+            ShadingMode::Pbr => true,
+            ShadingMode::BlinnPhong | ShadingMode::Flat | ShadingMode::Gouraud => false,
+            _ => m.native == Native::Pbr,
+        };
+        LaneMaterial::of_kind(ctx, m, LaneShading::Albedo { pbr }, (uvs, tangents))
+    }
+
+    fn of_kind(
+        ctx: &ShadeContext<'a>,
+        m: &'a Material,
+        kind: LaneShading,
+        (uvs, tangents): ([bool; 2], bool),
+    ) -> LaneMaterial<'a> {
         let mut maps = MapSet {
             ctx,
             uvs,
@@ -421,17 +487,19 @@ impl<'a> LaneMaterial<'a> {
             bump: None,
         };
         match kind {
-            LaneShading::BlinnPhong | LaneShading::Gouraud => maps.blinn_phong(m)?,
-            LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m)?,
-            LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m)?,
-            LaneShading::Normals => maps.normal(&m.normal_map)?,
+            LaneShading::BlinnPhong | LaneShading::Gouraud => maps.blinn_phong(m),
+            LaneShading::Albedo { pbr: false } => maps.blinn_phong(m),
+            LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m),
+            LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m),
+            LaneShading::Albedo { pbr: true } => maps.pbr(m),
+            LaneShading::Normals => maps.normal(&m.normal_map),
             LaneShading::Depth | LaneShading::Wireframe => {}
         }
         // A blended surface's opacity reads these too (`opacity`).
         let layers = m.alpha == AlphaMode::Blend;
         if layers {
-            maps.optional(&m.map_d)?;
-            maps.optional(&m.map_kd)?;
+            maps.optional(&m.map_d);
+            maps.optional(&m.map_kd);
         }
         let mut maps_read = maps.maps;
         for k in 0..maps_read.len() {
@@ -441,7 +509,7 @@ impl<'a> LaneMaterial<'a> {
                 maps_read[k].shared = true;
             }
         }
-        Some(LaneMaterial {
+        LaneMaterial {
             material: m,
             kind,
             layers,
@@ -455,7 +523,7 @@ impl<'a> LaneMaterial<'a> {
                 .any(|s| s.mag_nearest || s.min_limit.is_some()),
             bump: maps.bump,
             slots: maps.slots,
-        })
+        }
     }
 }
 
@@ -476,8 +544,8 @@ mod tests {
 
     /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
     /// maps, the KHR layers with their maps, texture transforms, samplers
-    /// with filters of their own and unlit materials do; a fourth slot
-    /// does not.
+    /// with filters of their own, unlit materials and any number of
+    /// slots do.
     #[test]
     fn which_materials_the_lanes_take() {
         let shadows = Shadows::none();
@@ -494,25 +562,22 @@ mod tests {
             scale: 1.0,
         });
         let kind = |ctx: &ShadeContext, m| {
-            LaneMaterial::new(ctx, m, [true; 2], true).map(|lm| {
-                let distinct = lm.maps.iter().enumerate().filter(|(i, m)| m.same == *i);
-                (lm.kind, lm.maps.len(), distinct.count())
-            })
+            let lm = LaneMaterial::new(ctx, m, [true; 2], true);
+            let distinct = lm.maps.iter().enumerate().filter(|(i, m)| m.same == *i);
+            (lm.kind, lm.maps.len(), distinct.count())
         };
         // The packed texture is one lookup, read twice.
-        assert_eq!(kind(&auto, &gltf), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &gltf), (LaneShading::Pbr, 4, 3));
         // Without coordinates its maps count as 1 and its normal map
         // leaves the normal as it is: nothing to look up.
-        assert_eq!(
-            LaneMaterial::new(&auto, &gltf, [false; 2], true).map(|lm| (lm.kind, lm.maps.len())),
-            Some((LaneShading::Pbr, 0))
-        );
+        let bare = LaneMaterial::new(&auto, &gltf, [false; 2], true);
+        assert_eq!((bare.kind, bare.maps.len()), (LaneShading::Pbr, 0));
         let mut obj = Material::default_named("obj");
         obj.map_kd = Some(map(16));
-        assert_eq!(kind(&auto, &obj), Some((LaneShading::BlinnPhong, 1, 1)));
+        assert_eq!(kind(&auto, &obj), (LaneShading::BlinnPhong, 1, 1));
         // Forced pbr shading takes the OBJ material's pbr view.
         let pbr = context(&shadows, ShadingMode::Pbr);
-        assert_eq!(kind(&pbr, &obj), Some((LaneShading::Pbr, 0, 0)));
+        assert_eq!(kind(&pbr, &obj), (LaneShading::Pbr, 0, 0));
         // Flat shading reads no normal map.
         let flat = context(&shadows, ShadingMode::Flat);
         let mut bumpy = obj.clone();
@@ -521,11 +586,11 @@ mod tests {
             space: NormalSpace::Tangent,
             scale: 1.0,
         });
-        assert_eq!(kind(&flat, &bumpy), Some((LaneShading::BlinnPhong, 1, 1)));
+        assert_eq!(kind(&flat, &bumpy), (LaneShading::BlinnPhong, 1, 1));
         let wireframe = context(&shadows, ShadingMode::Wireframe);
-        assert_eq!(kind(&wireframe, &obj), Some((LaneShading::Wireframe, 0, 0)));
+        assert_eq!(kind(&wireframe, &obj), (LaneShading::Wireframe, 0, 0));
         let gouraud = context(&shadows, ShadingMode::Gouraud);
-        assert_eq!(kind(&gouraud, &obj), Some((LaneShading::Gouraud, 1, 1)));
+        assert_eq!(kind(&gouraud, &obj), (LaneShading::Gouraud, 1, 1));
 
         let mut coat = gltf.clone();
         coat.pbr.clearcoat = Some(Clearcoat {
@@ -535,32 +600,35 @@ mod tests {
             roughness_map: Some(map(16)),
             normal_map: None,
         });
-        assert_eq!(kind(&auto, &coat), Some((LaneShading::Pbr, 5, 4)));
+        assert_eq!(kind(&auto, &coat), (LaneShading::Pbr, 5, 4));
         let mut unlit = gltf.clone();
         unlit.unlit = true;
-        assert_eq!(kind(&auto, &unlit), Some((LaneShading::Unlit, 4, 3)));
+        assert_eq!(kind(&auto, &unlit), (LaneShading::Unlit, 4, 3));
         let mut moved = gltf.clone();
         if let Some(t) = &mut moved.pbr.base_color_map {
             t.transform = glam::Affine2::from_translation(glam::Vec2::new(0.5, 0.0));
         }
         // A transform is a slot of its own.
-        assert_eq!(kind(&auto, &moved), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &moved), (LaneShading::Pbr, 4, 3));
         let mut limited = gltf.clone();
         if let Some(t) = &mut limited.pbr.base_color_map {
             t.mag_nearest = true;
         }
         // So is a sampler with filters of its own.
-        assert_eq!(kind(&auto, &limited), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &limited), (LaneShading::Pbr, 4, 3));
         let mut nearest = context(&shadows, ShadingMode::Auto);
         nearest.filter = Filter::Nearest;
-        assert_eq!(kind(&nearest, &gltf), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&nearest, &gltf), (LaneShading::Pbr, 4, 3));
         let mut sizes = gltf.clone();
         sizes.pbr.emissive = Vec3::ONE;
         sizes.pbr.emissive_map = Some(map(32));
-        assert_eq!(kind(&auto, &sizes), Some((LaneShading::Pbr, 5, 4)));
+        assert_eq!(kind(&auto, &sizes), (LaneShading::Pbr, 5, 4));
         let mut four = sizes.clone();
         four.pbr.base_color_map = Some(map(4));
-        assert_eq!(kind(&auto, &four), None);
+        // A fourth slot too: its footprints are computed per lane call.
+        assert_eq!(kind(&auto, &four), (LaneShading::Pbr, 5, 4));
+        let extra = |m| LaneMaterial::new(&auto, m, [true; 2], true).extra_slots();
+        assert_eq!((extra(&sizes), extra(&four)), (0, 1));
         // An object-space normal map is a map like the others, and so is
         // a bump map.
         let mut object = gltf.clone();
@@ -569,14 +637,14 @@ mod tests {
             space: NormalSpace::Object,
             scale: 1.0,
         });
-        assert_eq!(kind(&auto, &object), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &object), (LaneShading::Pbr, 4, 3));
         let mut bump = gltf.clone();
         bump.normal_map = Some(NormalMap::Height {
             map: map(16),
             scale: 1.0,
         });
-        assert_eq!(kind(&auto, &bump), Some((LaneShading::Pbr, 4, 3)));
+        assert_eq!(kind(&auto, &bump), (LaneShading::Pbr, 4, 3));
         let lm = LaneMaterial::new(&auto, &bump, [true; 2], true);
-        assert_eq!(lm.and_then(|lm| lm.bump), Some((0, Vec2::splat(16.0))));
+        assert_eq!(lm.bump, Some((0, Vec2::splat(16.0))));
     }
 }

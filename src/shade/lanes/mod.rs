@@ -27,13 +27,13 @@ use super::{Fetch, ShadeContext};
 use crate::assets::texture::Footprint;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::material::Native;
+use crate::scene::settings::ShadingMode;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 mod fetch;
 mod material;
 
 use fetch::{LaneFetch, Lookups};
-pub(super) use fetch::{object_space, tangent_space};
 use material::LaneShading;
 pub use material::{Footprints, LaneMaterial};
 
@@ -92,6 +92,10 @@ pub struct Coords<'p, L: Lane = Vec4> {
     /// from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
     pub first: usize,
+    /// The slots past `MAX_SIZES` (`LaneMaterial::extra_slots`): their
+    /// coordinates and, per lane from lane `first`, footprints.
+    pub extra_uv: Vec<(L, L)>,
+    pub extra: &'p [[Footprint; MAX_LANES]],
     /// A bump map's: the lanes' coordinates of sets 0 and 1 (before any
     /// transform), and its steps (`Footprints::bump`) per lane from lane
     /// `first`.
@@ -121,10 +125,22 @@ impl<L: Lane> Lanes<L> {
 }
 
 impl<L: Lane> Coords<'_, L> {
+    /// The coordinates of slot `slot`.
+    #[inline(always)]
+    fn uv(&self, slot: usize) -> (L, L) {
+        match self.uv.get(slot) {
+            Some(&uv) => uv,
+            None => self.extra_uv[slot - MAX_SIZES],
+        }
+    }
+
     /// Quad `q`'s footprints of slot `slot`.
     #[inline(always)]
     fn footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
-        let f = &self.footprints[slot][self.first..];
+        let f = match self.footprints.get(slot) {
+            Some(f) => &f[self.first..],
+            None => &self.extra[slot - MAX_SIZES][self.first..],
+        };
         if L::WIDTH == 1 {
             return [f[0]; 4];
         }
@@ -165,6 +181,27 @@ impl<'a> ShadeContext<'a> {
         };
         fetch.start();
         body(&mut fetch)
+    }
+
+    /// The data passes' values of the fragments of `lm` (prepared by
+    /// `LaneMaterial::for_aovs`) in `f`'s lanes: their shading normals
+    /// (normal and bump maps applied; the triangles' in flat mode), world
+    /// space, unit, facing the camera; and their albedos, linear (glTF's
+    /// base colour, or Kd, after textures), times the vertex colours.
+    pub fn aov_lanes<L: Lane>(
+        &self,
+        lm: &LaneMaterial<'a>,
+        f: &Lanes<L>,
+        coords: &Coords<'_, L>,
+    ) -> (V3<L>, V3<L>) {
+        self.fetching(lm, f, coords, |fetch| {
+            let albedo = self.shade_fetched(lm, f, fetch);
+            let n = match &lm.material.normal_map {
+                Some(map) if self.mode != ShadingMode::Flat => fetch.normal(map),
+                _ => f.normal,
+            };
+            (n.normalize_or(V3::splat(Vec3::Z)), albedo)
+        })
     }
 
     /// The fragments of a blended lane material (`LaneMaterial::layers`)
@@ -233,7 +270,10 @@ impl<'a> ShadeContext<'a> {
                 let none = (V3::zero(), V3::zero());
                 self.shade_blinn_phong(m, fetch, f, Some(f.vertex_light.unwrap_or(none)))
             }
-            LaneShading::Unlit => self.pbr_color(m, fetch, f).base,
+            LaneShading::Unlit | LaneShading::Albedo { pbr: true } => {
+                self.pbr_color(m, fetch, f).base
+            }
+            LaneShading::Albedo { pbr: false } => self.surface_color(m, fetch, f.color).kd,
             LaneShading::Emitted if m.native == Native::Pbr => {
                 let c = self.pbr_color(m, fetch, f);
                 c.base + c.emissive
