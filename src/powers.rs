@@ -1,9 +1,9 @@
 //! x^y four lanes at a time, for the Blinn-Phong specular power
 //! max(0, n.h)^Ns: exp2(y log2 x), both halves as polynomials on SSE
 //! lanes, in place of four calls of libm's `powf` per group of fragments
-//! (4% of a diablo3-matched frame's instructions). The one-fragment path
-//! takes lane 0 of the same arithmetic (`pow_unit`), so both paths give
-//! the same bits; and as plain IEEE operations, every x86-64 machine does
+//! (4% of a diablo3-matched frame's instructions). One lane takes lane 0
+//! of the same arithmetic (`pow_unit`), so every width gives the same
+//! bits; and as plain IEEE operations, every x86-64 machine does
 //! (libm picks its `powf` by the processor).
 //!
 //! Accuracy, for x in (0, 1.01] (the unit tests sweep it against f64): the

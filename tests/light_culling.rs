@@ -3,7 +3,7 @@
 //! of every pixel, over scenes with many lights that have a range or a
 //! cone (point and spot lights with and without shadows, more than 63
 //! lights, directional and unlimited ones among them), with and without
-//! MSAA, Blinn-Phong and pbr, on the one-fragment path and the lanes.
+//! MSAA, Blinn-Phong and pbr.
 //! Whether tiles do drop lights is the unit tests' part
 //! (`light_tiles::tests`, `shade::light::tests`).
 

@@ -299,7 +299,7 @@ pub(super) struct QuadAt<'q, 'a> {
 
 /// Shades the group of draw `draw` in `w` (`width` lanes at a time) and
 /// hands the fragments it holds to `sink` (linear colour, zero where not
-/// finite as the one-fragment path has it).
+/// finite: degenerate input must not poison the frame).
 fn shade_group(
     data: &FrameData,
     draw: usize,

@@ -1,7 +1,7 @@
 //! Gouraud shading's vertex half: Blinn-Phong light summed at each vertex
 //! (diffuse and specular apart, shadowed at the vertex), to be
 //! interpolated across the triangles and combined with the surface color
-//! per pixel (`ShadeContext::shade`).
+//! per pixel (`ShadeContext::shade_lanes`).
 
 use glam::Vec3;
 use rayon::prelude::*;

@@ -127,13 +127,6 @@ pub struct LightSet<'a> {
 }
 
 impl<'a> LightSet<'a> {
-    pub fn all(lights: &'a [Light]) -> LightSet<'a> {
-        LightSet {
-            lights,
-            mask: LightMask::ALL,
-        }
-    }
-
     /// Calls `f(i, light)` for each light of the set, in index order.
     #[inline(always)]
     pub fn for_each(&self, mut f: impl FnMut(usize, &'a Light)) {

@@ -59,12 +59,6 @@ impl Sheen {
             None => at(ndv),
         }
     }
-
-    /// The layer's directional albedo towards `v` per channel: C E(n.v).
-    #[inline]
-    pub fn reflectance(&self, ndv: f32) -> Vec3 {
-        self.color * albedo(ndv, self.roughness)
-    }
 }
 
 /// D V for the given cosines (n.h, n.l, n.v) and alpha.

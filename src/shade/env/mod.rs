@@ -439,16 +439,12 @@ fn level_of(roughness: f32) -> (usize, f32) {
     (k, x - k as f32)
 }
 
-/// Where to look up the prefiltered radiance for a lobe of `roughness`
-/// reflecting about unit normal `n` along mirror direction `r`: rough
-/// lobes lean toward the normal (their off-specular peak), which the split
-/// sum's n = v = r prefilter does not see (Lagarde and de Rousiers 2014,
-/// "Moving Frostbite to PBR", the dominant direction).
-pub fn dominant_direction(n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
-    dominant_direction_lanes(V3::<f32>::from(n), V3::from(r), roughness).into()
-}
-
-/// `dominant_direction` per lane, each with its roughness.
+/// Where to look up the prefiltered radiance for lobes of `roughness`
+/// reflecting about unit normals `n` along mirror directions `r`, per
+/// lane, each with its roughness: rough lobes lean toward the normal
+/// (their off-specular peak), which the split sum's n = v = r prefilter
+/// does not see (Lagarde and de Rousiers 2014, "Moving Frostbite to PBR",
+/// the dominant direction).
 #[inline(always)]
 pub fn dominant_direction_lanes<L: Lane>(n: V3<L>, r: V3<L>, roughness: L) -> V3<L> {
     let one = L::splat(1.0);

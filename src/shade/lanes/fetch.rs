@@ -1,8 +1,7 @@
 //! Where a lane call reads its material's texels (`LaneFetch`, the
 //! lanes' `Fetch`): each distinct lookup once, the lookups of one slot
 //! placed once for all its maps (`Lookups`); and the normal maps' math
-//! over the lane type (tangent space, object space, bump maps), which a
-//! lone fragment shares.
+//! over the lane type (tangent space, object space, bump maps).
 
 // Loops over the lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]

@@ -63,9 +63,6 @@ pub(super) enum LaneShading {
 pub struct LaneMaterial<'a> {
     pub(super) material: &'a Material,
     pub(super) kind: LaneShading,
-    /// Whether its blended surfaces are layers the lanes shade
-    /// (`layer_lanes`): blended, and not transmissive.
-    pub layers: bool,
     /// Every map its shading may read, in the order it reads them.
     pub(super) maps: Vec<Map<'a>>,
     /// Whether the mesh has tangents (without them a tangent-space
@@ -195,8 +192,8 @@ impl Footprints {
 impl<'a> LaneMaterial<'a> {
     /// The footprints of a fragment whose texture coordinates (of sets 0
     /// and 1) change by `g` across its quad: one per slot, in the order
-    /// `Coords::footprints` takes them (as `ShadeContext::sample` derives
-    /// them, the transform applied to the derivatives).
+    /// `Coords::footprints` takes them (the transform applied to the
+    /// derivatives); past `MAX_SIZES`, none (`slot_footprint`).
     pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> Footprints {
         let mut out = Footprints::NONE;
         if let Some((set, size)) = self.bump {
@@ -496,8 +493,7 @@ impl<'a> LaneMaterial<'a> {
             LaneShading::Depth | LaneShading::Wireframe => {}
         }
         // A blended surface's opacity reads these too (`opacity`).
-        let layers = m.alpha == AlphaMode::Blend;
-        if layers {
+        if m.alpha == AlphaMode::Blend {
             maps.optional(&m.map_d);
             maps.optional(&m.map_kd);
         }
@@ -512,7 +508,6 @@ impl<'a> LaneMaterial<'a> {
         LaneMaterial {
             material: m,
             kind,
-            layers,
             maps: maps_read,
             tangents,
             set1: maps.slots.iter().any(|s| s.set == 1),

@@ -4,16 +4,15 @@
 //! `shade_blinn_phong`); a lone fragment is its one-lane instance, and
 //! every lane of a wider call is bit for bit that instance's answer.
 //!
-//! What differs between the widths is where texels come from (`Fetch`).
-//! A lone fragment reads them through `ShadeContext::sample`. The
-//! renderer gathers the visible fragments of a band into wider calls
-//! wherever `LaneMaterial::new` accepts the material: its maps
-//! fall in at most three slots (coordinate set, transform, sampler
-//! filters, texture size and chain), and the mode is not wireframe or
-//! Gouraud. Their lookups are found four lanes at a time for all maps of
-//! one slot (`Texture::taps4`) and gathered per lane; a slot's footprint
-//! per fragment carries its filter (the frame's, lowered or magnified
-//! with the nearest texel by the map's sampler).
+//! The renderer gathers the visible fragments of a band into calls of
+//! one draw (`LaneMaterial::new`: the material's maps in slots by
+//! coordinate set, transform, sampler filters, texture size and chain).
+//! A slot's lookups are found four lanes at a time for all its maps
+//! (`Texture::taps4`) and gathered per lane; a slot's footprint per
+//! fragment carries its filter (the frame's, lowered or magnified with
+//! the nearest texel by the map's sampler). A fragment carries the
+//! footprints of three slots; those of further slots are computed per
+//! lane call (`Coords::extra`).
 //!
 //! The lanes of one call share a material but not a triangle.
 
@@ -128,19 +127,38 @@ impl<L: Lane> Coords<'_, L> {
     /// The coordinates of slot `slot`.
     #[inline(always)]
     fn uv(&self, slot: usize) -> (L, L) {
-        match self.uv.get(slot) {
-            Some(&uv) => uv,
-            None => self.extra_uv[slot - MAX_SIZES],
+        if slot < MAX_SIZES {
+            self.uv[slot]
+        } else {
+            self.extra_uv(slot)
         }
+    }
+
+    /// `uv` of a slot past `MAX_SIZES`.
+    #[cold]
+    #[inline(never)]
+    fn extra_uv(&self, slot: usize) -> (L, L) {
+        self.extra_uv[slot - MAX_SIZES]
+    }
+
+    /// `footprints4` of a slot past `MAX_SIZES`.
+    #[cold]
+    #[inline(never)]
+    fn extra_footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
+        let f = &self.extra[slot - MAX_SIZES][self.first..];
+        if L::WIDTH == 1 {
+            return [f[0]; 4];
+        }
+        [f[4 * q], f[4 * q + 1], f[4 * q + 2], f[4 * q + 3]]
     }
 
     /// Quad `q`'s footprints of slot `slot`.
     #[inline(always)]
     fn footprints4(&self, slot: usize, q: usize) -> [Footprint; 4] {
-        let f = match self.footprints.get(slot) {
-            Some(f) => &f[self.first..],
-            None => &self.extra[slot - MAX_SIZES][self.first..],
-        };
+        if slot >= MAX_SIZES {
+            return self.extra_footprints4(slot, q);
+        }
+        let f = &self.footprints[slot][self.first..];
         if L::WIDTH == 1 {
             return [f[0]; 4];
         }
