@@ -330,9 +330,8 @@ impl<'a> MapSet<'_, 'a> {
     }
 
     fn optional(&mut self, t: &'a Option<TextureRef>) {
-        match t {
-            Some(t) => self.map(t),
-            None => {}
+        if let Some(t) = t {
+            self.map(t);
         }
     }
 
@@ -351,27 +350,20 @@ impl<'a> MapSet<'_, 'a> {
         }
         match m {
             Some(NormalMap::Normals {
-                space: NormalSpace::Tangent,
-                ..
-            }) => {
-                if self.tangents {
-                    self.map(t);
-                }
-            }
-            Some(NormalMap::Normals {
                 space: NormalSpace::Object,
                 ..
             }) => self.map(t),
+            // Without tangents a tangent-space or bump map leaves the
+            // normal as it is.
+            _ if !self.tangents => {}
             Some(NormalMap::Height { .. }) => {
-                if self.tangents {
-                    self.map(t);
-                    let m = t.transform.matrix2;
-                    let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
-                        * Vec2::new(m.x_axis.length(), m.y_axis.length());
-                    self.bump = Some(((t.texcoord as usize).min(1), size));
-                }
+                self.map(t);
+                let m = t.transform.matrix2;
+                let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
+                    * Vec2::new(m.x_axis.length(), m.y_axis.length());
+                self.bump = Some(((t.texcoord as usize).min(1), size));
             }
-            None => {}
+            _ => self.map(t),
         }
     }
 
