@@ -212,3 +212,17 @@ fn displacement_map() {
 fn african_head_blended_eye_shell_over_the_iris() {
     real(&["african_head_eye"]);
 }
+
+#[test]
+fn a_material_with_five_slots() {
+    // Maps in five slots (two sizes, two transforms, both coordinate
+    // sets): the lanes carry three footprints per fragment and compute
+    // the others per call. The golden is the one-fragment path's frame,
+    // from before the lanes took such materials (byte-identical then).
+    check(
+        "many_slots",
+        &root().join("tests/data/many_slots/scene.toml"),
+        0,
+        &[],
+    );
+}

@@ -546,11 +546,6 @@ impl<'a> FrameData<'a> {
             back: normal.dot(raw).cmplt(L::splat(0.0)),
             footprints: &p.footprints,
             first: at,
-            extra_uv: if extra.is_empty() {
-                Vec::new()
-            } else {
-                lm.extra_coords([uv0, uv1])
-            },
             extra,
             sets: [uv0, uv1],
             bump: &p.bump,

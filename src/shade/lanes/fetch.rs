@@ -119,12 +119,9 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         let mut rgba = [[Vec4::ZERO; 4]; 2];
         for (q, out) in rgba.iter_mut().enumerate().take(L::QUADS) {
             let fps = f.footprints4(map.slot, q);
-            *out = map.chain.sample4_rgba(
-                f.uv(map.slot).0.quad(q),
-                f.uv(map.slot).1.quad(q),
-                &fps,
-                map.mode,
-            );
+            *out = map
+                .chain
+                .sample4_rgba(f.uv(map).0.quad(q), f.uv(map).1.quad(q), &fps, map.mode);
         }
         let channel = |c: usize| L::from_quads(|q| rgba[q][c]);
         let rgb = V3 {
@@ -271,8 +268,8 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
             *out = match self.taps[q].get(map.slot) {
                 Some(Some(t)) => map.chain.read4(t, map.mode),
                 _ => map.chain.sample4(
-                    f.uv(map.slot).0.quad(q),
-                    f.uv(map.slot).1.quad(q),
+                    f.uv(map).0.quad(q),
+                    f.uv(map).1.quad(q),
                     &f.footprints4(map.slot, q),
                     map.mode,
                 ),

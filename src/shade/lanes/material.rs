@@ -255,14 +255,6 @@ impl<'a> LaneMaterial<'a> {
         out
     }
 
-    /// `coords` of the slots past `MAX_SIZES`.
-    pub fn extra_coords<L: Lane>(&self, uv: [(L, L); 2]) -> Vec<(L, L)> {
-        self.slots[MAX_SIZES.min(self.slots.len())..]
-            .iter()
-            .map(|s| s.coords(uv))
-            .collect()
-    }
-
     /// Which of the maps `t` is.
     #[inline]
     pub(super) fn index_of(&self, t: &TextureRef) -> Option<usize> {

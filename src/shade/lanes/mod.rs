@@ -91,13 +91,12 @@ pub struct Coords<'p, L: Lane = Vec4> {
     /// from lane `first`.
     pub footprints: &'p [[Footprint; MAX_LANES]; MAX_SIZES],
     pub first: usize,
-    /// The slots past `MAX_SIZES` (`LaneMaterial::extra_slots`): their
-    /// coordinates and, per lane from lane `first`, footprints.
-    pub extra_uv: Vec<(L, L)>,
+    /// The footprints of the slots past `MAX_SIZES`
+    /// (`LaneMaterial::extra_slots`), per lane from lane `first`.
     pub extra: &'p [[Footprint; MAX_LANES]],
-    /// A bump map's: the lanes' coordinates of sets 0 and 1 (before any
-    /// transform), and its steps (`Footprints::bump`) per lane from lane
-    /// `first`.
+    /// The lanes' coordinates of sets 0 and 1 before any transform (a
+    /// bump map's offset lookups, the slots past `MAX_SIZES`), and a bump
+    /// map's steps (`Footprints::bump`) per lane from lane `first`.
     pub sets: [(L, L); 2],
     pub bump: &'p [Vec2; MAX_LANES],
 }
@@ -124,21 +123,30 @@ impl<L: Lane> Lanes<L> {
 }
 
 impl<L: Lane> Coords<'_, L> {
-    /// The coordinates of slot `slot`.
+    /// The coordinates of `map`.
     #[inline(always)]
-    fn uv(&self, slot: usize) -> (L, L) {
-        if slot < MAX_SIZES {
-            self.uv[slot]
+    fn uv(&self, map: &material::Map) -> (L, L) {
+        if map.slot < MAX_SIZES {
+            self.uv[map.slot]
         } else {
-            self.extra_uv(slot)
+            self.extra_uv(map.source)
         }
     }
 
-    /// `uv` of a slot past `MAX_SIZES`.
+    /// `uv` of a map in a slot past `MAX_SIZES`: the coordinates of its
+    /// set through its transform (`LaneMaterial::coords`).
     #[cold]
     #[inline(never)]
-    fn extra_uv(&self, slot: usize) -> (L, L) {
-        self.extra_uv[slot - MAX_SIZES]
+    fn extra_uv(&self, t: &crate::assets::texture::TextureRef) -> (L, L) {
+        let (u, v) = self.sets[(t.texcoord as usize).min(1)];
+        if t.transform == glam::Affine2::IDENTITY {
+            return (u, v);
+        }
+        let (m, o) = (t.transform.matrix2, t.transform.translation);
+        (
+            L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(o.x),
+            L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(o.y),
+        )
     }
 
     /// `footprints4` of a slot past `MAX_SIZES`.
