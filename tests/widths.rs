@@ -818,6 +818,21 @@ fn khr_layers_with_maps_are_the_same_at_every_width() {
     }
 }
 
+/// The scene `file` under each texture filter with one sample and MSAA
+/// 4, at every width (`same_at_every_width`).
+fn every_filter_and_msaa(file: &Path, what: &str) {
+    for filter in ["anisotropic", "trilinear", "bilinear", "nearest"] {
+        for msaa in [1, 4] {
+            let sets = [
+                format!("render.texture_filter=\"{filter}\""),
+                format!("render.msaa={msaa}"),
+            ];
+            let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+            same_at_every_width(&load_with(file, &sets), &[0], &format!("{what}, {sets:?}"));
+        }
+    }
+}
+
 /// Writes `file` in `dir`: `cube` turned, its one primitive drawn with
 /// material 0, and `body` (images, textures, samplers, materials,
 /// extensions) beside the node.
@@ -869,21 +884,7 @@ fn samplers_and_the_nearest_filter_are_the_same_at_every_width() {
     let s = scene_in(&dir, scene, &[]);
     let base = s.models[0].materials[0].pbr.base_color_map.as_ref();
     assert!(base.is_some_and(|t| t.mag_nearest && t.min_limit.is_none()));
-    let file = dir.join("scene.toml");
-    for filter in ["anisotropic", "trilinear", "bilinear", "nearest"] {
-        for msaa in [1, 4] {
-            let sets = [
-                format!("render.texture_filter=\"{filter}\""),
-                format!("render.msaa={msaa}"),
-            ];
-            let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-            same_at_every_width(
-                &load_with(&file, &sets),
-                &[0],
-                &format!("samplers, {sets:?}"),
-            );
-        }
-    }
+    every_filter_and_msaa(&dir.join("scene.toml"), "samplers");
 }
 
 #[test]
@@ -1112,20 +1113,6 @@ fn materials_with_many_slots_are_the_same_at_every_width() {
         let models = "[[model]]\npath = \"o.gltf\"\ntranslate = [0.4, 0.3, -1.5]\n\
             [[model]]\npath = \"c.gltf\"\n";
         scene_in(&dir, &format!("{LIT_CUBES}{models}"), &[]);
-        let file = dir.join("scene.toml");
-        for filter in ["trilinear", "anisotropic", "bilinear", "nearest"] {
-            for msaa in [1, 4] {
-                let sets = [
-                    format!("render.texture_filter=\"{filter}\""),
-                    format!("render.msaa={msaa}"),
-                ];
-                let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-                same_at_every_width(
-                    &load_with(&file, &sets),
-                    &[0],
-                    &format!("five slots, {alpha}, {filter}, msaa {msaa}"),
-                );
-            }
-        }
+        every_filter_and_msaa(&dir.join("scene.toml"), &format!("five slots, {alpha}"));
     }
 }
