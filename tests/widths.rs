@@ -609,9 +609,7 @@ fn clearcoats_are_the_same_at_every_width() {
     // a quad and a triangle behind it, under every light kind (the spot
     // with a ray-traced shadow), ambient, the studio environment with and
     // without SSAO, MSAA 4; a coat of factor 0 is no coat. (Maps are left
-    // out: with a map_Kd or a normal map this quad's pbr pixels at the
-    // far edge differ between the lanes and the one-fragment path by
-    // about 1e-4, at every width and before the coat; see the notes.)
+    // out here; the coat's maps are in `khr_layers_with_maps`.)
     let dir = scratch("lanes_clearcoat");
     let obj = "mtllib m.mtl\n\
         v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
