@@ -8,9 +8,10 @@
 //! frame by [`batch`]. [`color`], [`error`], [`files`], [`powers`], [`raster`], [`raytrace`] and
 //! [`simd`] are the ground floor: they import nothing of the layers above.
 //!
-//! The library is the renderer alone with `--no-default-features`; the
-//! default feature `tools` adds [`tools`] (bench, chart, accuracy tables,
-//! image comparison) and the `softraster` binary.
+//! This package is the renderer alone. The `softraster` binary, the tools
+//! that measure the renderer (bench, chart, accuracy tables, image
+//! comparison) and the showcase's asset generator are the workspace's
+//! `softraster-cli` package (`cli/`).
 //!
 //! Rendering a frame from Rust:
 //!
@@ -56,7 +57,5 @@ pub mod shade;
 pub mod simd;
 #[cfg(test)]
 mod testing;
-#[cfg(feature = "tools")]
-pub mod tools;
 
 pub use error::{Error, Result};

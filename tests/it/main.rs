@@ -1,0 +1,16 @@
+//! The renderer library's integration tests, one binary with a module per
+//! area. The tests that run the `softraster` binary or the tools that
+//! measure the renderer are the command line's (`cli/tests/it`).
+
+mod common;
+
+mod display;
+mod framing;
+mod gltf;
+mod gltf_animation;
+mod gltf_pose;
+mod known_answers;
+mod points_lines;
+mod shadows;
+mod textures;
+mod widths;
