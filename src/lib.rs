@@ -17,7 +17,7 @@
 //!
 //! ```
 //! use softraster::output::{png, resolve};
-//! use softraster::render::{Frame, Renderer};
+//! use softraster::render::{Frame, Renderer, Shot};
 //! use softraster::scene::{LoadOptions, Scene};
 //!
 //! # fn main() -> Result<(), softraster::Error> {
@@ -27,10 +27,11 @@
 //! let text = "[output]\nwidth = 64\nheight = 64\n[[model]]\npath = \"tri.obj\"\n";
 //! let scene = Scene::from_text(&dir.join("tri.toml"), text, &LoadOptions::default())?;
 //!
-//! // The renderer keeps BVHs and mip chains across frames: make it once.
+//! // The renderer borrows the scene and keeps BVHs and shadow maps
+//! // across its frames: make it once.
 //! let renderer = Renderer::new(&scene);
 //! let mut frame = Frame::new(0, 0);
-//! renderer.render(&scene, 0, 0, &mut frame); // camera 0, frame 0
+//! renderer.render(Shot::new(0, 0), &mut frame)?; // camera 0, frame 0
 //! assert!(frame.depth.iter().any(|d| d.is_finite()));
 //!
 //! // Tone map and encode as the scene says, and write it.

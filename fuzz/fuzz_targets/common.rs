@@ -53,7 +53,7 @@ pub fn load_and_render(name: &str, text: &str, render: bool) {
 /// As `load_and_render`, for the given frames.
 pub fn load_and_render_frames(name: &str, text: &str, render: bool, frames: &[u32]) {
     use softraster::output::Image8;
-    use softraster::render::{Frame, FrameSequence, Renderer};
+    use softraster::render::{Frame, FrameSequence, Renderer, Shot};
     use softraster::scene::{LoadOptions, Scene};
     let path = dir().join(name);
     let Ok(scene) = Scene::from_text(&path, text, &LoadOptions::plain()) else {
@@ -70,9 +70,15 @@ pub fn load_and_render_frames(name: &str, text: &str, render: bool, frames: &[u3
     let mut image = Image8::empty();
     for cam in 0..scene.cameras.len().min(2) {
         for &f in frames {
-            renderer.render(&scene, cam, f, &mut frame);
+            // The cameras are the scene's own: rendering them cannot fail.
+            let shot = Shot::new(cam, f);
+            renderer
+                .render(shot, &mut frame)
+                .expect("a camera of the scene");
             let want = softraster::output::resolve(&frame, &scene.settings);
-            renderer.render_next(&scene, cam, f, &mut seq, Some(&mut image));
+            renderer
+                .render_next(shot, &mut seq, Some(&mut image))
+                .expect("a camera of the scene");
             assert!(image == want, "render_next's bytes differ from resolve's");
         }
     }

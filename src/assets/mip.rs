@@ -15,12 +15,9 @@ use rayon::prelude::*;
 use super::texture::{Level, Texture};
 use crate::color::{encode_linear, encode_srgb};
 
-/// Levels 1.. of `t` (empty for a 1x1 texture); those read with it from
-/// the texture cache when it came from there.
+/// Levels 1.. of `t` (empty for a 1x1 texture), built from level 0.
+/// `Texture::mip_chain(build_chain)` keeps them with the texture.
 pub fn build_chain(t: &Texture) -> Vec<Level> {
-    if let Some(chain) = t.take_cached_chain() {
-        return chain;
-    }
     let mut levels = Vec::new();
     let base = t.base();
     // Level 0 decoded on the fly; later levels from the floats kept.

@@ -24,7 +24,7 @@ use writer::ToWriter;
 use crate::error::Error;
 pub use crate::output::FrameFiles;
 use crate::output::{self, Image8};
-use crate::render::{FrameSequence, Renderer};
+use crate::render::{FrameSequence, Renderer, Shot};
 use crate::scene::Scene;
 
 pub struct RenderJob {
@@ -209,7 +209,11 @@ impl RenderJob {
                 let t0 = Instant::now();
                 // The display image is made as the frame renders.
                 let mut image = (files.color.is_some() || in_video).then(Image8::empty);
-                renderer.render_next(scene, cam, frame, &mut buffer, image.as_mut());
+                let shot = Shot::new(cam, frame);
+                if let Err(e) = renderer.render_next(shot, &mut buffer, image.as_mut()) {
+                    result = Err(e);
+                    break 'frames;
+                }
                 let (outputs, color) = output::pack(buffer.frame(), image, files, in_video);
                 let done = FrameDone {
                     frame,

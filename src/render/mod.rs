@@ -18,10 +18,11 @@
 //! Each band owns its rows: no locks, no shared writes, and the same frame
 //! whatever the number of threads.
 //!
-//! `Renderer` is the render state built from a scene and kept across its
-//! frames: the BVH of each mesh and the mip chain of each texture, built
-//! on the first frame that needs them. Scene data is never written to.
-//! `Renderer::render` is the one entry for a frame.
+//! `Renderer` is the render state of one scene, which it borrows and
+//! never writes to, kept across its frames: the BVH of each mesh, built on
+//! the first frame that needs it (the mip chains are kept with the
+//! textures). `Renderer::render` of a `Shot` (camera and frame) is the
+//! one entry for a frame.
 
 mod ao_pass;
 mod aovs;
@@ -54,10 +55,10 @@ pub use exposure::auto_exposure;
 pub use frame::{AovPixel, Frame, FrameSequence};
 pub use frame_setup::FrameSetup;
 
-use crate::assets::environment::EnvImage;
 use crate::assets::mesh::Mesh;
 use crate::assets::mip;
-use crate::assets::texture::{Level, Texture};
+use crate::assets::texture::Level;
+use crate::error::Error;
 use crate::raster::coverage::sample_pattern;
 use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
@@ -74,25 +75,36 @@ use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
 use geometry::Geometry;
 
-/// The render state of one scene's assets, reusable across its frames.
-pub struct Renderer {
+/// What one call renders: a camera of the scene (its index in
+/// `Scene::cameras`) and a frame of its animation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Shot {
+    pub camera: usize,
+    pub frame: u32,
+}
+
+impl Shot {
+    pub fn new(camera: usize, frame: u32) -> Shot {
+        Shot { camera, frame }
+    }
+}
+
+/// The renderer of one scene: it borrows the scene, which it never
+/// writes to, and keeps what its frames share: the BVH of each mesh
+/// (built on the first frame that traces rays), the environment's
+/// prefiltered lighting, the last shadow maps and backdrop. The mip chains
+/// are kept with the textures themselves (`Texture::mip_chain`), so a
+/// renderer for another setting of the same scene reuses them. Another
+/// scene, or the same scene changed, takes a renderer of its own.
+pub struct Renderer<'s> {
+    scene: &'s Scene,
     /// The scene's distinct meshes (models may share one).
-    meshes: Vec<Arc<Mesh>>,
+    meshes: Vec<&'s Arc<Mesh>>,
     /// Per model: its mesh's index in `meshes`.
     model_mesh: Vec<usize>,
     /// Per mesh: its object-space BVH and bounds, built on first need.
     bvhs: Vec<OnceLock<(Bvh, (Vec3, Vec3))>>,
-    /// The scene's textures; `Texture::id` indexes this list.
-    textures: Vec<Arc<Texture>>,
-    /// Per texture: levels 1.. of its mip chain, built on the first frame
-    /// that minifies it.
-    mips: Vec<OnceLock<Vec<Level>>>,
-    /// The scene's environment image, and its prefiltered lighting (built
-    /// on the first frame).
-    env_image: Option<Arc<EnvImage>>,
-    /// The environment's intensity and rotation its lighting is built with.
-    /// The environment's intensity, rotation and prefilter size.
-    env_params: Option<(f32, f32, u32)>,
+    /// The environment's prefiltered lighting (built on the first frame).
     env: OnceLock<Option<Arc<EnvLight>>>,
     /// `method = "sampled"`: the environment's sampling tables.
     env_sampler: OnceLock<Option<EnvSampler>>,
@@ -109,9 +121,9 @@ pub struct Renderer {
     lane_width: usize,
 }
 
-impl Renderer {
-    pub fn new(scene: &Scene) -> Renderer {
-        let mut meshes: Vec<Arc<Mesh>> = Vec::new();
+impl<'s> Renderer<'s> {
+    pub fn new(scene: &'s Scene) -> Renderer<'s> {
+        let mut meshes: Vec<&Arc<Mesh>> = Vec::new();
         let model_mesh = scene
             .models
             .iter()
@@ -119,23 +131,17 @@ impl Renderer {
                 |m| match meshes.iter().position(|k| Arc::ptr_eq(k, &m.mesh)) {
                     Some(i) => i,
                     None => {
-                        meshes.push(m.mesh.clone());
+                        meshes.push(&m.mesh);
                         meshes.len() - 1
                     }
                 },
             )
             .collect();
         Renderer {
+            scene,
             bvhs: meshes.iter().map(|_| OnceLock::new()).collect(),
             meshes,
             model_mesh,
-            mips: scene.textures.iter().map(|_| OnceLock::new()).collect(),
-            textures: scene.textures.clone(),
-            env_image: scene.environment.as_ref().map(|e| e.image.clone()),
-            env_params: scene
-                .environment
-                .as_ref()
-                .map(|e| (e.intensity, e.rotation, e.prefilter_size)),
             env: OnceLock::new(),
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
@@ -148,10 +154,15 @@ impl Renderer {
         }
     }
 
+    /// The scene this renderer draws.
+    pub fn scene(&self) -> &'s Scene {
+        self.scene
+    }
+
     /// Shades `width` lanes at a time (1, 4 or 8; a width this build
     /// lacks (`simd::widths`) takes the widest it has). The frames are
     /// the same bytes at every width (tests compare them).
-    pub fn with_lane_width(mut self, width: usize) -> Renderer {
+    pub fn with_lane_width(mut self, width: usize) -> Renderer<'s> {
         self.lane_width = if crate::simd::widths().contains(&width) {
             width
         } else {
@@ -163,22 +174,19 @@ impl Renderer {
     /// With `on = false`, every fragment is shaded with every light, not
     /// only those that can reach its tile. The frames are the same either
     /// way (tests compare them bit for bit).
-    pub fn with_light_culling(mut self, on: bool) -> Renderer {
+    pub fn with_light_culling(mut self, on: bool) -> Renderer<'s> {
         self.light_culling = on;
         self
     }
 
-    /// Renders frame `frame` of camera `camera` into `out`, reusing its
-    /// buffers (resized to the scene's output size); every pixel is
-    /// written. With supersampling the frame is rendered `ssaa` times the
-    /// size per axis and box-filtered down.
-    ///
-    /// `scene` may differ from the one the renderer was made for in
-    /// anything but its meshes and textures (settings, lights, cameras:
-    /// the tools change those between frames); for other assets a
-    /// renderer of their own is made for the call.
-    pub fn render(&self, scene: &Scene, camera: usize, frame: u32, out: &mut Frame) {
-        self.render_frame(scene, camera, frame, out, None);
+    /// Renders `shot` into `out`, reusing its buffers (resized to the
+    /// scene's output size); every pixel is written. With supersampling
+    /// the frame is rendered `ssaa` times the size per axis and
+    /// box-filtered down. A camera the scene does not have is an error
+    /// naming it.
+    pub fn render(&self, shot: Shot, out: &mut Frame) -> Result<(), Error> {
+        self.render_frame(self.setup(shot)?, out, None);
+        Ok(())
     }
 
     /// `render`, and `*image = resolve(out, &scene.settings)`: the display
@@ -187,32 +195,55 @@ impl Renderer {
     /// supersampling's filter) still changes the frame.
     pub fn render_display(
         &self,
-        scene: &Scene,
-        camera: usize,
-        frame: u32,
+        shot: Shot,
         out: &mut Frame,
         image: &mut Image8,
-    ) {
-        self.render_frame(scene, camera, frame, out, Some(image));
+    ) -> Result<(), Error> {
+        self.render_frame(self.setup(shot)?, out, Some(image));
+        Ok(())
+    }
+
+    /// `render_display` (with `image`) or `render` of the next shot of a
+    /// sequence into `seq`: the band rows the last frame left as plain
+    /// background are not filled again (the same frames and bytes).
+    pub fn render_next(
+        &self,
+        shot: Shot,
+        seq: &mut FrameSequence,
+        image: Option<&mut Image8>,
+    ) -> Result<(), Error> {
+        let setup = self.setup(shot)?;
+        let (out, known) = seq.parts();
+        let s = &self.scene.settings;
+        if (out.width, out.height) != (s.width, s.height) || s.ssaa.max(1) > 1 {
+            // Another size, or a filter over a larger frame: nothing of
+            // the buffer is known.
+            known.clear();
+        }
+        if s.ssaa.max(1) > 1 {
+            self.render_frame(setup, out, image);
+        } else {
+            self.render_at(&setup, s.width, s.height, out, image, Some(known));
+        }
+        Ok(())
+    }
+
+    /// The frame's draw list for `shot`, or an error naming a camera the
+    /// scene does not have.
+    fn setup(&self, shot: Shot) -> Result<FrameSetup<'s>, Error> {
+        let n = self.scene.cameras.len();
+        if shot.camera >= n {
+            return Err(Error::Argument(format!(
+                "camera {}: the scene has {n} camera(s), 0..{n}",
+                shot.camera
+            )));
+        }
+        Ok(FrameSetup::new(self.scene, shot.camera, shot.frame))
     }
 
     /// `render`, and with `display` `render_display`.
-    fn render_frame(
-        &self,
-        scene: &Scene,
-        camera: usize,
-        frame: u32,
-        out: &mut Frame,
-        display: Option<&mut Image8>,
-    ) {
-        if !self.serves(scene) {
-            return Renderer::new(scene)
-                .with_light_culling(self.light_culling)
-                .with_lane_width(self.lane_width)
-                .render_frame(scene, camera, frame, out, display);
-        }
-        let setup = FrameSetup::new(scene, camera, frame);
-        let (s, k) = (&scene.settings, scene.settings.ssaa.max(1));
+    fn render_frame(&self, setup: FrameSetup, out: &mut Frame, display: Option<&mut Image8>) {
+        let (s, k) = (&self.scene.settings, self.scene.settings.ssaa.max(1));
         if k == 1 {
             self.render_at(&setup, s.width, s.height, out, display, None);
             return;
@@ -225,81 +256,45 @@ impl Renderer {
         }
     }
 
-    /// `render_display` (with `image`) or `render` of the next frame of a
-    /// sequence into `seq`: the band rows the last frame left as plain
-    /// background are not filled again (the same frames and bytes).
-    pub fn render_next(
-        &self,
-        scene: &Scene,
-        camera: usize,
-        frame: u32,
-        seq: &mut FrameSequence,
-        image: Option<&mut Image8>,
-    ) {
-        let (out, known) = seq.parts();
-        let s = &scene.settings;
-        if (out.width, out.height) != (s.width, s.height) {
-            // Another size: nothing of the buffer is known.
-            known.clear();
-        }
-        if !self.serves(scene) || s.ssaa.max(1) > 1 {
-            // Another renderer, or a filter over a larger frame.
-            known.clear();
-            return self.render_frame(scene, camera, frame, out, image);
-        }
-        let setup = FrameSetup::new(scene, camera, frame);
-        self.render_at(&setup, s.width, s.height, out, image, Some(known));
-    }
-
     /// Builds every texture's mip chain now (a benchmark counts them as
     /// loading). Frames still read a chain only where they minify.
     pub fn build_all_mips(&self) {
-        self.textures.par_iter().zip(&self.mips).for_each(|(t, m)| {
-            m.get_or_init(|| mip::build_chain(t));
+        self.scene.textures.par_iter().for_each(|t| {
+            t.mip_chain(mip::build_chain);
         });
     }
 
-    /// Prefilters `scene`'s environment now rather than at the first
+    /// Prefilters the scene's environment now rather than at the first
     /// frame (for timing it apart from frames); nothing without one.
-    pub fn build_environment(&self, scene: &Scene) {
-        let _ = self.env_light(scene);
+    pub fn build_environment(&self) {
+        let _ = self.env_light();
     }
 
-    /// Whether texture `id`'s mip chain has been built.
-    pub fn has_mips(&self, id: usize) -> bool {
-        self.mips.get(id).is_some_and(|m| m.get().is_some())
-    }
-
-    /// Whether `scene`'s meshes, textures and environment (image,
-    /// intensity, rotation, prefilter size) are the ones this renderer
-    /// holds state for.
-    fn serves(&self, scene: &Scene) -> bool {
-        scene.models.len() == self.model_mesh.len()
-            && scene
-                .models
-                .iter()
-                .zip(&self.model_mesh)
-                .all(|(m, &k)| Arc::ptr_eq(&m.mesh, &self.meshes[k]))
-            && match (&scene.environment, &self.env_image) {
-                (Some(e), Some(i)) => {
-                    Arc::ptr_eq(&e.image, i)
-                        && self.env_params == Some((e.intensity, e.rotation, e.prefilter_size))
-                }
-                (None, None) => true,
-                _ => false,
-            }
-            && scene.textures.len() == self.textures.len()
-            && scene
-                .textures
-                .iter()
-                .zip(&self.textures)
-                .all(|(a, b)| Arc::ptr_eq(a, b))
+    /// Builds now what frames otherwise build on first need: every
+    /// texture's mip chain, the environment's lighting and sampling
+    /// tables, and, when the scene traces rays, every mesh's BVH. For
+    /// timing frames apart from loading; the frames are the same either
+    /// way.
+    pub fn prepare(&self) {
+        self.build_all_mips();
+        let _ = self.env_light();
+        let s = &self.scene.settings;
+        let traced = (s.shadows == ShadowMethod::Raytraced
+            && self.scene.lights.iter().any(|l| l.shadows))
+            || s.ao.method == AoMethod::Raytraced
+            || self.env_sampler().is_some()
+            || self.scene.ground.is_some();
+        if traced {
+            self.meshes.par_iter().zip(&self.bvhs).for_each(|(m, b)| {
+                b.get_or_init(|| bvh_of(m));
+            });
+        }
     }
 
     /// The environment's lighting, prefiltered once per process
-    /// (`env_cache`; its intensity and rotation are taken from the first
-    /// frame's scene).
-    fn env_light(&self, scene: &Scene) -> Option<&EnvLight> {
+    /// (`env_cache`).
+    fn env_light(&self) -> Option<&EnvLight> {
+        let scene = self.scene;
         self.env
             .get_or_init(|| {
                 let e = scene.environment.as_ref()?;
@@ -319,8 +314,8 @@ impl Renderer {
 
     /// `method = "sampled"`: the sampling tables (built once) and the
     /// sample count.
-    fn env_sampler(&self, scene: &Scene) -> Option<(&EnvSampler, u32)> {
-        let e = scene.environment.as_ref()?;
+    fn env_sampler(&self) -> Option<(&EnvSampler, u32)> {
+        let e = self.scene.environment.as_ref()?;
         let EnvMethod::Sampled { samples } = e.method else {
             return None;
         };
@@ -346,10 +341,7 @@ impl Renderer {
             .map(|((&k, &world_from_object), posed)| {
                 let (bvh, bounds) = match posed {
                     Some(b) => b,
-                    None => self.bvhs[k].get_or_init(|| {
-                        let m = &self.meshes[k];
-                        (Bvh::build(&m.positions, &m.triangles), m.bounds())
-                    }),
+                    None => self.bvhs[k].get_or_init(|| bvh_of(self.meshes[k])),
                 };
                 Placed {
                     bvh,
@@ -376,10 +368,7 @@ impl Renderer {
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                     |(lo, hi), q| (lo.min(*q), hi.max(*q)),
                 );
-                let (rest, _) = self.bvhs[k].get_or_init(|| {
-                    let m = &self.meshes[k];
-                    (Bvh::build(&m.positions, &m.triangles), m.bounds())
-                });
+                let (rest, _) = self.bvhs[k].get_or_init(|| bvh_of(self.meshes[k]));
                 Some((rest.refit(&p.positions, &m.mesh.triangles), bounds))
             })
             .collect()
@@ -406,7 +395,7 @@ impl Renderer {
         };
         let shadow_rays =
             s.shadows == ShadowMethod::Raytraced && setup.lights.iter().any(|l| l.shadows);
-        let sampled = self.env_sampler(setup.scene);
+        let sampled = self.env_sampler();
         let traced = shadow_rays
             || s.ao.method == AoMethod::Raytraced
             || sampled.is_some()
@@ -420,7 +409,7 @@ impl Renderer {
 
         let mut verts = vertex::transform_all(setup);
         let shadows = shadow_pass::shadows(setup, &verts, tracer.as_ref(), &self.shadow_maps);
-        let env = self.env_light(setup.scene);
+        let env = self.env_light();
         if s.shading == ShadingMode::Gouraud {
             let ctx = shade_context(setup, &[], &shadows, env);
             for (m, mv) in setup.scene.models.iter().zip(&mut verts) {
@@ -430,7 +419,7 @@ impl Renderer {
         let filtered = matches!(
             s.texture_filter,
             TextureFilter::Trilinear | TextureFilter::Anisotropic
-        ) && !self.textures.is_empty();
+        ) && !self.scene.textures.is_empty();
         let geo = geometry::setup_and_bin(setup, &verts, vp, filtered);
         let mips = self.frame_mips(setup, &geo);
 
@@ -577,8 +566,8 @@ impl Renderer {
     /// triangle's footprint reaches half a texel (the level of detail can
     /// pass 0 there); the others read level 0 only, so a frame's pixels do
     /// not depend on which frames came before.
-    fn frame_mips(&self, setup: &FrameSetup, geo: &Geometry) -> Vec<Option<&[Level]>> {
-        let mut needed = vec![false; self.textures.len()];
+    fn frame_mips(&self, setup: &FrameSetup, geo: &Geometry) -> Vec<Option<&'s [Level]>> {
+        let mut needed = vec![false; self.scene.textures.len()];
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
             for map in setup.scene.models[d.model].materials[d.material].maps() {
@@ -592,13 +581,18 @@ impl Renderer {
                 }
             }
         }
-        self.textures
+        self.scene
+            .textures
             .par_iter()
-            .zip(&self.mips)
             .zip(&needed)
-            .map(|((t, m), &need)| need.then(|| m.get_or_init(|| mip::build_chain(t)).as_slice()))
+            .map(|(t, &need)| need.then(|| t.mip_chain(mip::build_chain)))
             .collect()
     }
+}
+
+/// A mesh's object-space BVH and bounds.
+fn bvh_of(m: &Mesh) -> (Bvh, (Vec3, Vec3)) {
+    (Bvh::build(&m.positions, &m.triangles), m.bounds())
 }
 
 /// The data-pass buffer in band-sized chunks, or an empty chunk per band

@@ -6,6 +6,7 @@
 //! line overlay drawn after the bands, and an image reused across sizes.
 
 use crate::common;
+use softraster::render::Shot;
 
 use common::{load_with, scene_in, scratch};
 use softraster::output::{Image8, resolve};
@@ -18,8 +19,8 @@ fn same_bytes(scene: &Scene, frames: &[u32], image: &mut Image8, what: &str) {
     let r = Renderer::new(scene);
     for &f in frames {
         let (mut a, mut b) = (Frame::new(0, 0), Frame::new(0, 0));
-        r.render(scene, 0, f, &mut a);
-        r.render_display(scene, 0, f, &mut b, image);
+        r.render(Shot::new(0, f), &mut a).unwrap();
+        r.render_display(Shot::new(0, f), &mut b, image).unwrap();
         let bits = |fr: &Frame| -> Vec<u32> {
             fr.color
                 .iter()
@@ -175,10 +176,11 @@ fn a_sequence_of_frames_equals_fresh_frames() {
     let mut image = Image8::empty();
     let same = |scene: &Scene, seq: &mut FrameSequence, image: &mut Image8, f: u32, what: &str| {
         let r = Renderer::new(scene);
-        r.render_next(scene, 0, f, seq, Some(image));
+        r.render_next(Shot::new(0, f), seq, Some(image)).unwrap();
         let mut fresh = Frame::new(0, 0);
         let mut want = Image8::empty();
-        r.render_display(scene, 0, f, &mut fresh, &mut want);
+        r.render_display(Shot::new(0, f), &mut fresh, &mut want)
+            .unwrap();
         let got = seq.frame();
         assert_eq!(got.color.len(), fresh.color.len(), "{what}");
         for (i, (a, b)) in got.color.iter().zip(&fresh.color).enumerate() {

@@ -4,6 +4,7 @@
 //! vertex through the frame's draw list and pixel by pixel in renders.
 
 use crate::common;
+use softraster::render::Shot;
 
 use base64::Engine;
 use glam::Vec3;
@@ -431,7 +432,7 @@ fn a_renderer_kept_across_frames_draws_what_fresh_ones_do() {
     let kept = softraster::render::Renderer::new(&scene);
     let mut out = softraster::render::Frame::new(0, 0);
     for frame in [0u32, 4, 5] {
-        kept.render(&scene, 0, frame, &mut out);
+        kept.render(Shot::new(0, frame), &mut out).unwrap();
         let fresh = common::render_frame(&scene, 0, frame);
         assert!(
             out.color == fresh.color,

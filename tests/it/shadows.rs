@@ -3,6 +3,7 @@
 //! grazing light, peter-panning at contact, SSAO halos).
 
 use crate::common;
+use softraster::render::Shot;
 
 use std::path::Path;
 
@@ -691,7 +692,7 @@ fn shadow_maps_reused_across_frames_match_maps_rendered_afresh() {
         let mut frames = Vec::new();
         for f in 0..4 {
             let mut out = Frame::new(0, 0);
-            shared.render(&scene, 0, f, &mut out);
+            shared.render(Shot::new(0, f), &mut out).unwrap();
             let fresh = render_frame(&scene, 0, f);
             assert!(
                 out.color == fresh.color,

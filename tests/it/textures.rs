@@ -3,6 +3,7 @@
 //! tangent- against object-space maps, cutout and blended opacity.
 
 use crate::common;
+use softraster::render::Shot;
 
 use common::render_frame;
 use glam::{Vec3, Vec4};
@@ -294,17 +295,24 @@ fn mip_chains_are_built_only_for_minified_textures() {
             ],
         );
         let renderer = Renderer::new(&s);
-        assert!(!renderer.has_mips(0));
-        renderer.render(&s, 0, 0, &mut Frame::new(0, 0));
-        assert_eq!(renderer.has_mips(0), minified, "{size}x{size} on 32x32");
+        assert!(!s.textures[0].has_mip_chain());
+        renderer
+            .render(Shot::new(0, 0), &mut Frame::new(0, 0))
+            .unwrap();
+        assert_eq!(
+            s.textures[0].has_mip_chain(),
+            minified,
+            "{size}x{size} on 32x32"
+        );
     }
 }
 
-/// The renderer keeps BVHs and mip chains across frames; a frame must not
-/// depend on which frames it rendered before, nor on whether the renderer
-/// was made for this scene's assets.
+/// The renderer keeps BVHs, shadow maps and the environment across
+/// frames, and the textures keep their mip chains: a frame must not
+/// depend on which frames were rendered before.
 #[test]
 fn render_state_carried_across_frames_changes_no_pixel() {
+    use softraster::render::Shot;
     use softraster::scene::{LoadOptions, Scene};
     let root = common::root();
     let sets = [
@@ -319,27 +327,48 @@ fn render_state_carried_across_frames_changes_no_pixel() {
         sets: sets.iter().map(|s| s.parse().unwrap()).collect(),
         ..Default::default()
     };
-    let scene = Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
-    let frame = |r: &Renderer, s: &Scene, f: u32| {
+    let load = || Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
+    let frame = |r: &Renderer, f: u32| {
         let mut out = Frame::new(0, 0);
-        r.render(s, 0, f, &mut out);
+        r.render(Shot::new(0, f), &mut out).unwrap();
         out
     };
+    let scene = load();
     let warm = Renderer::new(&scene);
     for f in 0..3 {
-        frame(&warm, &scene, f);
+        frame(&warm, f);
     }
     // The frames minified some texture: a chain is carried over.
-    assert!((0..scene.textures.len()).any(|t| warm.has_mips(t)));
-    let after = frame(&warm, &scene, 5);
-    let fresh = frame(&Renderer::new(&scene), &scene, 5);
-    assert_eq!(after.color, fresh.color);
-    assert_eq!(after.ao, fresh.ao);
-    // A renderer made for other assets renders this scene all the same.
-    let other = Scene::load(&root.join("scenes/showcase.toml"), &opts).unwrap();
-    let foreign = frame(&Renderer::new(&other), &scene, 5);
-    assert_eq!(foreign.color, fresh.color);
-    assert_eq!(foreign.depth, fresh.depth);
+    assert!(scene.textures.iter().any(|t| t.has_mip_chain()));
+    let after = frame(&warm, 5);
+    // A new renderer of the same scene (its textures keep their chains),
+    // and one of the scene loaded again (nothing built yet).
+    let again = frame(&Renderer::new(&scene), 5);
+    let other = load();
+    assert!(!other.textures.iter().any(|t| t.has_mip_chain()));
+    let fresh = frame(&Renderer::new(&other), 5);
+    for f in [&again, &fresh] {
+        assert_eq!(after.color, f.color);
+        assert_eq!(after.depth, f.depth);
+        assert_eq!(after.ao, f.ao);
+    }
+}
+
+/// A camera the scene does not have is an error naming it, not a panic.
+#[test]
+fn a_camera_out_of_range_is_an_error() {
+    use softraster::render::Shot;
+    let dir = scratch("camera_out_of_range");
+    let s = scene_in(
+        &dir,
+        &format!("{TOP_DOWN}[[model]]\npath = \"quad.obj\"\n"),
+        &[("quad.obj", QUAD), ("quad.mtl", "newmtl m\nKd 1 1 1\n")],
+    );
+    let e = Renderer::new(&s)
+        .render(Shot::new(3, 0), &mut Frame::new(0, 0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("camera 3") && e.contains("1 camera"), "{e}");
 }
 
 /// The centre of a square facing +Z with MTL `mtl`, seen head-on under the

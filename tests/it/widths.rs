@@ -31,13 +31,7 @@ fn same_at_every_width(scene: &Scene, frames: &[u32], what: &str) {
     let single = Renderer::new(scene).with_lane_width(1);
     for &width in &softraster::simd::widths()[1..] {
         let lanes = Renderer::new(scene).with_lane_width(width);
-        same_frames(
-            scene,
-            &lanes,
-            &single,
-            frames,
-            &format!("{what}, {width} lanes"),
-        );
+        same_frames(&lanes, &single, frames, &format!("{what}, {width} lanes"));
     }
 }
 

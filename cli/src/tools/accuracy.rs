@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use softraster::error::Error;
 use softraster::output;
-use softraster::render::{Frame, Renderer};
+use softraster::render::{Frame, Renderer, Shot};
 use softraster::scene::Scene;
 use softraster::scene::assemble::LoadOptions;
 
@@ -31,7 +31,7 @@ fn load(dir: &Path, text: &str) -> Result<Scene, Error> {
 }
 
 /// Renders frames `frames` of `scene`: the frames and the median time.
-fn timed(scene: &Scene, frames: &[u32]) -> (Vec<Frame>, f64) {
+fn timed(scene: &Scene, frames: &[u32]) -> Result<(Vec<Frame>, f64), Error> {
     let mut out = Vec::new();
     let mut times = Vec::new();
     // One buffer, as a render job reuses it; copies kept for comparison.
@@ -39,13 +39,13 @@ fn timed(scene: &Scene, frames: &[u32]) -> (Vec<Frame>, f64) {
     let renderer = Renderer::new(scene);
     for &f in frames {
         let t = Instant::now();
-        renderer.render(scene, 0, f, &mut frame);
+        renderer.render(Shot::new(0, f), &mut frame)?;
         let _ = output::resolve(&frame, &scene.settings);
         times.push(t.elapsed().as_secs_f64() * 1e3);
         out.push(frame.clone());
     }
     times.sort_by(f64::total_cmp);
-    (out, times[times.len() / 2])
+    Ok((out, times[times.len() / 2]))
 }
 
 /// diablo3 standing on the tinyrenderer floor, lit by one directional
@@ -72,8 +72,8 @@ pub fn shadows(assets: &Path, size: u32, frames: &[u32]) -> Result<Vec<Row>, Err
     let dir = assets.to_path_buf();
     let text = diablo3_scene(assets, size);
     let scene = |render: &str| load(&dir, &text.replace("{render}", render));
-    let (reference, rt_ms) = timed(&scene("shadows = \"raytraced\"")?, frames);
-    let (_, off_ms) = timed(&scene("shadows = \"off\"")?, frames);
+    let (reference, rt_ms) = timed(&scene("shadows = \"raytraced\"")?, frames)?;
+    let (_, off_ms) = timed(&scene("shadows = \"off\"")?, frames)?;
     let mut rows = vec![Row {
         method: "off (no shadow pass)".into(),
         ms: off_ms,
@@ -83,7 +83,7 @@ pub fn shadows(assets: &Path, size: u32, frames: &[u32]) -> Result<Vec<Row>, Err
     for filter in ["hard", "pcf"] {
         for map in [1024, 2048, 4096] {
             let s = scene(&format!("shadows = \"{filter}\"\nshadow_map_size = {map}"))?;
-            let (got, ms) = timed(&s, frames);
+            let (got, ms) = timed(&s, frames)?;
             let (mae, off) = color_error(&got, &reference, &s);
             rows.push(Row {
                 method: format!("{filter} {map}"),
@@ -140,8 +140,8 @@ pub fn ao(
         let (text, radius) = ao_scene(&dir, &assets.join(model), eye, size)?;
         let scene = |ao: &str| load(&dir, &text.replace("{ao}", ao));
         let rt = |n: u32| format!("{{ method = \"raytraced\", samples = {n}, radius = {radius} }}");
-        let (reference, ref_ms) = timed(&scene(&rt(reference_samples))?, frames);
-        let (_, off_ms) = timed(&scene("{ method = \"off\" }")?, frames);
+        let (reference, ref_ms) = timed(&scene(&rt(reference_samples))?, frames)?;
+        let (_, off_ms) = timed(&scene("{ method = \"off\" }")?, frames)?;
         let mut rows = vec![Row {
             method: "off".into(),
             ms: off_ms,
@@ -161,7 +161,7 @@ pub fn ao(
             methods.push((format!("raytraced {n}"), rt(n)));
         }
         for (label, ao) in methods {
-            let (got, ms) = timed(&scene(&ao)?, frames);
+            let (got, ms) = timed(&scene(&ao)?, frames)?;
             let (rmse, worst) = ao_error(got.iter().zip(&reference));
             rows.push(Row {
                 method: label,
@@ -358,7 +358,7 @@ pub fn edges(
     let scene = |render: &str| load(dir, &text.replace("{render}", render));
     let frames = vec![0; runs.max(1)];
     let reference_scene = scene("ssaa = 16")?;
-    let (reference, _) = timed(&reference_scene, &[0]);
+    let (reference, _) = timed(&reference_scene, &[0])?;
     let reference_img = output::resolve(&reference[0], &reference_scene.settings);
     let save = |name: &str, img: &output::Image8| -> Result<(), Error> {
         match images {
@@ -379,7 +379,7 @@ pub fn edges(
     ];
     for (name, render) in methods {
         let s = scene(render)?;
-        let (got, ms) = timed(&s, &frames);
+        let (got, ms) = timed(&s, &frames)?;
         let (mut abs, mut sq) = (0.0f64, 0.0f64);
         for (a, b) in got[0].color.iter().zip(&reference[0].color) {
             let d = (a.truncate() - b.truncate()).abs();

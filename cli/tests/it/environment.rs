@@ -541,16 +541,21 @@ fn keys_without_effect_warn_and_illum_0_takes_no_environment_light() {
 }
 
 #[test]
-fn a_renderer_does_not_keep_a_changed_intensity() {
-    use softraster::render::{Frame, Renderer};
+fn a_changed_intensity_is_not_served_from_the_lighting_cache() {
+    // The prefiltered lighting is cached per process (by image and
+    // parameters): the scene changed after a render takes a renderer of
+    // its own (the borrow forbids changing it under one), which must not
+    // get the first intensity's lighting.
+    use softraster::render::{Frame, Renderer, Shot};
     let dir = scratch("env_stale");
     write_env(&dir.join("env.exr"), 64, |_, _| [0.5; 3]);
     let mut s = load(&dir, &sphere_scene(&dir, [0.0, 0.0, 5.0], "", ""));
-    let r = Renderer::new(&s);
-    r.render(&s, 0, 0, &mut Frame::new(0, 0));
+    Renderer::new(&s)
+        .render(Shot::new(0, 0), &mut Frame::new(0, 0))
+        .unwrap();
     s.environment.as_mut().unwrap().intensity = 2.0;
     let mut f = Frame::new(0, 0);
-    r.render(&s, 0, 0, &mut f);
+    Renderer::new(&s).render(Shot::new(0, 0), &mut f).unwrap();
     // kd 0.6 under radiance 0.5 x 2.
     assert!(
         (f.color[32 * 64 + 32].x - 0.6).abs() < 0.003,
@@ -561,7 +566,7 @@ fn a_renderer_does_not_keep_a_changed_intensity() {
 
 #[test]
 fn prefilter_size_is_checked_and_changes_only_the_glossy_levels() {
-    use softraster::render::{Frame, Renderer};
+    use softraster::render::{Frame, Renderer, Shot};
     let dir = scratch("env_prefilter_size");
     // A sharp vertical bar of light toward -Z on a dark sky: a glossy
     // sphere seen from -Z shows it blurred by the roughness-0.2 level.
@@ -616,7 +621,7 @@ fn prefilter_size_is_checked_and_changes_only_the_glossy_levels() {
     let render = |keys: &str| {
         let s = load(&dir, &scene(keys));
         let mut f = Frame::new(0, 0);
-        Renderer::new(&s).render(&s, 0, 0, &mut f);
+        Renderer::new(&s).render(Shot::new(0, 0), &mut f).unwrap();
         f
     };
     let default = render("");
@@ -638,13 +643,15 @@ fn prefilter_size_is_checked_and_changes_only_the_glossy_levels() {
         "{coarse} {fine} {finer}"
     );
 
-    // A renderer kept across a changed size prefilters again.
+    // The same image at another size is prefiltered again, not served
+    // from the lighting cache.
     let mut s = load(&dir, &scene("prefilter_size = 16"));
-    let r = Renderer::new(&s);
-    r.render(&s, 0, 0, &mut Frame::new(0, 0));
+    Renderer::new(&s)
+        .render(Shot::new(0, 0), &mut Frame::new(0, 0))
+        .unwrap();
     s.environment.as_mut().unwrap().prefilter_size = 128;
     let mut f = Frame::new(0, 0);
-    r.render(&s, 0, 0, &mut f);
+    Renderer::new(&s).render(Shot::new(0, 0), &mut f).unwrap();
     assert_eq!(f.color, default.color);
 }
 

@@ -18,7 +18,7 @@ use softraster::scene::Scene;
 /// Frames `frames` of camera 0 with and without light culling.
 fn same_both_ways(scene: &Scene, frames: &[u32], what: &str) {
     let all = Renderer::new(scene).with_light_culling(false);
-    same_frames(scene, &Renderer::new(scene), &all, frames, what);
+    same_frames(&Renderer::new(scene), &all, frames, what);
 }
 
 /// 60 point lights with ranges in a grid over the showcase's ground, 8

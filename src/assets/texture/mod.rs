@@ -66,14 +66,13 @@ pub struct Level {
 pub struct Texture {
     pub width: u32,
     pub height: u32,
-    /// Level 0, as decoded. Levels 1.. (`mip::build_chain`) belong to
-    /// the renderer, which builds them when a frame first minifies the
-    /// texture and hands them to the lookups (`Filtering::mips`).
+    /// Level 0, as decoded. Levels 1.. (`chain`) are handed to the
+    /// lookups by the frames that minify the texture (`Filtering::mips`).
     base: Level,
     /// Color data stored sRGB-encoded (decoded to linear on fetch).
     pub srgb: bool,
-    /// Index in the scene's texture list (the renderer keeps this
-    /// texture's mip chain under it).
+    /// Index in the scene's texture list (a frame's chains are listed
+    /// under it).
     pub id: usize,
     /// Some texel has alpha below 255.
     pub has_alpha: bool,
@@ -82,9 +81,11 @@ pub struct Texture {
     pub binary_alpha: f32,
     /// Every texel has R = G = B (a height map rather than a normal map).
     pub grey: bool,
-    /// Levels 1.. read from the texture cache (`--cache`), which
-    /// `mip::build_chain` hands over instead of building them.
-    cached_chain: std::sync::Mutex<Option<Vec<Level>>>,
+    /// Levels 1.. of the mip chain: built the first time a frame minifies
+    /// the texture (`mip_chain`), or read with it from the texture cache
+    /// (`--cache`). Kept with the texture, so every renderer of every scene
+    /// that holds it shares one chain.
+    chain: std::sync::OnceLock<Vec<Level>>,
 }
 
 /// A data texel as `[b as f32 * (1.0 / 255.0); 4]`: on x86-64 the four
@@ -385,19 +386,27 @@ impl Texture {
                 hard as f32 / partial as f32
             },
             grey,
-            cached_chain: Default::default(),
+            chain: Default::default(),
         }
     }
 
-    /// With levels 1.. already built (`chain`), for `mip::build_chain`.
+    /// With levels 1.. already built (`chain`), as the texture cache
+    /// reads them.
     pub fn with_cached_chain(self, chain: Vec<Level>) -> Texture {
-        *self.cached_chain.lock().unwrap_or_else(|e| e.into_inner()) = Some(chain);
+        let _ = self.chain.set(chain);
         self
     }
 
-    /// The mip chain read from the texture cache, once (None otherwise).
-    pub fn take_cached_chain(&self) -> Option<Vec<Level>> {
-        self.cached_chain.lock().map_or(None, |mut c| c.take())
+    /// Levels 1.. of the mip chain (empty for a 1x1 texture): the chain
+    /// this texture holds, else made by `build` (`mip::build_chain`) now
+    /// and kept.
+    pub fn mip_chain(&self, build: impl FnOnce(&Texture) -> Vec<Level>) -> &[Level] {
+        self.chain.get_or_init(|| build(self))
+    }
+
+    /// Whether the texture holds its mip chain yet.
+    pub fn has_mip_chain(&self) -> bool {
+        self.chain.get().is_some()
     }
 
     /// The texture and its levels 1.. (`chain`) as a texture-cache entry:
@@ -494,7 +503,7 @@ impl Texture {
             has_alpha: flags[1] == 1,
             binary_alpha,
             grey: flags[2] == 1,
-            cached_chain: std::sync::Mutex::new((count > 1).then_some(chain)),
+            chain: chain.into(),
         })
     }
 

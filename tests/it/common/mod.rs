@@ -2,6 +2,7 @@
 //! line's tests include this file by path).
 #![allow(dead_code)]
 
+use softraster::render::Shot;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
 
@@ -12,7 +13,9 @@ use softraster::scene::assemble::LoadOptions;
 /// One frame of one camera, through the library's one entry for a frame.
 pub fn render_frame(scene: &Scene, camera: usize, frame: u32) -> Frame {
     let mut out = Frame::new(0, 0);
-    Renderer::new(scene).render(scene, camera, frame, &mut out);
+    Renderer::new(scene)
+        .render(Shot::new(camera, frame), &mut out)
+        .unwrap();
     out
 }
 
@@ -264,11 +267,11 @@ pub fn cube() -> Prim {
 /// equivalent paths (`a` and `b`); panics at the first pixel whose colour
 /// or depth differs in any bit, and where fewer than 100 pixels are
 /// covered (a comparison of empty frames would prove nothing).
-pub fn same_frames(scene: &Scene, a: &Renderer, b: &Renderer, frames: &[u32], what: &str) {
+pub fn same_frames(a: &Renderer, b: &Renderer, frames: &[u32], what: &str) {
     for &f in frames {
         let (mut x, mut y) = (Frame::new(0, 0), Frame::new(0, 0));
-        a.render(scene, 0, f, &mut x);
-        b.render(scene, 0, f, &mut y);
+        a.render(Shot::new(0, f), &mut x).unwrap();
+        b.render(Shot::new(0, f), &mut y).unwrap();
         assert_eq!(x.color.len(), y.color.len());
         let mut covered = 0;
         for (i, (p, q)) in x.color.iter().zip(&y.color).enumerate() {

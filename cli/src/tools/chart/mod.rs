@@ -26,7 +26,7 @@ use std::time::Instant;
 use crate::tools::compare::{Metric, score};
 use softraster::error::Error;
 use softraster::output::{self, Image8};
-use softraster::render::{Frame, Renderer};
+use softraster::render::{Frame, Renderer, Shot};
 use softraster::scene::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod};
 use softraster::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use softraster::scene::{AoSettings, Scene};
@@ -119,15 +119,19 @@ pub struct ChartOptions {
 
 /// Renders `frame` of `scene` up to `runs` times (fewer when a render takes
 /// seconds: at most about 4 s per setting after the first), timed; the
-/// last frame and its 8-bit image.
-fn timed(renderer: &Renderer, scene: &Scene, frame: u32, runs: usize) -> (Frame, Image8, Timing) {
+/// last frame and its 8-bit image. The setting's renderer is prepared
+/// first, untimed: mip chains (kept with the textures, so built once per
+/// sweep), BVHs and the environment are loading, not rendering.
+fn timed(scene: &Scene, frame: u32, runs: usize) -> Result<(Frame, Image8, Timing), Error> {
+    let renderer = Renderer::new(scene);
+    renderer.prepare();
     let mut f = Frame::new(0, 0);
     let mut times = Vec::new();
     let t_all = Instant::now();
     let mut img = None;
     while times.len() < runs.max(1) && (times.is_empty() || t_all.elapsed().as_secs_f64() < 4.0) {
         let t = Instant::now();
-        renderer.render(scene, 0, frame, &mut f);
+        renderer.render(Shot::new(0, frame), &mut f)?;
         img = Some(output::resolve(&f, &scene.settings));
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
@@ -139,20 +143,19 @@ fn timed(renderer: &Renderer, scene: &Scene, frame: u32, runs: usize) -> (Frame,
         runs: times.len(),
     };
     let img = img.unwrap_or_else(|| output::resolve(&f, &scene.settings));
-    (f, img, timing)
+    Ok((f, img, timing))
 }
 
 /// The reference setting measured like the others: rendered again,
 /// compared with the first render (deterministic rendering makes this 0),
 /// its time the median of both renders.
 fn reference_row(
-    renderer: &Renderer,
     scene: &Scene,
     opts: &ChartOptions,
     first: Timing,
     error: impl FnOnce(&Frame, &Image8) -> Result<f64, Error>,
 ) -> Result<(Timing, f64), Error> {
-    let (f, img, t) = timed(renderer, scene, opts.frame, 1);
+    let (f, img, t) = timed(scene, opts.frame, 1)?;
     let (lo, hi) = (first.min_ms.min(t.min_ms), first.max_ms.max(t.max_ms));
     let time = Timing {
         median_ms: (first.median_ms + t.median_ms) * 0.5,
@@ -251,8 +254,8 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
         )));
     }
     // Mip chains up front: building them is loading, not rendering.
-    let renderer = Renderer::new(scene);
-    renderer.build_all_mips();
+    // They stay with the textures, which every setting's renderer shares.
+    Renderer::new(scene).build_all_mips();
     let original = scene.settings.clone();
     let original_lights = scene.lights.clone();
     let mut rows = Vec::new();
@@ -264,12 +267,12 @@ pub fn sweep(scene: &mut Scene, opts: &ChartOptions) -> Result<Vec<Row>, Error> 
                 scene.settings.ao.method = AoMethod::Off;
             }
             match knob {
-                Knob::Aa => sweep_aa(&renderer, scene, opts, &mut rows)?,
-                Knob::Texture => sweep_texture(&renderer, scene, opts, &mut rows)?,
-                Knob::Shadows => sweep_shadows(&renderer, scene, opts, &mut rows)?,
-                Knob::Ao => sweep_ao(&renderer, scene, opts, &mut rows)?,
+                Knob::Aa => sweep_aa(scene, opts, &mut rows)?,
+                Knob::Texture => sweep_texture(scene, opts, &mut rows)?,
+                Knob::Shadows => sweep_shadows(scene, opts, &mut rows)?,
+                Knob::Ao => sweep_ao(scene, opts, &mut rows)?,
                 Knob::Depth => sweep_depth(opts, &mut rows)?,
-                Knob::Env => sweep_env(&renderer, scene, opts, &mut rows)?,
+                Knob::Env => sweep_env(scene, opts, &mut rows)?,
             }
         }
         Ok(())
@@ -302,20 +305,13 @@ fn row(
     }
 }
 
-fn sweep_aa(
-    renderer: &Renderer,
-    scene: &mut Scene,
-    opts: &ChartOptions,
-    rows: &mut Vec<Row>,
-) -> Result<(), Error> {
+fn sweep_aa(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
     let k = reference_ssaa(scene, opts.quick);
     scene.settings.msaa = 1;
     scene.settings.ssaa = k;
-    let (_, reference, t) = timed(renderer, scene, opts.frame, 1);
+    let (_, reference, t) = timed(scene, opts.frame, 1)?;
     let against = format!("ssaa {k}x{k}");
-    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
-        flip(&reference, img, None)
-    })?;
+    let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference, img, None))?;
     rows.push(row(Knob::Aa, &against, false, true, t, e, &against));
     let settings: &[(u32, u32)] = if opts.quick {
         &[(1, 1), (4, 1), (1, 2)]
@@ -325,7 +321,7 @@ fn sweep_aa(
     for &(msaa, ssaa) in settings {
         scene.settings.msaa = msaa;
         scene.settings.ssaa = ssaa;
-        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+        let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
         let name = if ssaa > 1 {
             format!("ssaa {ssaa}x{ssaa}")
         } else {
@@ -345,12 +341,7 @@ fn sweep_aa(
     Ok(())
 }
 
-fn sweep_texture(
-    renderer: &Renderer,
-    scene: &mut Scene,
-    opts: &ChartOptions,
-    rows: &mut Vec<Row>,
-) -> Result<(), Error> {
+fn sweep_texture(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
     if scene.textures.is_empty() {
         return Ok(());
     }
@@ -360,9 +351,9 @@ fn sweep_texture(
     scene.settings.msaa = 1;
     scene.settings.texture_filter = TextureFilter::Anisotropic;
     scene.settings.max_anisotropy = 16.0;
-    let (reference_frame, reference, t) = timed(renderer, scene, opts.frame, 1);
+    let (reference_frame, reference, t) = timed(scene, opts.frame, 1)?;
     let against = format!("ssaa {k}x{k}, anisotropic 16");
-    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
+    let (t, e) = reference_row(scene, opts, t, |_, img| {
         flip(&reference, img, Some(&interior_mask(&reference_frame)))
     })?;
     rows.push(row(Knob::Texture, &against, false, true, t, e, &against));
@@ -387,7 +378,7 @@ fn sweep_texture(
     for &(filter, aniso, name) in settings {
         scene.settings.texture_filter = filter;
         scene.settings.max_anisotropy = aniso;
-        let (f, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+        let (f, img, t) = timed(scene, opts.frame, opts.runs)?;
         let m = mask.get_or_insert_with(|| interior_mask(&f));
         let e = flip(&reference, &img, Some(m))?;
         let default = filter == TextureFilter::Anisotropic && aniso == 16.0;
@@ -398,16 +389,11 @@ fn sweep_texture(
 
 /// Environment lighting, for scenes with an `[environment]`: the
 /// prefiltered split sum at several prefilter sizes (the sharpest glossy
-/// level 32 to 256 texels wide; each with a renderer of its own, warmed
+/// level 32 to 256 texels wide; each with a renderer of its own, prepared
 /// first, so the time is per frame; the one-off prefiltering time goes to
 /// standard error) and sampled estimates of 4 to 64 direction pairs,
 /// against the sampled reference (256 pairs; 64 with `quick`).
-fn sweep_env(
-    renderer: &Renderer,
-    scene: &mut Scene,
-    opts: &ChartOptions,
-    rows: &mut Vec<Row>,
-) -> Result<(), Error> {
+fn sweep_env(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
     let Some(original) = scene
         .environment
         .as_ref()
@@ -423,11 +409,9 @@ fn sweep_env(
     };
     let reference = if opts.quick { 64 } else { 256 };
     set(scene, EnvMethod::Sampled { samples: reference }, original.1);
-    let (_, reference_img, t) = timed(renderer, scene, opts.frame, 1);
+    let (_, reference_img, t) = timed(scene, opts.frame, 1)?;
     let against = format!("sampled {reference}");
-    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
-        flip(&reference_img, img, None)
-    })?;
+    let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference_img, img, None))?;
     rows.push(row(Knob::Env, &against, false, true, t, e, &against));
     let sizes: &[u32] = if opts.quick {
         &[64, 128]
@@ -441,10 +425,7 @@ fn sweep_env(
             let _ = EnvLight::with_size(&e.image, e.intensity, e.rotation, size);
             t.elapsed().as_secs_f64() * 1e3
         });
-        let own = Renderer::new(scene);
-        let mut warm = Frame::new(0, 0);
-        own.render(scene, 0, opts.frame, &mut warm);
-        let (_, img, t) = timed(&own, scene, opts.frame, opts.runs);
+        let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
         let e = flip(&reference_img, &img, None)?;
         // Once per run, not per frame: printed beside the table (the
         // setting's name stays the same from run to run).
@@ -462,7 +443,7 @@ fn sweep_env(
     let counts: &[u32] = if opts.quick { &[4, 16] } else { &[4, 16, 64] };
     for &samples in counts {
         set(scene, EnvMethod::Sampled { samples }, original.1);
-        let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+        let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
         let e = flip(&reference_img, &img, None)?;
         rows.push(row(
             Knob::Env,
@@ -478,12 +459,7 @@ fn sweep_env(
     Ok(())
 }
 
-fn sweep_shadows(
-    renderer: &Renderer,
-    scene: &mut Scene,
-    opts: &ChartOptions,
-    rows: &mut Vec<Row>,
-) -> Result<(), Error> {
+fn sweep_shadows(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
     if scene.lights.is_empty() {
         return Ok(());
     }
@@ -498,11 +474,9 @@ fn sweep_shadows(
         " (all lights made to cast)"
     };
     scene.settings.shadows = ShadowMethod::Raytraced;
-    let (_, reference, t) = timed(renderer, scene, opts.frame, opts.runs);
+    let (_, reference, t) = timed(scene, opts.frame, opts.runs)?;
     let against = format!("raytraced{note}");
-    let (t, e) = reference_row(renderer, scene, opts, t, |_, img| {
-        flip(&reference, img, None)
-    })?;
+    let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference, img, None))?;
     rows.push(row(Knob::Shadows, "raytraced", true, true, t, e, &against));
     let sizes: &[u32] = if opts.quick {
         &[512, 2048]
@@ -513,7 +487,7 @@ fn sweep_shadows(
         for &size in sizes {
             scene.settings.shadows = method;
             scene.settings.shadow_map_size = size;
-            let (_, img, t) = timed(renderer, scene, opts.frame, opts.runs);
+            let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
             let e = flip(&reference, &img, None)?;
             rows.push(row(
                 Knob::Shadows,
@@ -529,12 +503,7 @@ fn sweep_shadows(
     Ok(())
 }
 
-fn sweep_ao(
-    renderer: &Renderer,
-    scene: &mut Scene,
-    opts: &ChartOptions,
-    rows: &mut Vec<Row>,
-) -> Result<(), Error> {
+fn sweep_ao(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
     let r = scene
         .settings
         .ao
@@ -555,11 +524,11 @@ fn sweep_ao(
             radius: Some(radius),
             samples: rays,
         };
-        let (reference, _, t) = timed(renderer, scene, opts.frame, 1);
+        let (reference, _, t) = timed(scene, opts.frame, 1)?;
         let noise = crate::tools::accuracy::ao_noise_bound(&reference, rays);
         let against =
             format!("raytraced {rays} rays, radius {radius:.4} (noise RMSE below {noise:.4})");
-        let (t, e) = reference_row(renderer, scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;
+        let (t, e) = reference_row(scene, opts, t, |f, _| Ok(ao_rmse(f, &reference)))?;
         rows.push(row(
             Knob::Ao,
             format!("raytraced {rays} r{scale}"),
@@ -582,7 +551,7 @@ fn sweep_ao(
                 radius: Some(radius),
                 samples: n,
             };
-            let (f, _, t) = timed(renderer, scene, opts.frame, opts.runs);
+            let (f, _, t) = timed(scene, opts.frame, opts.runs)?;
             let e = ao_rmse(&f, &reference);
             let ssao = method == AoMethod::Gtao;
             let default =
@@ -657,7 +626,7 @@ fn sweep_depth(opts: &ChartOptions, rows: &mut Vec<Row>) -> Result<(), Error> {
         ] {
             let scene = depth_scene(&dir, name)?;
             debug_assert_eq!(scene.settings.depth, mode);
-            let (f, _, t) = timed(&Renderer::new(&scene), &scene, 0, opts.runs);
+            let (f, _, t) = timed(&scene, 0, opts.runs)?;
             let (mut red, mut green) = (0usize, 0usize);
             for c in &f.color {
                 if c.x > 0.5 && c.y < 0.5 {
