@@ -8,7 +8,7 @@
 
 use std::sync::OnceLock;
 
-/// The sRGB decoding curve: encoded [0,1] -> linear [0,1].
+/// The sRGB decoding curve: encoded \[0, 1\] -> linear \[0, 1\].
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
@@ -17,7 +17,7 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// The sRGB encoding curve: linear [0,1] -> encoded [0,1].
+/// The sRGB encoding curve: linear \[0, 1\] -> encoded \[0, 1\].
 pub fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 {
         c * 12.92
@@ -110,7 +110,7 @@ impl Segments {
     }
 }
 
-/// Linear [0,1] -> sRGB byte (clamped; NaN gives 0): the byte of the
+/// Linear \[0, 1\] -> sRGB byte (clamped; NaN gives 0): the byte of the
 /// nearest of 64K evenly spaced values, accurate to a twentieth of a code.
 #[inline]
 pub fn encode_srgb(v: f32) -> u8 {
@@ -170,7 +170,7 @@ pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
     [byte(0), byte(1), byte(2)]
 }
 
-/// [0,1] -> byte without transfer curve (data: normals, depth, alpha).
+/// \[0, 1\] -> byte without transfer curve (data: normals, depth, alpha).
 #[inline]
 pub fn encode_linear(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8

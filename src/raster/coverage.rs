@@ -531,7 +531,7 @@ impl Drop for Visibility {
 }
 
 /// Whether depth `z` is in front of the stored depth `stored` (z outside
-/// [0,1] only comes from rounding at clipped edges and never passes).
+/// \[0, 1\] only comes from rounding at clipped edges and never passes).
 #[inline]
 pub fn in_front(z: f32, stored: f32, reverse_z: bool) -> bool {
     (0.0..=1.0).contains(&z) && if reverse_z { z > stored } else { z < stored }

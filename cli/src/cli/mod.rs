@@ -140,7 +140,7 @@ struct ChartArgs {
     /// The frame to measure.
     #[arg(long, default_value_t = 0)]
     frame: u32,
-    /// Where chart.csv, chart.png and chart.svg go (default out/<stem>-chart).
+    /// Where chart.csv, chart.png and chart.svg go (default `out/<stem>-chart`).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Timed renders per setting (fewer for settings that take seconds).
