@@ -2,7 +2,7 @@
 //!
 //! Data flows one way: scene file ([`scene::desc`]) -> loaded
 //! [`scene::Scene`] ([`scene::assemble`]) -> per-frame draw list
-//! ([`render::FrameSetup`]) -> the frame's passes ([`render`]: vertex,
+//! ([`render::DrawList`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
 //! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
 //! frame by [`batch`]. [`color`], [`error`], [`raster`], [`simd`] and the

@@ -11,7 +11,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use libfuzzer_sys::fuzz_target;
-use softraster::batch::{FramePlan, RenderJob};
+use softraster::batch::{RenderPlan, RenderJob};
 use softraster::scene::{LoadOptions, Scene};
 
 /// A basic string, quoted (TOML and JSON escape alike here).
@@ -94,7 +94,7 @@ fuzz_target!(|data: &[u8]| {
         assert_eq!(files(&root), before, "a refused scene wrote files");
         return;
     };
-    let Ok(plan) = FramePlan::select(&scene, None, None) else {
+    let Ok(plan) = RenderPlan::select(&scene, None, None) else {
         return;
     };
     let mut job = RenderJob::all(scene);

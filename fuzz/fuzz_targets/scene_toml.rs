@@ -16,7 +16,7 @@ fuzz_target!(|data: &[u8]| {
     };
     let path = common::dir().join("scene.toml");
     if let Ok(scene) = Scene::from_text(&path, text, &LoadOptions::plain()) {
-        if let Ok(plan) = softraster::batch::FramePlan::select(&scene, None, None) {
+        if let Ok(plan) = softraster::batch::RenderPlan::select(&scene, None, None) {
             for &f in plan.frames.iter().take(2) {
                 let _ = softraster::scene::expand_pattern(&scene.output.name, "s", "c", f);
             }

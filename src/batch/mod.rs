@@ -18,11 +18,11 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use encoders::VideoFrame;
-pub use plan::{FramePlan, parse_frames};
+pub use plan::{RenderPlan, parse_frames};
 use writer::ToWriter;
 
 use crate::error::Error;
-pub use crate::output::FrameFiles;
+pub use crate::output::OutputFiles;
 use crate::output::{self, Image8};
 use crate::render::{FrameSequence, Renderer, Shot};
 use crate::scene::Scene;
@@ -31,14 +31,14 @@ pub struct RenderJob {
     /// With `render.exposure = "auto"` resolved to stops (`all`).
     scene: Scene,
     /// Which frames of which cameras, and the files each writes.
-    pub plan: FramePlan,
+    pub plan: RenderPlan,
     /// Frames whose files all exist already are not rendered again.
     pub skip_existing: bool,
 }
 
 /// Reported once per finished (written, or skipped) frame and camera.
 #[derive(Debug, Clone)]
-pub struct FrameDone {
+pub struct ShotDone {
     pub frame: u32,
     pub camera: String,
     pub files: Vec<PathBuf>,
@@ -84,7 +84,7 @@ impl RenderJob {
             scene.settings.auto_exposure = false;
         }
         RenderJob {
-            plan: FramePlan::all(&scene),
+            plan: RenderPlan::all(&scene),
             scene,
             skip_existing: false,
         }
@@ -98,7 +98,7 @@ impl RenderJob {
     /// Renders and writes everything; calls `on_done` as frames land. The
     /// videos are encoded as the frames land; then each camera's GIF is
     /// written. Both need the job to cover every frame of the animation.
-    pub fn run(&self, on_done: impl FnMut(&FrameDone)) -> Result<JobSummary, Error> {
+    pub fn run(&self, on_done: impl FnMut(&ShotDone)) -> Result<JobSummary, Error> {
         let mut summary = JobSummary::default();
         let plan = &self.plan;
         let total = plan.total_frames;
@@ -149,7 +149,7 @@ impl RenderJob {
     fn render_frames(
         &self,
         videos: bool,
-        mut on_done: impl FnMut(&FrameDone),
+        mut on_done: impl FnMut(&ShotDone),
     ) -> Result<Vec<PathBuf>, Error> {
         let scene = &self.scene;
         let plan = &self.plan;
@@ -160,10 +160,10 @@ impl RenderJob {
             fps: scene.output.video_fps,
             quality: scene.output.video_quality,
         };
-        let (done_tx, done_rx) = mpsc::channel::<Result<FrameDone, Error>>();
+        let (done_tx, done_rx) = mpsc::channel::<Result<ShotDone, Error>>();
         let (to_writer, writer) = writer::spawn(video_paths, video_opts, done_tx);
         let mut result = Ok(());
-        let drain = |block: bool, on_done: &mut dyn FnMut(&FrameDone)| -> Result<(), Error> {
+        let drain = |block: bool, on_done: &mut dyn FnMut(&ShotDone)| -> Result<(), Error> {
             loop {
                 let msg = if block {
                     done_rx.recv().ok()
@@ -187,7 +187,7 @@ impl RenderJob {
                 // A skipped frame's video frame is read back from its PNG.
                 let can_skip = !in_video || files.color.is_some();
                 if self.skip_existing && can_skip && files.all().iter().all(|f| f.is_file()) {
-                    let done = FrameDone {
+                    let done = ShotDone {
                         frame,
                         camera,
                         files: files.all(),
@@ -215,7 +215,7 @@ impl RenderJob {
                     break 'frames;
                 }
                 let (outputs, color) = output::pack(buffer.frame(), image, files, in_video);
-                let done = FrameDone {
+                let done = ShotDone {
                     frame,
                     camera,
                     files: outputs.iter().map(|o| o.path().to_path_buf()).collect(),

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::output::FrameFiles;
+use crate::output::OutputFiles;
 use crate::scene::{Scene, expand_pattern};
 
 /// Frame selection for `--frames`: `a..b` (half-open), `a..` (to the end),
@@ -63,7 +63,7 @@ pub fn parse_frames(s: &str, total: u32) -> Result<Vec<u32>, Error> {
 /// frame writes: `--frames` and `--camera` choose, and the writers,
 /// `--skip-existing` and the GIF read their file names from here only.
 #[derive(Debug, Clone)]
-pub struct FramePlan {
+pub struct RenderPlan {
     /// Frame numbers, in the order they are rendered.
     pub frames: Vec<u32>,
     /// Indices into `scene.cameras`.
@@ -91,10 +91,10 @@ struct Naming {
     video: Option<String>,
 }
 
-impl FramePlan {
+impl RenderPlan {
     /// Every frame of every camera.
-    pub fn all(scene: &Scene) -> FramePlan {
-        FramePlan {
+    pub fn all(scene: &Scene) -> RenderPlan {
+        RenderPlan {
             frames: (0..scene.animation.frames).collect(),
             cameras: (0..scene.cameras.len()).collect(),
             total_frames: scene.animation.frames,
@@ -122,8 +122,8 @@ impl FramePlan {
         scene: &Scene,
         frames: Option<&str>,
         camera: Option<&str>,
-    ) -> Result<FramePlan, Error> {
-        let mut plan = FramePlan::all(scene);
+    ) -> Result<RenderPlan, Error> {
+        let mut plan = RenderPlan::all(scene);
         if let Some(f) = frames {
             plan.frames = parse_frames(f, plan.total_frames)?;
         }
@@ -155,11 +155,11 @@ impl FramePlan {
     }
 
     /// The files frame `frame` of camera `cam` writes.
-    pub fn files(&self, cam: usize, frame: u32) -> FrameFiles {
+    pub fn files(&self, cam: usize, frame: u32) -> OutputFiles {
         let n = &self.naming;
         let stem = expand_pattern(&n.pattern, &n.stem, &n.cameras[cam], frame);
         let file = |on: bool, suffix: &str| on.then(|| n.dir.join(format!("{stem}{suffix}")));
-        FrameFiles {
+        OutputFiles {
             color: file(n.color, ".png"),
             depth: file(n.depth, "_depth.exr"),
             ao: file(n.ao, "_ao.exr"),
@@ -231,19 +231,19 @@ mod tests {
         let two =
             "[[camera]]\nname = \"front\"\n[[camera]]\nname = \"side\"\neye = [5.0, 0.0, 0.0]\n";
         let s = scene(two);
-        let all = FramePlan::all(&s);
+        let all = RenderPlan::all(&s);
         assert_eq!(
             (all.frames.len(), all.cameras.clone(), all.total()),
             (12, vec![0, 1], 24)
         );
         assert!(all.covers_animation());
-        let p = FramePlan::select(&s, Some("1-3,10.."), Some("side")).unwrap();
+        let p = RenderPlan::select(&s, Some("1-3,10.."), Some("side")).unwrap();
         assert_eq!(p.frames, vec![1, 2, 3, 10, 11]);
         assert_eq!((p.cameras.clone(), p.camera_name(1)), (vec![1], "side"));
         assert!(!p.covers_animation());
-        let e = FramePlan::select(&s, None, Some("top")).unwrap_err();
+        let e = RenderPlan::select(&s, None, Some("top")).unwrap_err();
         assert_eq!(e.to_string(), "--camera top: the scene has front, side");
-        assert!(FramePlan::select(&s, Some("11..13"), None).is_err());
+        assert!(RenderPlan::select(&s, Some("11..13"), None).is_err());
     }
 
     #[test]
@@ -251,7 +251,7 @@ mod tests {
         let s = scene(
             "[output]\nname = \"{scene}-{camera}-{frame:03}\"\ndepth = true\ngif = \"t.gif\"\n",
         );
-        let p = FramePlan::all(&s);
+        let p = RenderPlan::all(&s);
         let f = p.files(0, 7);
         let dir = &s.output.dir;
         assert_eq!(f.color, Some(dir.join("shot-camera-007.png")));
@@ -269,7 +269,7 @@ mod tests {
         let s = scene(
             "[output]\ngif = \"t.gif\"\n[[camera]]\nname = \"a\"\n[[camera]]\nname = \"b\"\neye = [5.0, 0.0, 0.0]\n",
         );
-        let p = FramePlan::all(&s);
+        let p = RenderPlan::all(&s);
         assert_eq!(p.gif_path(1), Some(s.output.dir.join("t_b.gif")));
         assert_eq!(p.files(1, 0).color, Some(s.output.dir.join("b_0000.png")));
     }

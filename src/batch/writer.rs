@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 
-use super::FrameDone;
+use super::ShotDone;
 use super::encoders::{VideoFrame, Videos};
 use crate::error::Error;
 use crate::output::{FileToWrite, video::VideoOptions};
@@ -14,7 +14,7 @@ use crate::output::{FileToWrite, video::VideoOptions};
 /// What the render loop sends the writer thread.
 pub(super) enum ToWriter {
     /// A frame's files, and its colour for the camera's video.
-    Frame(FrameDone, Vec<FileToWrite>, Option<VideoFrame>),
+    Frame(ShotDone, Vec<FileToWrite>, Option<VideoFrame>),
     /// Every frame was sent: finish the videos.
     Finish,
 }
@@ -27,7 +27,7 @@ pub(super) enum ToWriter {
 pub(super) fn spawn(
     paths: Vec<Option<PathBuf>>,
     opts: VideoOptions,
-    done: mpsc::Sender<Result<FrameDone, Error>>,
+    done: mpsc::Sender<Result<ShotDone, Error>>,
 ) -> (
     mpsc::SyncSender<ToWriter>,
     JoinHandle<Result<Vec<PathBuf>, Error>>,

@@ -4,13 +4,13 @@
 //! half-written frame under the final name.
 
 pub mod exr;
-mod frame_files;
 pub mod gif;
 pub mod ids;
+mod pack;
 pub mod png;
 pub mod video;
 
-pub use frame_files::{FileToWrite, FrameFiles, pack};
+pub use pack::{FileToWrite, OutputFiles, pack};
 
 /// Tone mapping lives with shading (`shade::tonemap`); its old path stays.
 pub use crate::shade::tonemap;

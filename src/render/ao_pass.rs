@@ -3,7 +3,7 @@
 //! BVHs. It runs between visibility and shading, which multiplies the
 //! ambient term by it.
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use crate::raytrace::Tracer;
 use crate::scene::settings::AoMethod;
 use crate::shade::ao::{self, AoView, GPixel};
@@ -11,7 +11,7 @@ use crate::shade::ao::{self, AoView, GPixel};
 /// Per pixel, 1 = unoccluded. `tracer`: the frame's ray tracer (needed
 /// for `AoMethod::Raytraced`, unused otherwise).
 pub(super) fn occlusion(
-    setup: &FrameSetup,
+    setup: &DrawList,
     gbuf: &[GPixel],
     width: u32,
     height: u32,

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::band::{InterpolatorCache, fragments};
-use super::fragment::FrameData;
+use super::fragment::BandInputs;
 use super::frame::AovPixel;
 use super::lanes::Pending;
 use crate::raster::coverage::{NO_TRIANGLE, Visibility};
@@ -14,7 +14,7 @@ use crate::raster::interp::Fragment;
 use crate::shade::lanes::{LaneMaterial, MAX_LANES};
 use crate::shade::light::LightMask;
 
-impl FrameData<'_> {
+impl BandInputs<'_> {
     /// The data passes of a band into `out`; the background and the
     /// ground shadow catcher are `AovPixel::EMPTY`.
     pub fn aovs(&self, vis: &Visibility, out: &mut [AovPixel]) {

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 use glam::Vec4;
 use rayon::prelude::*;
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use super::rays::CameraRays;
 use crate::scene::settings::Background;
 use crate::shade::env::EnvLight;
@@ -45,7 +45,7 @@ impl<'a> EnvBackground<'a> {
     /// The backdrop of the frame `setup` at `width` x `height` pixels, or
     /// None where the background is not the environment.
     pub fn new(
-        setup: &FrameSetup,
+        setup: &DrawList,
         env: Option<&'a EnvLight>,
         width: u32,
         height: u32,

@@ -17,7 +17,7 @@
 use glam::{Vec3, Vec4};
 
 use super::display::PlainBackground;
-use super::fragment::{FrameData, LANE_SLOT, PixelShare, Sink, resolve};
+use super::fragment::{BandInputs, LANE_SLOT, PixelShare, Sink, resolve};
 use super::lanes::{LaneBatches, Pending, QuadAt};
 use super::surface::FragmentLighting;
 use crate::assets::texture::Gradients;
@@ -32,7 +32,7 @@ use crate::shade::ao::GPixel;
 use crate::shade::lanes::{Footprints, LaneMaterial};
 use crate::shade::light::LightMask;
 
-impl<'a> FrameData<'a> {
+impl<'a> BandInputs<'a> {
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
     /// alpha-tested triangle per pixel, and the blended triangles to
     /// composite over them. `bins`: per setup chunk, its per-band triangle
@@ -605,7 +605,7 @@ struct QuadEntry {
     footprints: Footprints,
 }
 
-/// Where `FrameData::fragment` shades: the pixel's position and its
+/// Where `BandInputs::fragment` shades: the pixel's position and its
 /// quad's top-left pixel, its AO and lights, and the band's state.
 struct FragmentAt<'c> {
     px: (i32, i32),

@@ -64,7 +64,7 @@ pub fn resolve_into(frame: &Frame, s: &RenderSettings, image: &mut Image8) {
 
 /// What a band knows of its background when it is one flat colour: the
 /// colour, and the columns outside which every pixel of the band holds
-/// exactly that colour (`FrameData::shade_band`).
+/// exactly that colour (`BandInputs::shade_band`).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct PlainBackground {
     pub color: Vec4,

@@ -1,5 +1,5 @@
 //! What a frame's bands share and how a fragment's result reaches its
-//! pixel: the frame's data (`FrameData`, built once per frame: set-up,
+//! pixel: the frame's data (`BandInputs`, built once per frame: set-up,
 //! shading context, vertices, draws, per-draw lane materials, the
 //! backgrounds) and the sink that takes shaded fragments
 //! (`Sink`, `PixelShare`, `resolve`). The band loop (`band`) and the lane
@@ -8,7 +8,7 @@
 use glam::{Vec3, Vec4};
 
 use super::backdrop::EnvBackground;
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use super::geometry::{Draw, Geometry};
 use super::ground::Ground;
 use super::light_tiles::Culling;
@@ -21,8 +21,8 @@ use crate::shade::lanes::LaneMaterial;
 use crate::shade::{ShadeContext, background};
 
 /// What every band of one frame reads.
-pub(super) struct FrameData<'a> {
-    pub setup: &'a FrameSetup<'a>,
+pub(super) struct BandInputs<'a> {
+    pub setup: &'a DrawList<'a>,
     pub ctx: ShadeContext<'a>,
     pub verts: &'a [ModelVertices],
     pub draws: &'a [Draw],
@@ -64,19 +64,19 @@ pub(super) struct Paths {
     pub lane_width: usize,
 }
 
-impl<'a> FrameData<'a> {
+impl<'a> BandInputs<'a> {
     /// `verts` and `geo`: the frame's vertex and geometry passes.
     /// `pattern`: the sample offsets; `grads`: the texture filter reads
     /// derivatives (trilinear, anisotropic). `paths`: the lane width,
     /// and whether to skip lights per tile (`light_tiles`).
     pub fn new(
-        setup: &'a FrameSetup<'a>,
+        setup: &'a DrawList<'a>,
         ctx: ShadeContext<'a>,
         (verts, geo): (&'a [ModelVertices], &'a Geometry),
         (pattern, grads): (&'static [(i8, i8)], bool),
         tracer: Option<&'a Tracer<'a>>,
         paths: Paths,
-    ) -> FrameData<'a> {
+    ) -> BandInputs<'a> {
         let s = &setup.scene.settings;
         let alpha = geo
             .draws
@@ -107,7 +107,7 @@ impl<'a> FrameData<'a> {
                 )
             })
             .flatten();
-        FrameData {
+        BandInputs {
             setup,
             verts,
             draws: &geo.draws,

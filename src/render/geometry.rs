@@ -8,7 +8,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use super::vertex::{self, ModelVertices};
 use crate::assets::mesh::Mesh;
 use crate::raster::CullMode;
@@ -70,7 +70,7 @@ impl Geometry {
 
 /// `densities`: whether to measure texel densities (filters with mip maps).
 pub(super) fn setup_and_bin(
-    setup: &FrameSetup,
+    setup: &DrawList,
     verts: &[ModelVertices],
     vp: Viewport,
     densities: bool,
@@ -266,7 +266,7 @@ fn corners_all_of(clip: &[Vec4], vp: Viewport) -> Vec<Corner> {
 /// corners' projections, which is what `clip_triangle` and `setup` would
 /// give them; only the others are clipped.
 fn setup_range(
-    setup: &FrameSetup,
+    setup: &DrawList,
     (mv, corners): (&ModelVertices, &[Corner]),
     (d, di): (Draw, usize),
     prims: std::ops::Range<u32>,
@@ -398,7 +398,7 @@ mod tests {
     }
 
     /// Frame `setup` transformed, set up and binned at `width` x `height`.
-    fn geometry_of(setup: &FrameSetup, width: u32, height: u32, densities: bool) -> Geometry {
+    fn geometry_of(setup: &DrawList, width: u32, height: u32, densities: bool) -> Geometry {
         let verts = super::super::vertex::transform_all(setup);
         let vp = Viewport {
             width,
@@ -520,7 +520,7 @@ mod tests {
                     [[camera]]\neye = [0.3, -0.2, 5.0]\ntarget = [0.0, 0.0, 0.0]\nnear = 0.5\n\
                     [[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\n";
         let scene = scene_in(&dir, text);
-        let setup = FrameSetup::new(&scene, 0, 0);
+        let setup = DrawList::new(&scene, 0, 0);
         let geo = geometry_of(&setup, 48, 40, true);
         let (mut checked, mut cut) = (0, 0);
         for c in &geo.chunks {
@@ -654,7 +654,7 @@ mod tests {
                     [[camera]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\
                     projection = \"orthographic\"\nheight = 2.0\nnear = 0.1\nfar = 10.0\n";
         let scene = scene_in(&dir, text);
-        let setup = FrameSetup::new(&scene, 0, 0);
+        let setup = DrawList::new(&scene, 0, 0);
         let geo = geometry_of(&setup, 32, 32, false);
         assert_eq!(geo.draws.len(), 1);
         // The quad behind the camera is clipped away.

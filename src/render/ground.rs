@@ -19,7 +19,7 @@ use std::sync::OnceLock;
 
 use glam::{Vec3, Vec4};
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use super::rays::CameraRays;
 use crate::raytrace::Tracer;
 use crate::scene::Light;
@@ -56,7 +56,7 @@ fn luminance(c: Vec3) -> f32 {
 impl<'a> Ground<'a> {
     /// The frame's catcher, when the scene asks for one.
     pub fn new(
-        setup: &'a FrameSetup<'a>,
+        setup: &'a DrawList<'a>,
         ctx: &ShadeContext<'a>,
         tracer: Option<&'a Tracer<'a>>,
         width: u32,

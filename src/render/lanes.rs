@@ -11,7 +11,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::fragment::{FrameData, Sink};
+use super::fragment::{BandInputs, Sink};
 use crate::assets::texture::Footprint;
 use crate::assets::texture::Gradients;
 use crate::raster::interp::Interpolator;
@@ -46,7 +46,7 @@ pub(super) struct Pending {
     /// The lights that may reach its tile.
     pub lights: LightMask,
     /// Wireframe: its distance to its triangle's nearest edge, in
-    /// pixels (`FrameData::edge_distance`).
+    /// pixels (`BandInputs::edge_distance`).
     pub edge: f32,
 }
 
@@ -96,7 +96,7 @@ impl CornerCache {
     /// Puts the corners of triangle `id` (`t`, of draw `draw`) in its slot
     /// unless they are there.
     #[inline]
-    fn fill(&mut self, data: &FrameData, draw: usize, id: u32, t: &Tri) {
+    fn fill(&mut self, data: &BandInputs, draw: usize, id: u32, t: &Tri) {
         let k = Self::slot(id);
         if self.ids[k] != id {
             self.corners[k] = data.corners(draw, t);
@@ -113,7 +113,7 @@ impl CornerCache {
 
     /// The corners of triangle `id` (`t`, of draw `draw`).
     #[inline]
-    pub fn get(&mut self, data: &FrameData, draw: usize, id: u32, t: &Tri) -> &Corners {
+    pub fn get(&mut self, data: &BandInputs, draw: usize, id: u32, t: &Tri) -> &Corners {
         self.fill(data, draw, id, t);
         &self.corners[Self::slot(id)]
     }
@@ -165,7 +165,7 @@ impl LaneBatches {
     /// Adds `p` (of draw `draw`) as the next slot, which it returns; a
     /// full group of its draw is shaded into `sink`.
     #[inline]
-    pub fn push(&mut self, data: &FrameData, draw: u32, p: Pending, sink: &mut Sink) -> u32 {
+    pub fn push(&mut self, data: &BandInputs, draw: u32, p: Pending, sink: &mut Sink) -> u32 {
         let slot = self.next;
         self.next += 1;
         let w = &mut self.waiting[draw as usize];
@@ -181,7 +181,7 @@ impl LaneBatches {
 
     /// Shades every group that is not full (its last fragment repeated),
     /// and a quad still waiting.
-    pub fn finish(&mut self, data: &FrameData, sink: &mut Sink) {
+    pub fn finish(&mut self, data: &BandInputs, sink: &mut Sink) {
         self.flush_quad(data, sink.color, sink.depth);
         for (draw, w) in self.waiting.iter_mut().enumerate() {
             if w.len > 0 {
@@ -200,7 +200,7 @@ impl LaneBatches {
     /// the band ends: `finish`).
     pub fn quad(
         &mut self,
-        data: &FrameData,
+        data: &BandInputs,
         q: QuadAt,
         pixels: [usize; 4],
         (color, depth): (&mut [glam::Vec4], &mut [f32]),
@@ -241,7 +241,7 @@ impl LaneBatches {
     }
 
     /// Shades a quad still waiting for a second.
-    fn flush_quad(&mut self, data: &FrameData, color: &mut [glam::Vec4], depth: &mut [f32]) {
+    fn flush_quad(&mut self, data: &BandInputs, color: &mut [glam::Vec4], depth: &mut [f32]) {
         if let Some(first) = self.quad.take() {
             first.shade(data, color, depth);
         }
@@ -259,7 +259,7 @@ struct WaitingQuad {
 
 impl WaitingQuad {
     /// Shades it alone.
-    fn shade(&self, data: &FrameData, color: &mut [glam::Vec4], depth: &mut [f32]) {
+    fn shade(&self, data: &BandInputs, color: &mut [glam::Vec4], depth: &mut [f32]) {
         let c = &self.corners;
         let out = data.shade_prepared(&self.prepared, &[c; MAX_LANES], &[], 8);
         put_quad(&out[..4], self.pixels, color, depth, self.samples);
@@ -301,7 +301,7 @@ pub(super) struct QuadAt<'q, 'a> {
 /// hands the fragments it holds to `sink` (linear colour, zero where not
 /// finite: degenerate input must not poison the frame).
 fn shade_group(
-    data: &FrameData,
+    data: &BandInputs,
     draw: usize,
     w: &Waiting,
     corners: &mut CornerCache,
@@ -425,7 +425,7 @@ impl Corners {
     };
 }
 
-impl<'a> FrameData<'a> {
+impl<'a> BandInputs<'a> {
     /// The corners of triangle `t` (of draw `draw`).
     #[inline]
     pub(super) fn corners(&self, draw: usize, t: &Tri) -> Corners {

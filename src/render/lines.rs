@@ -10,8 +10,8 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
+use super::draw_list::DrawList;
 use super::frame::Frame;
-use super::frame_setup::FrameSetup;
 use super::vertex::ModelVertices;
 
 /// A projected end of a segment (or a point): screen position, 1/w and
@@ -30,7 +30,7 @@ struct End {
 const DEPTH_SLACK: f32 = 2e-3;
 
 /// Whether some model of the scene has lines or points to draw.
-pub(super) fn any(setup: &FrameSetup) -> bool {
+pub(super) fn any(setup: &DrawList) -> bool {
     setup
         .scene
         .models
@@ -38,7 +38,7 @@ pub(super) fn any(setup: &FrameSetup) -> bool {
         .any(|m| !m.mesh.lines.is_empty() || !m.mesh.points.is_empty())
 }
 
-pub(super) fn draw(setup: &FrameSetup, verts: &[ModelVertices], pixel_scale: f32, out: &mut Frame) {
+pub(super) fn draw(setup: &DrawList, verts: &[ModelVertices], pixel_scale: f32, out: &mut Frame) {
     let s = &setup.scene.settings;
     let view = setup.camera.view_from_world();
     let near = setup.camera.near;

@@ -1,5 +1,5 @@
 //! One frame, as a short list of passes over the frame's draw list
-//! (`FrameSetup`):
+//! (`DrawList`):
 //!
 //! 1. `vertex`: every model's vertices placed for the frame;
 //! 2. `shadow_pass`: a depth map per shadow-casting light, or the BVHs for
@@ -29,11 +29,11 @@ mod aovs;
 mod backdrop;
 mod band;
 pub mod display;
+mod draw_list;
 mod env_cache;
 mod exposure;
 mod fragment;
 mod frame;
-mod frame_setup;
 mod geometry;
 mod ground;
 mod lanes;
@@ -51,9 +51,9 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 pub use display::{Image8, resolve};
+pub use draw_list::DrawList;
 pub use exposure::auto_exposure;
 pub use frame::{AovPixel, Frame, FrameSequence};
-pub use frame_setup::FrameSetup;
 
 use crate::assets::mesh::Mesh;
 use crate::assets::mip;
@@ -230,7 +230,7 @@ impl<'s> Renderer<'s> {
 
     /// The frame's draw list for `shot`, or an error naming a camera the
     /// scene does not have.
-    fn setup(&self, shot: Shot) -> Result<FrameSetup<'s>, Error> {
+    fn setup(&self, shot: Shot) -> Result<DrawList<'s>, Error> {
         let n = self.scene.cameras.len();
         if shot.camera >= n {
             return Err(Error::Argument(format!(
@@ -238,11 +238,11 @@ impl<'s> Renderer<'s> {
                 shot.camera
             )));
         }
-        Ok(FrameSetup::new(self.scene, shot.camera, shot.frame))
+        Ok(DrawList::new(self.scene, shot.camera, shot.frame))
     }
 
     /// `render`, and with `display` `render_display`.
-    fn render_frame(&self, setup: FrameSetup, out: &mut Frame, display: Option<&mut Image8>) {
+    fn render_frame(&self, setup: DrawList, out: &mut Frame, display: Option<&mut Image8>) {
         let (s, k) = (&self.scene.settings, self.scene.settings.ssaa.max(1));
         if k == 1 {
             self.render_at(&setup, s.width, s.height, out, display, None);
@@ -330,7 +330,7 @@ impl<'s> Renderer<'s> {
     /// frame's posed models (`posed_bvhs`).
     fn tracer<'a>(
         &'a self,
-        setup: &FrameSetup,
+        setup: &DrawList,
         posed: &'a [Option<(Bvh, (Vec3, Vec3))>],
     ) -> Tracer<'a> {
         let placed = self
@@ -355,7 +355,7 @@ impl<'s> Renderer<'s> {
     /// Per model: the BVH of its vertices as this frame poses them, the
     /// kept BVH of its rest pose refitted (None for models at rest, whose
     /// BVH the renderer keeps).
-    fn posed_bvhs(&self, setup: &FrameSetup) -> Vec<Option<(Bvh, (Vec3, Vec3))>> {
+    fn posed_bvhs(&self, setup: &DrawList) -> Vec<Option<(Bvh, (Vec3, Vec3))>> {
         setup
             .scene
             .models
@@ -378,7 +378,7 @@ impl<'s> Renderer<'s> {
     /// with `display`, resolved into it too.
     fn render_at(
         &self,
-        setup: &FrameSetup,
+        setup: &DrawList,
         width: u32,
         height: u32,
         out: &mut Frame,
@@ -427,7 +427,7 @@ impl<'s> Renderer<'s> {
         ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
-        let mut data = fragment::FrameData::new(
+        let mut data = fragment::BandInputs::new(
             setup,
             ctx,
             (&verts, &geo),
@@ -464,7 +464,7 @@ impl<'s> Renderer<'s> {
     /// `display`, each band's display bytes as soon as it is shaded.
     fn bands(
         &self,
-        data: &fragment::FrameData,
+        data: &fragment::BandInputs,
         geo: &Geometry,
         tracer: Option<&Tracer>,
         out: &mut Frame,
@@ -566,7 +566,7 @@ impl<'s> Renderer<'s> {
     /// triangle's footprint reaches half a texel (the level of detail can
     /// pass 0 there); the others read level 0 only, so a frame's pixels do
     /// not depend on which frames came before.
-    fn frame_mips(&self, setup: &FrameSetup, geo: &Geometry) -> Vec<Option<&'s [Level]>> {
+    fn frame_mips(&self, setup: &DrawList, geo: &Geometry) -> Vec<Option<&'s [Level]>> {
         let mut needed = vec![false; self.scene.textures.len()];
         for c in &geo.chunks {
             let d = geo.draws[c.draw];
@@ -606,7 +606,7 @@ fn aov_chunks(aov: &mut [AovPixel], band: usize, bands: usize) -> Vec<&mut [AovP
 }
 
 fn shade_context<'a>(
-    setup: &'a FrameSetup,
+    setup: &'a DrawList,
     mips: &'a [Option<&'a [Level]>],
     shadows: &'a Shadows<'a>,
     env: Option<&'a EnvLight>,

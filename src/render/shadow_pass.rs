@@ -24,7 +24,7 @@ use std::sync::{Arc, Mutex};
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 use super::vertex::ModelVertices;
 use crate::raster::bin::{TileGrid, bin};
 use crate::raster::clip::{ClipVertex, Clipped, clip_triangle};
@@ -91,7 +91,7 @@ struct MapKey {
 /// `render.shadows = "raytraced"` tests against. `cache`: the maps of the
 /// renderer's last frame.
 pub(super) fn shadows<'a>(
-    setup: &FrameSetup,
+    setup: &DrawList,
     mv: &[ModelVertices],
     tracer: Option<&'a Tracer<'a>>,
     cache: &MapCache,
@@ -166,7 +166,7 @@ pub(super) fn shadows<'a>(
 /// Each light's shadow: its map(s), rays, or none. Maps draw into the
 /// buffers of `spare` where they fit.
 fn light_shadows(
-    setup: &FrameSetup,
+    setup: &DrawList,
     mv: &[ModelVertices],
     spare: &mut Vec<Spare>,
 ) -> Vec<LightShadow> {

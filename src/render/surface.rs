@@ -7,7 +7,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use super::fragment::{FrameData, Point};
+use super::fragment::{BandInputs, Point};
 use crate::assets::texture::Gradients;
 use crate::raster::interp::{Fragment, Interpolator};
 use crate::raster::setup::Tri;
@@ -15,7 +15,7 @@ use crate::scene::settings::ShadingMode;
 use crate::shade::lanes::LaneMaterial;
 use crate::shade::light::LightMask;
 
-impl<'a> FrameData<'a> {
+impl<'a> BandInputs<'a> {
     /// Where a fragment of `it` covering samples `mask` of pixel (px, py)
     /// is interpolated: the pixel center when it is inside the triangle,
     /// otherwise the centroid of the covered samples.
@@ -167,7 +167,7 @@ pub(super) struct FragmentLighting {
     pub lights: LightMask,
 }
 
-impl FrameData<'_> {
+impl BandInputs<'_> {
     /// Wireframe shading: the distance in pixels from the shading point
     /// (barycentrics `l`) in pixel (px, py) to the nearest edge of the
     /// triangle `it` interpolates; infinite in the other modes.

@@ -5,7 +5,7 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::frame_setup::FrameSetup;
+use super::draw_list::DrawList;
 
 /// Vertices of one model after the vertex pass.
 pub(super) struct ModelVertices {
@@ -39,7 +39,7 @@ impl ModelVertices {
 }
 
 /// Model `m`'s per-corner tangents (at rest or posed) in object space.
-pub(super) fn tangent_source<'a>(setup: &'a FrameSetup, m: usize) -> &'a [Vec4] {
+pub(super) fn tangent_source<'a>(setup: &'a DrawList, m: usize) -> &'a [Vec4] {
     match &setup.posed[m] {
         Some((p, _)) => &p.tangents,
         None => &setup.scene.models[m].mesh.tangents,
@@ -47,7 +47,7 @@ pub(super) fn tangent_source<'a>(setup: &'a FrameSetup, m: usize) -> &'a [Vec4] 
 }
 
 /// Every model of the frame, in scene order.
-pub(super) fn transform_all(setup: &FrameSetup) -> Vec<ModelVertices> {
+pub(super) fn transform_all(setup: &DrawList) -> Vec<ModelVertices> {
     setup
         .scene
         .models

@@ -9,7 +9,7 @@ use softraster::render::Shot;
 use base64::Engine;
 use glam::Vec3;
 use serde_json::{Value, json};
-use softraster::render::FrameSetup;
+use softraster::render::DrawList;
 use softraster::scene::Scene;
 use softraster::scene::assemble::LoadOptions;
 use softraster::scene::light::LightKind;
@@ -250,7 +250,7 @@ fn load(dir: &std::path::Path, scene: &str) -> Result<Scene, String> {
 
 /// Positions of model 0 at `frame`, as the frame's draw list has them.
 fn posed(scene: &Scene, frame: u32) -> Vec<Vec3> {
-    let fs = FrameSetup::new(scene, 0, frame);
+    let fs = DrawList::new(scene, 0, frame);
     let (p, _) = fs.posed[0].as_ref().expect("model 0 is posed");
     p.positions.clone()
 }
@@ -309,7 +309,7 @@ fn a_skinned_bar_follows_its_joints_through_the_clip() {
         assert!(near(*g, *w), "frame 4: {p:?}\nwant {want:?}");
     }
     // Normals stay +Z under turns about Z.
-    let fs = FrameSetup::new(&scene, 0, 4);
+    let fs = DrawList::new(&scene, 0, 4);
     let (pz, _) = fs.posed[0].as_ref().unwrap();
     assert!(
         pz.normals.iter().all(|n| near(*n, Vec3::Z)),
@@ -323,7 +323,7 @@ fn a_skinned_bar_follows_its_joints_through_the_clip() {
         _ => None,
     });
     assert!(near(light.unwrap(), Vec3::new(2.0, 2.0, 0.0)), "{light:?}");
-    let fs0 = FrameSetup::new(&scene, 0, 0);
+    let fs0 = DrawList::new(&scene, 0, 0);
     let light0 = fs0.lights.iter().find_map(|l| match l.kind {
         LightKind::Point { position, .. } => Some(position),
         _ => None,
@@ -399,7 +399,7 @@ fn a_morphing_cube_follows_its_cubic_spline_weights() {
         assert!((min_x + 0.5).abs() < 1e-6);
     }
     // Flat normals are the posed faces': still axis-aligned, outward.
-    let fs = FrameSetup::new(&scene, 0, 1);
+    let fs = DrawList::new(&scene, 0, 1);
     let (p, _) = fs.posed[0].as_ref().unwrap();
     for (v, n) in p.positions.iter().zip(&p.normals) {
         let axis = n.abs().max_element();
@@ -529,7 +529,7 @@ fn the_walker_steps_with_alternate_feet() {
     assert!(l1.z > 0.15 && r1.z < -0.15, "{l1} {r1}");
     assert!(l3.z < -0.15 && r3.z > 0.15, "{l3} {r3}");
     // Posed, the figure stays about 1.8 tall and on its feet.
-    let fs = FrameSetup::new(&scene, 0, 6);
+    let fs = DrawList::new(&scene, 0, 6);
     let (posed, _) = fs.posed[0].as_ref().unwrap();
     let lo = posed
         .positions

@@ -1,5 +1,5 @@
 //! The command line: flags -> validated library objects (a `Scene`, a
-//! `FramePlan`), progress display, error chain and exit status (0 success,
+//! `RenderPlan`), progress display, error chain and exit status (0 success,
 //! 1 render or I/O failure, 2 bad scene, asset or arguments). Only the
 //! binary and the tools (`bench`'s arguments) know about clap; the
 //! renderer library does not depend on it.

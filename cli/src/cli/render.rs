@@ -7,7 +7,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use softraster::batch::{FrameDone, FramePlan, JobSummary, RenderJob, thread_pool};
+use softraster::batch::{JobSummary, RenderJob, RenderPlan, ShotDone, thread_pool};
 use softraster::error::Error;
 use softraster::scene::Scene;
 use softraster::scene::assemble::LoadOptions;
@@ -195,7 +195,7 @@ fn render_one(
     }
     let warnings = scene.warnings.len();
     check_memory(scene, args.max_memory, path, args.quiet || !one)?;
-    let plan = FramePlan::select(scene, args.frames.as_deref(), args.camera.as_deref())?;
+    let plan = RenderPlan::select(scene, args.frames.as_deref(), args.camera.as_deref())?;
     job.plan = plan;
     job.skip_existing = args.skip_existing;
     if !args.quiet && one {
@@ -291,7 +291,7 @@ impl<'a> Reporter<'a> {
         }
     }
 
-    fn frame(&self, d: &FrameDone) {
+    fn frame(&self, d: &ShotDone) {
         if self.json {
             let mut line = serde_json::json!({
                 "event": "frame",

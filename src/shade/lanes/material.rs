@@ -426,7 +426,7 @@ impl<'a> LaneMaterial<'a> {
             _ if m.unlit => LaneShading::Unlit,
             ShadingMode::Gouraud => LaneShading::Gouraud,
             ShadingMode::Unlit => LaneShading::Emitted,
-            // Flat: the triangles' normals (`FrameData::lanes`).
+            // Flat: the triangles' normals (`BandInputs::lanes`).
             ShadingMode::BlinnPhong | ShadingMode::Flat => LaneShading::BlinnPhong,
             ShadingMode::Pbr => LaneShading::Pbr,
             ShadingMode::Auto if m.native == Native::BlinnPhong => LaneShading::BlinnPhong,

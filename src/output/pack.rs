@@ -1,4 +1,4 @@
-//! A frame's files: where they go (`FrameFiles`, named by the run's
+//! A frame's files: where they go (`OutputFiles`, named by the run's
 //! plan) and its buffers packed for them (`FileToWrite`): the display image
 //! as PNG, depth and AO as one-channel EXRs, the data passes (normal,
 //! albedo, position, ids) as EXR layers of several channels.
@@ -11,7 +11,7 @@ use crate::render::{AovPixel, Frame};
 
 /// The files of one frame of one camera (None: the scene does not ask).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FrameFiles {
+pub struct OutputFiles {
     /// `<name>.png`.
     pub color: Option<PathBuf>,
     /// `<name>_depth.exr`, channel `Z`.
@@ -28,7 +28,7 @@ pub struct FrameFiles {
     pub id: Option<PathBuf>,
 }
 
-impl FrameFiles {
+impl OutputFiles {
     /// The files, color first.
     pub fn all(&self) -> Vec<PathBuf> {
         [
@@ -86,7 +86,7 @@ impl FileToWrite {
 pub fn pack(
     frame: &Frame,
     image: Option<Image8>,
-    files: FrameFiles,
+    files: OutputFiles,
     color: bool,
 ) -> (Vec<FileToWrite>, Option<Image8>) {
     let (width, height) = (frame.width, frame.height);

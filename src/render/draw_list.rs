@@ -13,7 +13,7 @@ use crate::scene::camera::Camera;
 use crate::scene::light::{Light, LightKind};
 
 /// Everything placed where it is at one frame.
-pub struct FrameSetup<'a> {
+pub struct DrawList<'a> {
     pub scene: &'a Scene,
     pub camera: Camera,
     /// Per model, this frame's placement.
@@ -25,8 +25,8 @@ pub struct FrameSetup<'a> {
     pub clip_from_world: Mat4,
 }
 
-impl<'a> FrameSetup<'a> {
-    pub fn new(scene: &'a Scene, camera: usize, frame: u32) -> FrameSetup<'a> {
+impl<'a> DrawList<'a> {
+    pub fn new(scene: &'a Scene, camera: usize, frame: u32) -> DrawList<'a> {
         let turn = scene.animation.turn(frame);
         let mut cam = scene.cameras[camera].at_frame(frame);
         if scene.animation.rotates_camera() {
@@ -91,7 +91,7 @@ impl<'a> FrameSetup<'a> {
         let s = &scene.settings;
         let aspect = s.width as f32 / s.height as f32;
         let clip_from_world = cam.clip_from_view(aspect, s.depth) * cam.view_from_world();
-        FrameSetup {
+        DrawList {
             scene,
             camera: cam,
             world_from_object,
