@@ -10,8 +10,11 @@ use std::path::{Path, PathBuf};
 /// A place in a text file, 1-based.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Location {
+    /// The file.
     pub file: PathBuf,
+    /// The line, from 1.
     pub line: usize,
+    /// The column in characters, from 1.
     pub column: usize,
 }
 
@@ -37,42 +40,69 @@ impl Location {
     }
 }
 
+/// Everything the library can fail with. `Display` gives the message the
+/// command line prints: the file (and line and column where known) first.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The scene file is malformed, has an unknown key, a wrong type or an
     /// out-of-range value.
     #[error("{location}: {message}")]
-    Scene { location: Location, message: String },
+    Scene {
+        /// Where in the scene file.
+        location: Location,
+        /// What is wrong and what was expected.
+        message: String,
+    },
 
     /// A scene-level problem that has no single place in the file (e.g. two
     /// cameras with the same name when both were defaulted).
     #[error("{file}: {message}")]
-    SceneGlobal { file: PathBuf, message: String },
+    SceneGlobal {
+        /// The scene file.
+        file: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 
     /// A model, material library or texture that cannot be read or is
     /// malformed. `line` is set when the format is text and the line is known.
     #[error("{}{}: {message}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Asset {
+        /// The file.
         path: PathBuf,
+        /// The line, for text formats where it is known.
         line: Option<usize>,
+        /// What is wrong.
         message: String,
     },
 
     /// `--sandbox`: a file names a path outside the scene's folder (with
     /// `..`, absolute, a URI scheme, or a link leading out). Never lenient.
     #[error("{}: --sandbox: refused to read it{message}", path.display())]
-    Sandbox { path: PathBuf, message: String },
+    Sandbox {
+        /// The file that names the path.
+        path: PathBuf,
+        /// The path refused, and why.
+        message: String,
+    },
 
     /// An asset would take more memory than the budget (`--max-memory`,
     /// or the default: what the machine has), seen from its header
     /// before anything is allocated.
     #[error("{}: {message}", path.display())]
-    Memory { path: PathBuf, message: String },
+    Memory {
+        /// The asset.
+        path: PathBuf,
+        /// The estimate and the budget.
+        message: String,
+    },
 
     /// `--strict` and the load gave warnings.
     #[error("{}: --strict: {} warning(s) treated as errors:\n  {}", file.display(), warnings.len(), warnings.join("\n  "))]
     Strict {
+        /// The scene or model loaded.
         file: PathBuf,
+        /// The warnings, each naming its file and line.
         warnings: Vec<String>,
     },
 
@@ -90,14 +120,21 @@ pub enum Error {
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The system's error.
         #[source]
         source: std::io::Error,
     },
 
     /// Encoding an output image failed.
     #[error("{}: {message}", path.display())]
-    Encode { path: PathBuf, message: String },
+    Encode {
+        /// The file being written.
+        path: PathBuf,
+        /// The encoder's message.
+        message: String,
+    },
 }
 
 impl Error {
@@ -116,6 +153,7 @@ impl Error {
         }
     }
 
+    /// An I/O failure on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Error {
         Error::Io {
             path: path.into(),
@@ -123,6 +161,7 @@ impl Error {
         }
     }
 
+    /// A bad asset at `path` (and `line`, where known).
     pub fn asset(
         path: impl Into<PathBuf>,
         line: Option<usize>,
@@ -136,6 +175,7 @@ impl Error {
     }
 }
 
+/// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 #[cfg(test)]

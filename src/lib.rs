@@ -103,16 +103,21 @@
 //! ```
 
 pub mod assets;
+#[deny(missing_docs)]
 pub mod batch;
 mod bigbuf;
 pub mod color;
+#[deny(missing_docs)]
 pub mod error;
 mod files;
+#[deny(missing_docs)]
 pub mod output;
 mod powers;
+#[deny(missing_docs)]
 pub mod procedural;
 pub mod raster;
 mod raytrace;
+#[deny(missing_docs)]
 pub mod render;
 pub mod scene;
 pub mod shade;

@@ -27,6 +27,9 @@ use crate::output::{self, Image8};
 use crate::render::{FrameSequence, Renderer, Shot};
 use crate::scene::Scene;
 
+/// A scene's frames to render and write: the scene, its plan (frames,
+/// cameras, file names) and whether existing files are kept. `run`
+/// renders in order while a writer thread writes the previous frame.
 pub struct RenderJob {
     /// With `render.exposure = "auto"` resolved to stops (`all`).
     scene: Scene,
@@ -39,8 +42,11 @@ pub struct RenderJob {
 /// Reported once per finished (written, or skipped) frame and camera.
 #[derive(Debug, Clone)]
 pub struct ShotDone {
+    /// The frame of the animation.
     pub frame: u32,
+    /// The camera's name.
     pub camera: String,
+    /// The files written (or found, when skipped).
     pub files: Vec<PathBuf>,
     /// Render time (without writing); 0 when skipped.
     pub render_seconds: f64,

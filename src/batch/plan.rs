@@ -150,6 +150,7 @@ impl RenderPlan {
         self.frames.len() == self.total_frames as usize
     }
 
+    /// The name camera `cam` gives its files.
     pub fn camera_name(&self, cam: usize) -> &str {
         &self.naming.cameras[cam]
     }

@@ -53,7 +53,9 @@ pub fn write_channel(
 
 /// One channel's samples for `write_channels`.
 pub enum Samples {
+    /// 32-bit float samples.
     F32(Vec<f32>),
+    /// 32-bit unsigned samples (ids).
     U32(Vec<u32>),
 }
 

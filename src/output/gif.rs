@@ -17,21 +17,27 @@ use super::write_atomic;
 use crate::error::Error;
 use crate::scene::settings::GifDither;
 
+/// How `assemble` writes a GIF.
 #[derive(Debug, Clone, Copy)]
 pub struct GifOptions {
     /// Per frame; GIF stores centiseconds, so this is rounded to 10 ms.
     pub delay_ms: u32,
+    /// How colours between palette entries are approximated.
     pub dither: GifDither,
 }
 
 /// What was written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GifInfo {
+    /// Frames written.
     pub frames: usize,
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Palette entries (256 at most, including a transparent one).
     pub colors: usize,
+    /// Whether one palette entry is transparent.
     pub transparent: bool,
 }
 
@@ -284,14 +290,19 @@ const BAYER8: [[u8; 8]; 8] = [
 /// A decoded GIF, for tests and checks.
 #[derive(Debug)]
 pub struct DecodedGif {
+    /// Logical screen width.
     pub width: u16,
+    /// Logical screen height.
     pub height: u16,
+    /// The global palette, RGB bytes.
     pub global_palette: Option<Vec<u8>>,
+    /// Whether the animation loops forever (NETSCAPE2.0).
     pub repeat_infinite: bool,
     /// Per frame: delay in centiseconds, whether it has a local palette.
     pub frames: Vec<(u16, bool)>,
 }
 
+/// Reads the GIF at `path`: its screen, palette, loop and frames.
 pub fn decode(path: &Path) -> Result<DecodedGif, Error> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut opts = gif::DecodeOptions::new();

@@ -51,6 +51,7 @@ impl OutputFiles {
 /// own, copied out of the renderer's (which renders the next frame into
 /// them while this one is written).
 pub enum FileToWrite {
+    /// Path, display image.
     Png(PathBuf, Image8),
     /// Path, width, height, channel name, values.
     Exr(PathBuf, u32, u32, &'static str, Vec<f32>),

@@ -9,6 +9,8 @@ use image::{ExtendedColorType, ImageEncoder};
 use super::{Image8, write_atomic};
 use crate::error::Error;
 
+/// Writes `img` as a PNG at `path` (to a temporary name, then renamed:
+/// a file already there stays whole until the new one is complete).
 pub fn write(path: &Path, img: &Image8) -> Result<(), Error> {
     write_atomic(path, |w| {
         let enc = PngEncoder::new_with_quality(w, CompressionType::Fast, FilterType::Adaptive);

@@ -29,21 +29,27 @@ use super::Image8;
 use crate::error::Error;
 pub use crate::scene::settings::{VideoQuality, check_video_size};
 
+/// How the video writer encodes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VideoOptions {
     /// Frames per second (constant frame rate).
     pub fps: f64,
+    /// A quality from 1 to 100 or a bit rate.
     pub quality: VideoQuality,
 }
 
 /// What was written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VideoInfo {
+    /// Frames written.
     pub frames: usize,
     /// The stream's size (the frames' size rounded up to even).
     pub width: u32,
+    /// The stream's height.
     pub height: u32,
+    /// Frames per second.
     pub fps: f64,
+    /// The file's size.
     pub bytes: u64,
 }
 
@@ -278,6 +284,7 @@ impl VideoWriter {
         })
     }
 
+    /// Where the video goes.
     pub fn path(&self) -> &Path {
         &self.path
     }

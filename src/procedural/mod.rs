@@ -10,6 +10,7 @@ use crate::output::Image8;
 
 /// A mesh as OBJ text: positions, uvs (OBJ convention, v up), normals, faces.
 pub struct ObjText {
+    /// The file's text.
     pub text: String,
 }
 
@@ -17,9 +18,13 @@ pub struct ObjText {
 /// vertex; counter-clockwise triangles with 1-based indices (as OBJ writes
 /// them).
 pub struct Builder {
+    /// Positions.
     pub v: Vec<[f32; 3]>,
+    /// Texture coordinates (v up).
     pub vt: Vec<[f32; 2]>,
+    /// Unit normals.
     pub vn: Vec<[f32; 3]>,
+    /// Triangles: 1-based indices into all three lists.
     pub f: Vec<[usize; 3]>,
 }
 
@@ -67,6 +72,8 @@ impl Builder {
         }
     }
 
+    /// The mesh as OBJ text: object `name`, material library `mtllib`
+    /// and material `material` (files the caller writes beside it).
     pub fn to_obj(self, name: &str, mtllib: &str, material: &str) -> ObjText {
         let mut t = String::new();
         let _ = writeln!(

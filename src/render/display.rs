@@ -19,9 +19,13 @@ use crate::shade::tonemap::tonemap;
 /// 8-bit display image: RGB, or RGBA for a transparent background.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Image8 {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// 3 (RGB) or 4 (RGBA).
     pub channels: u8,
+    /// The bytes, row-major from the top, `channels` per pixel.
     pub data: Vec<u8>,
 }
 

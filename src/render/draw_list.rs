@@ -14,18 +14,24 @@ use crate::scene::light::{Light, LightKind};
 
 /// Everything placed where it is at one frame.
 pub struct DrawList<'a> {
+    /// The scene drawn.
     pub scene: &'a Scene,
+    /// The camera as it stands at this frame (path, turntable).
     pub camera: Camera,
     /// Per model, this frame's placement.
     pub world_from_object: Vec<Mat4>,
     /// Per model that plays a clip: its vertices posed for this frame, and
     /// the clip time they are posed at.
     pub posed: Vec<Option<(Posed, f32)>>,
+    /// The lights as they stand at this frame.
     pub lights: Vec<Light>,
+    /// The camera's projection times its view.
     pub clip_from_world: Mat4,
 }
 
 impl<'a> DrawList<'a> {
+    /// The draw list of frame `frame` seen by camera `camera` (an index
+    /// the caller has checked: `Renderer::render` does).
     pub fn new(scene: &'a Scene, camera: usize, frame: u32) -> DrawList<'a> {
         let turn = scene.animation.turn(frame);
         let mut cam = scene.cameras[camera].at_frame(frame);

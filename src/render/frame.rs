@@ -8,7 +8,9 @@ use rayon::prelude::*;
 /// A rendered frame in linear space, before tone mapping.
 #[derive(Debug, Clone)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Linear RGB and coverage alpha per pixel, row-major from the top.
     /// For the data views (normals, depth, wireframe) RGB is already the
@@ -63,6 +65,7 @@ impl Default for FrameSequence {
 }
 
 impl FrameSequence {
+    /// An empty sequence: its first frame fills the whole buffer.
     pub fn new() -> FrameSequence {
         FrameSequence {
             frame: Frame::new(0, 0),
@@ -82,6 +85,7 @@ impl FrameSequence {
 }
 
 impl AovPixel {
+    /// A pixel no surface covers.
     pub const EMPTY: AovPixel = AovPixel {
         normal: Vec3::ZERO,
         albedo: Vec3::ZERO,
@@ -92,6 +96,8 @@ impl AovPixel {
 }
 
 impl Frame {
+    /// A frame of `width` x `height` background pixels (a renderer resizes
+    /// it to the scene's output size).
     pub fn new(width: u32, height: u32) -> Frame {
         let n = width as usize * height as usize;
         Frame {

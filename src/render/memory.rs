@@ -19,10 +19,12 @@ use crate::scene::settings::{AoMethod, Background, ShadowMethod, TextureFilter};
 /// The parts of the estimate, in bytes.
 #[derive(Debug, Clone, Default)]
 pub struct MemoryEstimate {
+    /// What each part is, and its bytes.
     pub parts: Vec<(&'static str, u64)>,
 }
 
 impl MemoryEstimate {
+    /// The sum of the parts.
     pub fn total(&self) -> u64 {
         self.parts.iter().map(|p| p.1).sum()
     }

@@ -79,11 +79,14 @@ use geometry::Geometry;
 /// `Scene::cameras`) and a frame of its animation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Shot {
+    /// The camera's index in `Scene::cameras`.
     pub camera: usize,
+    /// The frame of the animation, from 0.
     pub frame: u32,
 }
 
 impl Shot {
+    /// Camera `camera` at frame `frame`.
     pub fn new(camera: usize, frame: u32) -> Shot {
         Shot { camera, frame }
     }
@@ -122,6 +125,7 @@ pub struct Renderer<'s> {
 }
 
 impl<'s> Renderer<'s> {
+    /// The renderer of `scene`; it builds nothing until a frame needs it.
     pub fn new(scene: &'s Scene) -> Renderer<'s> {
         let mut meshes: Vec<&Arc<Mesh>> = Vec::new();
         let model_mesh = scene
