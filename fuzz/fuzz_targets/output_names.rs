@@ -11,7 +11,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use libfuzzer_sys::fuzz_target;
-use softraster::batch::{RenderPlan, RenderJob};
+use softraster::batch::{RenderJob, RenderPlan};
 use softraster::scene::{LoadOptions, Scene};
 
 /// A basic string, quoted (TOML and JSON escape alike here).
