@@ -1,6 +1,6 @@
 //! softraster: a data-driven CPU batch renderer.
 //!
-//! Data flows one way: scene file ([`scene::desc`]) -> loaded
+//! Data flows one way: scene file (`scene::desc`, private) -> loaded
 //! [`scene::Scene`] ([`scene::assemble`]) -> per-frame draw list
 //! ([`render::DrawList`]) -> the frame's passes ([`render`]: vertex,
 //! shadows, geometry through [`raster`], visibility, AO and shading through
@@ -119,6 +119,7 @@ pub mod raster;
 mod raytrace;
 #[deny(missing_docs)]
 pub mod render;
+#[deny(missing_docs)]
 pub mod scene;
 pub mod shade;
 pub mod simd;

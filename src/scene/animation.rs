@@ -15,7 +15,9 @@ use crate::scene::light::Light;
 /// A glTF clip played on one model.
 #[derive(Debug)]
 pub struct Playback {
+    /// The file's nodes and skins.
     pub rig: Arc<Rig>,
+    /// The clip played.
     pub clip: Clip,
     /// The clip's index in the file.
     pub index: usize,
@@ -43,7 +45,9 @@ impl Playback {
 pub struct NodeLight {
     /// Index in `Scene::lights`.
     pub light: usize,
+    /// The model whose file holds the light (index in `Scene::models`).
     pub model: usize,
+    /// The node the light hangs on, in its file.
     pub node: usize,
     /// The light in its node's space (at the origin, shining down -Z).
     pub local: Light,
@@ -59,21 +63,29 @@ pub enum TurntableTarget {
     Camera,
 }
 
+/// `[animation] turntable`: the turn spread over the frames.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Turntable {
+    /// The axis of the turn, unit (default +Y).
     pub axis: Vec3,
+    /// The whole turn in degrees over the animation (default 360); frame i
+    /// turns by i * degrees / frames, so a loop is seamless.
     pub degrees: f32,
+    /// What turns.
     pub rotate: TurntableTarget,
     /// Degrees above the plane of the turn the cameras look from (their
     /// orbit is a cone); None leaves them where they are.
     pub elevation: Option<f32>,
 }
 
+/// `[animation]`: frames, their rate and the turntable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Animation {
+    /// Frames in the animation (default 1).
     pub frames: u32,
     /// Frame i is at time i / fps seconds.
     pub fps: f32,
+    /// None: nothing turns.
     pub turntable: Option<Turntable>,
     /// Bounding-box center of all models at rest (the turntable's pivot).
     pub pivot: Vec3,
@@ -114,10 +126,12 @@ impl Animation {
         frame as f64 / self.fps as f64
     }
 
+    /// Whether a turntable turns the models.
     pub fn rotates_models(&self) -> bool {
         matches!(&self.turntable, Some(t) if t.rotate == TurntableTarget::Models)
     }
 
+    /// Whether a turntable turns the cameras.
     pub fn rotates_camera(&self) -> bool {
         matches!(&self.turntable, Some(t) if t.rotate == TurntableTarget::Camera)
     }

@@ -9,22 +9,37 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::raster::DepthMode;
 
+/// How a camera projects.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Projection {
-    /// Vertical field of view in degrees.
-    Perspective { fov_y: f32 },
-    /// Height of the view volume in world units.
-    Orthographic { height: f32 },
+    /// A pinhole camera.
+    Perspective {
+        /// Vertical field of view in degrees.
+        fov_y: f32,
+    },
+    /// Parallel rays.
+    Orthographic {
+        /// Height of the view volume in world units.
+        height: f32,
+    },
 }
 
+/// A camera as loaded: where it stands at rest, and its path if it has keys.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
+    /// Its name (unique in the scene; output file names use it).
     pub name: String,
+    /// Where it stands.
     pub eye: Vec3,
+    /// Where it looks.
     pub target: Vec3,
+    /// Which way is up (need not be orthogonal to the view).
     pub up: Vec3,
+    /// Perspective or orthographic.
     pub projection: Projection,
+    /// Near plane distance (> 0).
     pub near: f32,
+    /// Far plane distance (> near).
     pub far: f32,
     /// Keys the camera follows over the animation (`[[camera.keys]]`).
     pub path: Option<std::sync::Arc<CameraPath>>,
@@ -146,6 +161,7 @@ impl Camera {
         }
     }
 
+    /// The unit view direction, from eye to target.
     pub fn forward(&self) -> Vec3 {
         (self.target - self.eye).normalize()
     }
@@ -163,6 +179,8 @@ impl Camera {
         )
     }
 
+    /// Camera -> clip space for an image of `aspect` (width / height), with
+    /// the depth mapping `depth` (reverse-Z by default).
     pub fn clip_from_view(&self, aspect: f32, depth: DepthMode) -> Mat4 {
         let (n, f) = (self.near, self.far);
         // Depth as a function of view-space z (negative in front):
@@ -221,23 +239,31 @@ pub enum Interpolation {
     /// neighbouring keys, scaled by their spacing in frames).
     #[default]
     Smooth,
+    /// Straight lines between keys.
     Linear,
 }
 
+/// One key of a camera path (`[[camera.keys]]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CameraKey {
+    /// The frame it holds at.
     pub frame: u32,
+    /// Where the camera stands.
     pub eye: Vec3,
+    /// Where it looks.
     pub target: Vec3,
+    /// Which way is up.
     pub up: Vec3,
     /// Perspective cameras only; None keeps the camera's.
     pub fov: Option<f32>,
 }
 
+/// The keys a camera follows over the animation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CameraPath {
     /// At least one, frames strictly increasing.
     pub keys: Vec<CameraKey>,
+    /// How the keys are joined.
     pub interpolation: Interpolation,
     /// Near and far follow the eye (fitted to the models' bounding sphere,
     /// center and radius) unless the camera gives them.

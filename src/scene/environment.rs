@@ -13,12 +13,18 @@ pub enum EnvMethod {
     Prefiltered,
     /// Monte Carlo with visibility: `samples` environment and `samples`
     /// BRDF directions a point, combined by MIS (the reference).
-    Sampled { samples: u32 },
+    Sampled {
+        /// Directions of each kind per point (default 64).
+        samples: u32,
+    },
 }
 
+/// `[environment]`: an image lighting the scene from every direction.
 #[derive(Debug, Clone)]
 pub struct Environment {
+    /// How its light is integrated.
     pub method: EnvMethod,
+    /// The equirectangular radiance image (linear).
     pub image: Arc<EnvImage>,
     /// Multiplies the radiance (default 1).
     pub intensity: f32,

@@ -4,28 +4,48 @@
 
 use glam::{Mat4, Vec3};
 
+/// What a light is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightKind {
     /// Radiant intensity `intensity` (times `color`) from `position`.
-    Point { position: Vec3, intensity: f32 },
+    Point {
+        /// Where it stands.
+        position: Vec3,
+        /// Radiant intensity: irradiance = intensity * cos / r^2.
+        intensity: f32,
+    },
     /// Irradiance `irradiance` on a surface facing the light; `direction` is
     /// the unit vector the light travels along.
-    Directional { direction: Vec3, irradiance: f32 },
+    Directional {
+        /// The unit vector the light travels along.
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: f32,
+    },
     /// A point light limited to a cone around `direction` (unit), with the
     /// KHR_lights_punctual smooth falloff between the cone angles.
     Spot {
+        /// Where it stands.
         position: Vec3,
+        /// The cone's axis, unit, the way the light travels.
         direction: Vec3,
+        /// Radiant intensity on the axis.
         intensity: f32,
+        /// Cosine of the angle inside which the light is full.
         cos_inner: f32,
+        /// Cosine of the angle outside which there is no light.
         cos_outer: f32,
     },
 }
 
+/// A light of the scene (`[[light]]`, or a glTF file's lights).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Light {
+    /// Its kind and geometry.
     pub kind: LightKind,
+    /// Linear RGB colour multiplying its intensity.
     pub color: Vec3,
+    /// Whether it casts shadows (`render.shadows` says how).
     pub shadows: bool,
     /// Point and spot: distance beyond which the light has no effect, with
     /// the KHR_lights_punctual smooth window clamp(1 - (r/range)^4, 0, 1)^2
@@ -34,6 +54,7 @@ pub struct Light {
 }
 
 impl Light {
+    /// Whether it is a directional light.
     pub fn kind_is_directional(&self) -> bool {
         matches!(self.kind, LightKind::Directional { .. })
     }

@@ -36,20 +36,30 @@ pub enum NormalMap {
     /// RGB normal map in tangent or object space; `scale` multiplies the
     /// tangent-space x and y (`-bm`).
     Normals {
+        /// The normal map (linear).
         map: TextureRef,
+        /// Tangent or object space.
         space: NormalSpace,
+        /// Multiplies the tangent-space x and y (`-bm`, glTF `scale`).
         scale: f32,
     },
     /// Height map (bump): the normal tilts against the height gradient,
     /// `scale` (`-bm`) height units per texel step.
-    Height { map: TextureRef, scale: f32 },
+    Height {
+        /// The height map (red, linear).
+        map: TextureRef,
+        /// Height units per texel step.
+        scale: f32,
+    },
 }
 
 /// Which shading model a material's file describes (`shading = "auto"`
 /// uses it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Native {
+    /// An MTL material: Blinn-Phong.
     BlinnPhong,
+    /// A glTF (or FBX, USD) material: metallic-roughness.
     Pbr,
 }
 
@@ -60,16 +70,20 @@ pub struct Pbr {
     pub base_color: glam::Vec4,
     /// sRGB RGBA.
     pub base_color_map: Option<TextureRef>,
+    /// Metallic factor, 0..1.
     pub metallic: f32,
+    /// Perceptual roughness factor, 0..1.
     pub roughness: f32,
     /// Linear; roughness in green, metallic in blue.
     pub metallic_roughness_map: Option<TextureRef>,
     /// Linear, red: separate roughness and metallic maps (MTL `map_Pr`,
     /// `map_Pm`), multiplying the factors like the combined map.
     pub roughness_map: Option<TextureRef>,
+    /// Linear, red: the metallic map (MTL `map_Pm`).
     pub metallic_map: Option<TextureRef>,
     /// Linear; occlusion in red, applied to the ambient term.
     pub occlusion_map: Option<TextureRef>,
+    /// How much of the occlusion map applies, 0..1.
     pub occlusion_strength: f32,
     /// Linear RGB, KHR_materials_emissive_strength folded in.
     pub emissive: Vec3,
@@ -91,14 +105,18 @@ pub struct Pbr {
 /// A thin film over the material (KHR_materials_iridescence).
 #[derive(Debug, Clone)]
 pub struct IridescenceLayer {
+    /// The film's strength, 0..1.
     pub factor: f32,
     /// Linear; red multiplies `factor`.
     pub map: Option<TextureRef>,
+    /// The film's index of refraction.
     pub ior: f32,
     /// Thickness in nanometres: `thickness_max` without a map, else
     /// from `thickness_min` to `thickness_max` by the map's green.
     pub thickness_min: f32,
+    /// The film's thickest, in nanometres.
     pub thickness_max: f32,
+    /// Linear; green picks the thickness between min and max.
     pub thickness_map: Option<TextureRef>,
 }
 
@@ -109,6 +127,7 @@ pub struct SheenLayer {
     pub color: Vec3,
     /// sRGB; RGB multiplies `color`.
     pub color_map: Option<TextureRef>,
+    /// Perceptual roughness of the sheen lobe.
     pub roughness: f32,
     /// Linear; alpha multiplies `roughness`.
     pub roughness_map: Option<TextureRef>,
@@ -118,9 +137,11 @@ pub struct SheenLayer {
 /// roughness and normal.
 #[derive(Debug, Clone)]
 pub struct Clearcoat {
+    /// The coat's strength, 0..1.
     pub factor: f32,
     /// Linear; red multiplies `factor`.
     pub map: Option<TextureRef>,
+    /// The coat's perceptual roughness.
     pub roughness: f32,
     /// Linear; green multiplies `roughness`.
     pub roughness_map: Option<TextureRef>,
@@ -133,6 +154,7 @@ pub struct Clearcoat {
 /// thickness by Beer's law.
 #[derive(Debug, Clone)]
 pub struct Transmission {
+    /// The share of light transmitted, 0..1.
     pub factor: f32,
     /// Linear; red multiplies `factor`.
     pub map: Option<TextureRef>,
@@ -142,6 +164,8 @@ pub struct Transmission {
     pub thickness_map: Option<TextureRef>,
     /// Colour that white light becomes after `attenuation_distance`.
     pub attenuation_color: Vec3,
+    /// The distance at which white light becomes `attenuation_color`
+    /// (infinite: no attenuation).
     pub attenuation_distance: f32,
 }
 
@@ -189,6 +213,7 @@ pub fn ns_from_roughness(roughness: f32) -> f32 {
     (2.0 / (a * a) - 2.0).clamp(1.0, 10_000.0)
 }
 
+/// The inverse of `ns_from_roughness`.
 pub fn roughness_from_ns(ns: f32) -> f32 {
     let a = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
     a.sqrt().clamp(0.0, 1.0)
@@ -199,17 +224,28 @@ pub fn roughness_from_ns(ns: f32) -> f32 {
 /// whose map is given is 1 (the map alone decides).
 #[derive(Debug, Clone)]
 pub struct Material {
+    /// Its name in the file.
     pub name: String,
     /// None: the ambient term uses the (textured) diffuse color.
     pub ka: Option<Vec3>,
+    /// Diffuse colour, linear.
     pub kd: Vec3,
+    /// Specular colour, linear.
     pub ks: Vec3,
+    /// Emitted colour, linear.
     pub ke: Vec3,
+    /// Blinn-Phong exponent.
     pub ns: f32,
+    /// MTL illumination model (0: colour alone, 1: diffuse, 2: and
+    /// specular).
     pub illum: u8,
+    /// Ambient colour map (sRGB).
     pub map_ka: Option<TextureRef>,
+    /// Diffuse colour map (sRGB).
     pub map_kd: Option<TextureRef>,
+    /// Specular colour map (sRGB).
     pub map_ks: Option<TextureRef>,
+    /// Emission map (sRGB).
     pub map_ke: Option<TextureRef>,
     /// Scales Ns (red channel, linear).
     pub map_ns: Option<TextureRef>,
@@ -217,10 +253,13 @@ pub struct Material {
     pub d: f32,
     /// Opacity map (linear; its alpha if it has one, else its red channel).
     pub map_d: Option<TextureRef>,
+    /// Normal or bump map.
     pub normal_map: Option<NormalMap>,
+    /// How opacity is used: opaque, a cutout or blended.
     pub alpha: AlphaMode,
     /// Metallic-roughness description (native for glTF, derived for MTL).
     pub pbr: Pbr,
+    /// The model its file describes.
     pub native: Native,
     /// glTF doubleSided: never culled, whatever `render.cull` says.
     pub double_sided: bool,
@@ -238,6 +277,7 @@ impl Material {
         }
     }
 
+    /// The defaults above, named `name`.
     pub fn default_named(name: &str) -> Material {
         Material {
             name: name.to_string(),

@@ -9,7 +9,7 @@
 pub mod animation;
 pub mod assemble;
 pub mod camera;
-pub mod desc;
+mod desc;
 pub mod environment;
 pub mod light;
 pub mod material;
@@ -25,14 +25,19 @@ use crate::assets::mesh::Mesh;
 pub use animation::Animation;
 pub use assemble::LoadOptions;
 pub use camera::Camera;
+pub use desc::parse_size;
 pub use light::Light;
 pub use material::Material;
 pub use settings::{AoSettings, OutputSettings, RenderSettings, ShadowBias};
 
+/// A model of the scene: its mesh, materials and placement.
 #[derive(Debug, Clone)]
 pub struct Model {
+    /// `[[model]] name`, else the file's stem.
     pub name: String,
+    /// Its mesh (models may share one).
     pub mesh: Arc<Mesh>,
+    /// Its materials; the mesh's groups index them.
     pub materials: Vec<Material>,
     /// Placement at rest (before any turntable turn).
     pub world_from_object: Mat4,
@@ -74,13 +79,21 @@ impl Model {
     }
 }
 
+/// A loaded scene: models with their meshes, materials and textures,
+/// lights, cameras, environment and settings. Load one with `Scene::load`
+/// (a scene file or a model file) or `Scene::from_text`, then render it with
+/// `render::Renderer`.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// The scene file (a model file's path for a one-line scene).
     pub file: PathBuf,
     /// The scene file's stem, for `{scene}` and the default output dir.
     pub stem: String,
+    /// How frames are rendered (`[render]`, the output size).
     pub settings: RenderSettings,
+    /// What files each frame writes (`[output]`).
     pub output: OutputSettings,
+    /// The models, in the file's order.
     pub models: Vec<Model>,
     /// Empty, and no environment (a model imported no lights it asked
     /// for): every camera gets a headlight (a directional light along its
@@ -92,10 +105,14 @@ pub struct Scene {
     pub environment: Option<environment::Environment>,
     /// The shadow catcher under the models (`[ground] shadow = true`).
     pub ground: Option<GroundPlane>,
+    /// The cameras, in the file's order (a fitted camera when none is
+    /// given).
     pub cameras: Vec<Camera>,
+    /// `[animation]`.
     pub animation: Animation,
     /// World-space bounding sphere of all models at rest.
     pub bounds_center: Vec3,
+    /// The bounding sphere's radius.
     pub bounds_radius: f32,
     /// Every decoded texture; `Texture::id` indexes this list.
     pub textures: Vec<Arc<crate::assets::texture::Texture>>,
@@ -108,7 +125,9 @@ pub struct Scene {
 /// models' lowest point at rest, around their center.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroundPlane {
+    /// Its height (y).
     pub height: f32,
+    /// The models' center at rest (the catcher's middle).
     pub center: Vec3,
     /// The models' bounding radius: the catcher fades out between 2 and 3
     /// of them from the center.
@@ -116,6 +135,7 @@ pub struct GroundPlane {
 }
 
 impl Scene {
+    /// Triangles over every model.
     pub fn triangle_count(&self) -> usize {
         self.models.iter().map(|m| m.mesh.triangles.len()).sum()
     }

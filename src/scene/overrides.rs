@@ -15,14 +15,20 @@ use crate::error::{Error, Location};
 /// One parsed `--set`.
 #[derive(Debug, Clone)]
 pub struct SetOverride {
+    /// The key's path (`light.0.shadows`: a key, an index, a key).
     pub path: Vec<PathPart>,
+    /// The `key=value` text as given.
     pub raw: String,
+    /// The value, parsed as TOML.
     pub value: Value,
 }
 
+/// One step of a `--set` key's path.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PathPart {
+    /// A table key.
     Key(String),
+    /// An index into an array of tables (from 0).
     Index(usize),
 }
 
@@ -187,9 +193,13 @@ fn set_one(root: &mut Table, s: &SetOverride) -> Result<(), Error> {
 /// user can fix: `text` is the scene file's own text (None: a model
 /// file's generated one-line scene), `edited` the text after `sets`.
 pub struct Origin<'a> {
+    /// The scene or model file.
     pub file: &'a Path,
+    /// The scene file's own text.
     pub text: Option<&'a str>,
+    /// The text after the overrides.
     pub edited: &'a str,
+    /// The `--set` overrides applied.
     pub sets: &'a [SetOverride],
 }
 

@@ -20,6 +20,7 @@ pub enum ShadingMode {
     /// Each material in its file's model: Blinn-Phong for MTL, pbr for glTF.
     #[default]
     Auto,
+    /// Blinn-Phong for every material.
     BlinnPhong,
     /// glTF 2.0 metallic-roughness (appendix B BRDF) for every material.
     Pbr,
@@ -50,6 +51,7 @@ impl ShadingMode {
 /// `render.shadows`: how lights with `shadows = true` cast them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ShadowMethod {
+    /// No shadows.
     Off,
     /// One texel of a shadow map per lookup.
     Hard,
@@ -65,6 +67,7 @@ pub enum ShadowMethod {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AoMethod {
     #[default]
+    /// No ambient occlusion.
     Off,
     /// Screen-space ground-truth AO (GTAO: horizons per slice of the depth
     /// buffer); the file calls it `ssao`.
@@ -77,7 +80,9 @@ pub enum AoMethod {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Tonemap {
     #[default]
+    /// Clamped to 0..1.
     Clamp,
+    /// x / (1 + x).
     Reinhard,
     /// Narkowicz's fit of the ACES filmic curve.
     Aces,
@@ -91,8 +96,11 @@ pub enum Tonemap {
 /// scene's environment seen through the camera, sharp or blurred.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Background {
+    /// A colour, linear RGB.
     Color(Vec3),
+    /// Alpha 0: the PNG gets an alpha channel.
     Transparent,
+    /// The environment through the camera, sharp.
     Environment,
     /// The environment prefiltered at roughness `output.background_blur`.
     Blurred(f32),
@@ -114,28 +122,41 @@ pub enum GifDither {
 /// Everything that decides how a frame is rasterized and shaded.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderSettings {
+    /// Output width in pixels.
     pub width: u32,
+    /// Output height in pixels.
     pub height: u32,
+    /// The shading model.
     pub shading: ShadingMode,
+    /// How textures are filtered.
     pub texture_filter: TextureFilter,
+    /// The largest anisotropy `anisotropic` filtering takes (default 16).
     pub max_anisotropy: f32,
+    /// How texture coordinates outside 0..1 wrap.
     pub address: AddressMode,
+    /// Which faces are culled (`auto`: closed meshes' back faces).
     pub cull: CullMode,
+    /// How depth is stored (reverse-Z by default).
     pub depth: DepthMode,
+    /// Linear radiance to display range.
     pub tonemap: Tonemap,
     /// Stops (`2^exposure` scales the radiance before the tone map).
     pub exposure: f32,
     /// `render.exposure = "auto"`: the batch sets `exposure` once for the
     /// whole sequence (`render::auto_exposure`) before the first frame.
     pub auto_exposure: bool,
+    /// What shows where no model is.
     pub background: Background,
+    /// Ambient light, linear RGB (0 under an environment).
     pub ambient: Vec3,
     /// How lights with `shadows = true` cast them (default raytraced; pcf
     /// when the scene sets a shadow-map key without a method).
     pub shadows: ShadowMethod,
     /// Shadow map size in texels, per side (default 2048).
     pub shadow_map_size: u32,
+    /// Shadow-map bias.
     pub shadow_bias: ShadowBias,
+    /// Ambient occlusion.
     pub ao: AoSettings,
     /// Samples per pixel: 1, 2, 4, 8 or 16 (standard D3D positions).
     pub msaa: u32,
@@ -148,6 +169,7 @@ pub struct RenderSettings {
     pub sandbox: bool,
     /// Output pixels across a point and a line.
     pub point_size: f32,
+    /// Output pixels across a line.
     pub line_width: f32,
 }
 
@@ -177,6 +199,7 @@ impl Default for ShadowBias {
 /// `render.ao`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AoSettings {
+    /// Off, screen-space (GTAO) or ray-traced.
     pub method: AoMethod,
     /// Occluders within this distance count; None (raytraced only): rays of
     /// unbounded length. SSAO without a radius uses a fifth of the scene's
@@ -239,12 +262,16 @@ pub fn check_video_size(width: u32, height: u32) -> Result<(), String> {
     Ok(())
 }
 
+/// `[output]`: which files each frame writes, where, and the GIF and
+/// video.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSettings {
+    /// The output folder (`--out` wins).
     pub dir: PathBuf,
     /// File stem pattern with `{scene}`, `{camera}`, `{frame}` (`{frame:04}`
     /// pads with zeros).
     pub name: String,
+    /// Whether the PNG is written.
     pub color: bool,
     /// `<name>_depth.exr`, channel `Z`.
     pub depth: bool,
@@ -253,11 +280,15 @@ pub struct OutputSettings {
     /// The GIF's file name (in `dir`; `{camera}`, or `_<camera>` added
     /// before the extension when the scene has several cameras).
     pub gif: Option<String>,
+    /// GIF frame delay in milliseconds.
     pub gif_delay_ms: u32,
+    /// GIF dithering.
     pub gif_dither: GifDither,
     /// The video's file name (in `dir`; per camera like the GIF).
     pub video: Option<String>,
+    /// Video frames per second.
     pub video_fps: f64,
+    /// Video quality or bit rate.
     pub video_quality: VideoQuality,
     /// `{stem}_normal.exr`, channels `N.X N.Y N.Z` (world, unit).
     pub normal: bool,

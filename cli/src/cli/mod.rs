@@ -124,7 +124,7 @@ struct RenderArgs {
 }
 
 fn parse_memory(s: &str) -> Result<u64, String> {
-    softraster::scene::desc::parse_size(s)
+    softraster::scene::parse_size(s)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
