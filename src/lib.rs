@@ -3,11 +3,19 @@
 //! Data flows one way: scene file (`scene::desc`, private) -> loaded
 //! [`scene::Scene`] ([`scene::assemble`]) -> per-frame draw list
 //! ([`render::DrawList`]) -> the frame's passes ([`render`]: vertex,
-//! shadows, geometry through [`raster`], visibility, AO and shading through
-//! [`shade`]) -> [`render::Frame`] -> writers ([`output`]), driven frame by
-//! frame by [`batch`]. [`color`], [`error`], [`raster`], [`simd`] and the
-//! private `files`, `powers`, `raytrace` and `bigbuf` are the ground floor:
-//! they import nothing of the layers above.
+//! shadows, geometry through `raster`, visibility, AO and shading through
+//! `shade`) -> [`render::Frame`] -> writers ([`output`]), driven frame by
+//! frame by [`batch`]. [`color`], [`error`], `raster`, `simd`, `files`,
+//! `powers`, `raytrace` and `bigbuf` are the ground floor: they import
+//! nothing of the layers above.
+//!
+//! The documented API is scene loading ([`scene`], with the meshes and
+//! textures of [`assets`] and the primitives of [`procedural`]), the
+//! renderer and its frames ([`render`]), a scene's whole run ([`batch`]),
+//! the writers ([`output`]) and the errors ([`error`]). The internals
+//! (`raster`, `shade`, `simd`, and the loaders behind `Scene::load`) are
+//! hidden from these docs: public only for the CLI package's tools, the
+//! integration tests and the fuzz targets, and free to change.
 //!
 //! This package is the renderer alone. The `softraster` binary, the tools
 //! that measure the renderer (bench, chart, accuracy tables, image
@@ -102,26 +110,28 @@
 //! # }
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod assets;
-#[deny(missing_docs)]
 pub mod batch;
 mod bigbuf;
 pub mod color;
-#[deny(missing_docs)]
 pub mod error;
 mod files;
-#[deny(missing_docs)]
 pub mod output;
 mod powers;
-#[deny(missing_docs)]
 pub mod procedural;
+// Internals: public only for the CLI package's tools, the integration
+// tests and the fuzz targets, which reach into them; not part of the
+// documented API and free to change.
+#[doc(hidden)]
 pub mod raster;
 mod raytrace;
-#[deny(missing_docs)]
 pub mod render;
-#[deny(missing_docs)]
 pub mod scene;
+#[doc(hidden)]
 pub mod shade;
+#[doc(hidden)]
 pub mod simd;
 #[cfg(test)]
 mod testing;

@@ -12,8 +12,11 @@ use crate::error::Error;
 /// Linear RGB radiance, row-major from the top; `width == 2 * height`.
 #[derive(Debug, Clone)]
 pub struct EnvImage {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// The radiance, row-major from the top.
     pub texels: Vec<Vec3>,
 }
 

@@ -75,10 +75,12 @@ impl Input {
         self
     }
 
+    /// The memory budget in bytes that assets are checked against.
     pub fn budget(&self) -> u64 {
         self.budget
     }
 
+    /// Whether reads are kept inside the sandbox's folders.
     pub fn is_sandboxed(&self) -> bool {
         self.sandbox.is_some()
     }

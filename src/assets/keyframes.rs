@@ -10,24 +10,35 @@ use glam::{Quat, Vec4};
 /// What a channel drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ChannelPath {
+    /// The node's translation.
     Translation,
+    /// The node's rotation.
     Rotation,
+    /// The node's scale.
     Scale,
     /// The node's morph target weights.
     Weights,
 }
 
+/// How a channel moves between keys (glTF's sampler interpolation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interpolation {
+    /// Each key's value until the next.
     Step,
+    /// Linear (rotations: spherical linear).
     Linear,
+    /// Cubic Hermite with the file's tangents.
     CubicSpline,
 }
 
+/// One animated property of one node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
+    /// The node it drives.
     pub node: usize,
+    /// What it drives.
     pub path: ChannelPath,
+    /// How it moves between keys.
     pub interpolation: Interpolation,
     /// Key times in seconds, increasing.
     pub times: Vec<f32>,
@@ -44,6 +55,7 @@ pub struct Channel {
 pub struct Clip {
     /// The file's name for it ("" when it has none).
     pub name: String,
+    /// Its channels.
     pub channels: Vec<Channel>,
     /// Seconds: the last key time of any channel.
     pub duration: f32,

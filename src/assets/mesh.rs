@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 /// A run of triangles drawn with one material.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Group {
+    /// The triangles, as a range of `Mesh::triangles`.
     pub triangles: Range<u32>,
     /// Index into the model's material list.
     pub material: usize,
@@ -20,12 +21,17 @@ pub struct Group {
 /// A point or line: its vertices and its material.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Primitive<const N: usize> {
+    /// Its vertex indices.
     pub vertices: [u32; N],
+    /// Index into the model's material list.
     pub material: usize,
 }
 
+/// A loaded mesh: per-vertex attributes, triangles grouped by material,
+/// lines and points.
 #[derive(Debug, Clone, Default)]
 pub struct Mesh {
+    /// Vertex positions in object space.
     pub positions: Vec<Vec3>,
     /// One unit normal per vertex (always present after loading).
     pub normals: Vec<Vec3>,
@@ -43,6 +49,7 @@ pub struct Mesh {
     pub authored_tangents: Vec<glam::Vec4>,
     /// Counter-clockwise triangles (front faces).
     pub triangles: Vec<[u32; 3]>,
+    /// Runs of triangles by material.
     pub groups: Vec<Group>,
     /// Line segments (OBJ `l`, glTF lines, strips and loops): two vertices
     /// and a material, drawn as anti-aliased lines `render.line_width`
@@ -61,6 +68,7 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// The axis-aligned bounds of the positions (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.positions.iter().fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
@@ -68,6 +76,7 @@ impl Mesh {
         )
     }
 
+    /// Whether the mesh has texture coordinates.
     pub fn has_uvs(&self) -> bool {
         !self.uvs.is_empty()
     }

@@ -1,27 +1,32 @@
 //! Asset loaders: meshes and materials from OBJ/MTL, glTF, STL, PLY, FBX,
 //! USD and 3MF, textures from images.
 
-pub mod accessor;
-pub mod dds;
-pub mod draco;
+pub(crate) mod accessor;
+pub(crate) mod dds;
+pub(crate) mod draco;
 pub mod environment;
-pub mod fbx;
+pub(crate) mod fbx;
+// The loaders are reached through `Scene::load`; `gltf::load` and
+// `obj::load` are public for the fuzz targets and tests only, not part of
+// the documented API.
+#[doc(hidden)]
 pub mod gltf;
-pub mod guard;
+pub(crate) mod guard;
 pub mod input;
 pub mod keyframes;
-pub mod ktx2;
+pub(crate) mod ktx2;
 pub mod mesh;
-pub mod meshopt;
+pub(crate) mod meshopt;
 pub mod mip;
+#[doc(hidden)]
 pub mod obj;
-pub mod ply;
+pub(crate) mod ply;
 pub mod rig;
-pub mod stl;
-pub mod text;
+pub(crate) mod stl;
+pub(crate) mod text;
 pub mod texture;
-pub mod threemf;
-pub mod usd;
+pub(crate) mod threemf;
+pub(crate) mod usd;
 
 /// The model file extensions softraster reads (case-insensitive).
 pub const MODEL_EXTENSIONS: [&str; 11] = [

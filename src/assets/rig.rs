@@ -20,8 +20,10 @@ use super::gltf::pose::{Influences, Target, joint_matrices, morph_vertex};
 use super::keyframes::{ChannelPath, Clip};
 use super::mesh::Mesh;
 
+/// A node of a glTF file.
 #[derive(Debug, Clone)]
 pub struct RigNode {
+    /// Its parent's index (None: a root).
     pub parent: Option<usize>,
     /// The node's own transform as the file gives it.
     pub matrix: Mat4,
@@ -32,10 +34,12 @@ pub struct RigNode {
     pub weights: Vec<f32>,
 }
 
+/// A glTF skin.
 #[derive(Debug, Clone)]
 pub struct RigSkin {
     /// Node index of each joint.
     pub joints: Vec<usize>,
+    /// Per joint: mesh space to the joint's space at bind time.
     pub inverse_bind: Vec<Mat4>,
 }
 
@@ -46,7 +50,11 @@ pub enum SegmentNormals {
     Vertex(Vec<Vec3>),
     /// None in the file: the face normal per corner (three mesh vertices
     /// per triangle, from `first_triangle` on).
-    Faces { first_triangle: u32 },
+    /// Face normals, from a triangle on.
+    Faces {
+        /// The first of the segment's triangles in the mesh.
+        first_triangle: u32,
+    },
     /// Points and lines: +Y, unused.
     Fixed,
 }
@@ -59,20 +67,27 @@ pub struct Segment {
     /// Per mesh vertex of the segment: its source vertex (None: the same
     /// index).
     pub order: Option<Vec<u32>>,
+    /// The node the primitive hangs on.
     pub node: usize,
+    /// The skin that bends it (index in `Rig::skins`).
     pub skin: Option<usize>,
+    /// Per source vertex: its position.
     pub positions: Vec<Vec3>,
+    /// Its normals.
     pub normals: SegmentNormals,
+    /// Its morph targets.
     pub targets: Vec<Target>,
     /// Skinned segments: per source vertex.
     pub influences: Vec<Influences>,
 }
 
 impl Segment {
+    /// Its vertices in the loaded mesh.
     pub fn len(&self) -> usize {
         self.order.as_ref().map_or(self.positions.len(), Vec::len)
     }
 
+    /// Whether it has no vertex.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -91,11 +106,15 @@ impl Segment {
     }
 }
 
+/// The nodes, skins and clips of a model file: what poses its mesh over
+/// time.
 #[derive(Debug, Clone, Default)]
 pub struct Rig {
+    /// The file's nodes.
     pub nodes: Vec<RigNode>,
     /// Node indices, parents before children.
     pub order: Vec<usize>,
+    /// The file's skins.
     pub skins: Vec<RigSkin>,
     /// In mesh vertex order, covering every vertex.
     pub segments: Vec<Segment>,
@@ -109,14 +128,18 @@ pub struct Rig {
 /// Every node's world transform and morph weights at one time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodePose {
+    /// Per node: object to world.
     pub worlds: Vec<Mat4>,
+    /// Per node: its morph weights.
     pub weights: Vec<Vec<f32>>,
 }
 
 /// A mesh's vertices as one pose places them (the mesh's object space).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Posed {
+    /// Per vertex: its position.
     pub positions: Vec<Vec3>,
+    /// Per vertex: its unit normal.
     pub normals: Vec<Vec3>,
     /// Per triangle corner, as `Mesh::tangents` (empty when it is).
     pub tangents: Vec<Vec4>,

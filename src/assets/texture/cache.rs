@@ -25,6 +25,7 @@ pub struct TextureCache {
 /// How a texture was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Lookup {
+    /// Read from the cache.
     Hit,
     /// Decoded; the entry was written (or, with a warning, could not be).
     Miss,

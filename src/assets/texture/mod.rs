@@ -29,7 +29,9 @@ pub use lanes::{Chain, Rgb4, Taps4};
 /// sampler's limit lowers a scene's filter to it, never raises it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum TextureFilter {
+    /// The nearest texel of level 0.
     Nearest,
+    /// Four texels of level 0, blended.
     Bilinear,
     /// Mip level from the longer footprint axis, blended between levels.
     Trilinear,
@@ -44,8 +46,11 @@ pub enum TextureFilter {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AddressMode {
     #[default]
+    /// Tiles.
     Repeat,
+    /// Tiles, every other copy mirrored.
     Mirror,
+    /// The edge texels extend.
     Clamp,
     /// Transparent black (`BORDER`).
     Border,
@@ -55,16 +60,23 @@ pub enum AddressMode {
 /// (see the module notes).
 #[derive(Debug)]
 pub struct Level {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
     blocks: crate::bigbuf::BigBuf<Block>,
     /// Blocks per row of blocks.
     blocks_x: u32,
 }
 
+/// A decoded image with its texel layout, colour space and the facts
+/// shading asks of it (alpha, greyness); its mip chain is built on the
+/// first frame that minifies it.
 #[derive(Debug)]
 pub struct Texture {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
     /// Level 0, as decoded. Levels 1.. (`chain`) are handed to the
     /// lookups by the frames that minify the texture (`Filtering::mips`).
@@ -139,6 +151,7 @@ unsafe impl bytemuck::Pod for Block {}
 /// change its lookup.
 #[derive(Debug, Clone)]
 pub struct TextureRef {
+    /// The image.
     pub texture: std::sync::Arc<Texture>,
     /// Applied to the texture coordinates before the lookup: MTL `-s` and
     /// `-o`, glTF KHR_texture_transform.
@@ -168,7 +181,9 @@ impl From<AddressMode> for Wrap {
 /// How to filter a lookup that carries screen-space derivatives.
 #[derive(Debug, Clone, Copy)]
 pub struct Filtering<'a> {
+    /// The scene's filter (or a sampler's lower limit).
     pub filter: TextureFilter,
+    /// The largest anisotropy taken.
     pub max_anisotropy: f32,
     /// The texture's levels 1.. (empty for a 1x1 texture); None where this
     /// frame never minifies the texture: level 0 only.
@@ -178,7 +193,9 @@ pub struct Filtering<'a> {
 /// Texture-coordinate derivatives along screen x and y (from a 2x2 quad).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Gradients {
+    /// Along screen x.
     pub dx: Vec2,
+    /// Along screen y.
     pub dy: Vec2,
 }
 
@@ -205,7 +222,14 @@ pub enum Footprint {
     Lod(f32),
     /// `n` trilinear probes at `lod`, spread over `axis` (texture
     /// coordinates) centred on the lookup.
-    Probes { n: f32, lod: f32, axis: Vec2 },
+    Probes {
+        /// How many probes.
+        n: f32,
+        /// Their level of detail.
+        lod: f32,
+        /// The footprint's long axis.
+        axis: Vec2,
+    },
     /// The nearest texel of the image (level 0): the scene's `nearest`
     /// filter, or a sampler's magnification filter NEAREST.
     Nearest,
@@ -249,6 +273,7 @@ impl Level {
     }
 
     #[inline]
+    /// The RGBA8 texel at (x, y).
     pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
         let i = self.index(x, y);
         self.blocks[i >> 4].0[i & 15]
@@ -682,6 +707,8 @@ impl TextureRef {
         self.transform == Affine2::IDENTITY && self.min_limit.is_none() && !self.mag_nearest
     }
 
+    /// A plain reference to `texture`: no transform, the scene's address
+    /// mode, coordinate set 0.
     pub fn new(texture: std::sync::Arc<Texture>) -> TextureRef {
         TextureRef {
             texture,
