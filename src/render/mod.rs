@@ -63,11 +63,11 @@ use crate::raster::coverage::sample_pattern;
 use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
 use crate::raytrace::{Placed, Tracer};
-use crate::scene::Scene;
 use crate::scene::camera::Projection;
 use crate::scene::environment::EnvMethod;
 use crate::scene::material::{Native, roughness_from_ns};
 use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter};
+use crate::scene::{Light, Scene};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
 use crate::shade::env::sampled::EnvSampler;
@@ -282,13 +282,7 @@ impl<'s> Renderer<'s> {
     pub fn prepare(&self) {
         self.build_all_mips();
         let _ = self.env_light();
-        let s = &self.scene.settings;
-        let traced = (s.shadows == ShadowMethod::Raytraced
-            && self.scene.lights.iter().any(|l| l.shadows))
-            || s.ao.method == AoMethod::Raytraced
-            || self.env_sampler().is_some()
-            || self.scene.ground.is_some();
-        if traced {
+        if self.traces_rays(&self.scene.lights) {
             self.meshes.par_iter().zip(&self.bvhs).for_each(|(m, b)| {
                 b.get_or_init(|| bvh_of(m));
             });
@@ -328,6 +322,17 @@ impl<'s> Renderer<'s> {
             .get_or_init(|| Some(EnvSampler::new(&e.image, e.intensity, e.rotation)))
             .as_ref()?;
         Some((sampler, samples))
+    }
+
+    /// Whether frames lit by `lights` trace rays through the BVHs:
+    /// ray-traced shadows of a light that casts them, ray-traced AO, the
+    /// sampled environment or the ground's shadow catcher.
+    fn traces_rays(&self, lights: &[Light]) -> bool {
+        let s = &self.scene.settings;
+        (s.shadows == ShadowMethod::Raytraced && lights.iter().any(|l| l.shadows))
+            || s.ao.method == AoMethod::Raytraced
+            || self.env_sampler().is_some()
+            || self.scene.ground.is_some()
     }
 
     /// The frame's meshes as placed, for rays. `posed`: the BVHs of this
@@ -397,13 +402,8 @@ impl<'s> Renderer<'s> {
             height,
             msaa: pattern.len() > 1,
         };
-        let shadow_rays =
-            s.shadows == ShadowMethod::Raytraced && setup.lights.iter().any(|l| l.shadows);
         let sampled = self.env_sampler();
-        let traced = shadow_rays
-            || s.ao.method == AoMethod::Raytraced
-            || sampled.is_some()
-            || setup.scene.ground.is_some();
+        let traced = self.traces_rays(&setup.lights);
         let posed_bvhs = if traced {
             self.posed_bvhs(setup)
         } else {
