@@ -13,9 +13,8 @@
 //! textures of [`assets`] and the primitives of [`procedural`]), the
 //! renderer and its frames ([`render`]), a scene's whole run ([`batch`]),
 //! the writers ([`output`]) and the errors ([`error`]). The internals
-//! (`raster`, `shade`, `simd`, and the loaders behind `Scene::load`) are
-//! hidden from these docs: public only for the CLI package's tools, the
-//! integration tests and the fuzz targets, and free to change.
+//! (`raster`, `shade`, `simd`, `raytrace`, and the loaders behind
+//! `Scene::load`) are private.
 //!
 //! This package is the renderer alone. The `softraster` binary, the tools
 //! that measure the renderer (bench, chart, accuracy tables, image
@@ -121,18 +120,12 @@ mod files;
 pub mod output;
 mod powers;
 pub mod procedural;
-// Internals: public only for the CLI package's tools, the integration
-// tests and the fuzz targets, which reach into them; not part of the
-// documented API and free to change.
-#[doc(hidden)]
-pub mod raster;
+mod raster;
 mod raytrace;
 pub mod render;
 pub mod scene;
-#[doc(hidden)]
-pub mod shade;
-#[doc(hidden)]
-pub mod simd;
+mod shade;
+mod simd;
 #[cfg(test)]
 mod testing;
 

@@ -4,7 +4,7 @@ fn main() {
     if let Some(missing) = missing_cpu_feature() {
         refuse(missing);
     }
-    if let Err(e) = softraster::simd::lane_width() {
+    if let Err(e) = softraster::render::forced_lane_width() {
         eprintln!("error: {e}");
         std::process::exit(2);
     }

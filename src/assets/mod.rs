@@ -6,11 +6,7 @@ pub(crate) mod dds;
 pub(crate) mod draco;
 pub mod environment;
 pub(crate) mod fbx;
-// The loaders are reached through `Scene::load`; `gltf::load` and
-// `obj::load` are public for the fuzz targets and tests only, not part of
-// the documented API.
-#[doc(hidden)]
-pub mod gltf;
+pub(crate) mod gltf;
 pub(crate) mod guard;
 pub mod input;
 pub mod keyframes;
@@ -18,8 +14,7 @@ pub(crate) mod ktx2;
 pub mod mesh;
 pub(crate) mod meshopt;
 pub mod mip;
-#[doc(hidden)]
-pub mod obj;
+pub(crate) mod obj;
 pub(crate) mod ply;
 pub mod rig;
 pub(crate) mod stl;

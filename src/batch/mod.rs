@@ -31,8 +31,9 @@ use crate::scene::Scene;
 /// cameras, file names) and whether existing files are kept. `run`
 /// renders in order while a writer thread writes the previous frame.
 pub struct RenderJob {
-    /// With `render.exposure = "auto"` resolved to stops (`all`).
     scene: Scene,
+    /// Every frame's exposure in stops (`Renderer::exposure`).
+    exposure: f32,
     /// Which frames of which cameras, and the files each writes.
     pub plan: RenderPlan,
     /// Frames whose files all exist already are not rendered again.
@@ -82,23 +83,28 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, Error> {
 }
 
 impl RenderJob {
-    /// Every frame of every camera of `scene`, whose `render.exposure =
-    /// "auto"` is resolved here, once, to stops for the whole sequence.
-    pub fn all(mut scene: Scene) -> RenderJob {
-        if scene.settings.auto_exposure {
-            scene.settings.exposure = crate::render::auto_exposure(&scene);
-            scene.settings.auto_exposure = false;
-        }
+    /// Every frame of every camera of `scene`. Its exposure is resolved
+    /// here, once for the whole sequence (with `render.exposure = "auto"`,
+    /// by rendering small frames), whichever frames the plan keeps.
+    pub fn all(scene: Scene) -> RenderJob {
+        let exposure = Renderer::new(&scene).exposure();
         RenderJob {
             plan: RenderPlan::all(&scene),
             scene,
+            exposure,
             skip_existing: false,
         }
     }
 
-    /// The job's scene (its exposure resolved).
+    /// The job's scene.
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// The exposure of every frame, in stops (`render.exposure`, "auto"
+    /// resolved).
+    pub fn exposure(&self) -> f32 {
+        self.exposure
     }
 
     /// Renders and writes everything; calls `on_done` as frames land. The
@@ -215,7 +221,7 @@ impl RenderJob {
                 let t0 = Instant::now();
                 // The display image is made as the frame renders.
                 let mut image = (files.color.is_some() || in_video).then(Image8::empty);
-                let shot = Shot::new(cam, frame);
+                let shot = Shot::new(cam, frame).with_exposure(self.exposure);
                 if let Err(e) = renderer.render_next(shot, &mut buffer, image.as_mut()) {
                     result = Err(e);
                     break 'frames;

@@ -12,7 +12,8 @@ pub mod video;
 
 pub use pack::{FileToWrite, OutputFiles, pack};
 
-/// Tone mapping lives with shading (`shade::tonemap`); its old path stays.
+/// The tone maps `resolve` applies (`render.tonemap`), for display values
+/// of a linear colour.
 pub use crate::shade::tonemap;
 
 use std::io::Write;

@@ -102,7 +102,7 @@ impl Interpolator {
 }
 
 /// Interpolates at the center of pixel (px, py).
-#[inline]
+#[cfg(test)]
 pub fn at_pixel(t: &Tri, px: i32, py: i32) -> Fragment {
     Interpolator::new(t).at_pixel(px, py)
 }

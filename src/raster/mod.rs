@@ -8,6 +8,8 @@ pub mod bin;
 pub mod clip;
 pub mod coverage;
 pub mod interp;
+#[cfg(test)]
+mod known_answers;
 pub mod setup;
 
 /// Which triangles setup discards by their winding on screen.
@@ -19,7 +21,10 @@ pub enum CullMode {
     Auto,
     /// Counter-clockwise triangles face the camera; clockwise ones go.
     Back,
+    /// Counter-clockwise triangles go; clockwise ones stay (the inside of
+    /// a closed mesh shows).
     Front,
+    /// Both windings are drawn.
     None,
 }
 

@@ -94,27 +94,6 @@ impl<'a> Tracer<'a> {
             }
         })
     }
-
-    /// Ray parameter of the nearest hit on `o + t d`, t in (0, t_max).
-    pub fn nearest(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<f32> {
-        let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
-        let mut best = t_max;
-        let mut hit = None;
-        for i in &self.instances {
-            if !box_hit(i.lo, i.hi, oa, inv, best) {
-                continue;
-            }
-            let m = &i.object_from_world;
-            if let Some(h) = i
-                .bvh
-                .nearest(m.transform_point3(o), m.transform_vector3(d), 0.0, best)
-            {
-                best = h.t;
-                hit = Some(h.t);
-            }
-        }
-        hit
-    }
 }
 
 #[inline]

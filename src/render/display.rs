@@ -41,9 +41,9 @@ impl Image8 {
     }
 }
 
-/// Exposure, tone map and sRGB encoding (the data views are written as
-/// their values, without a transfer curve). Frame colors are premultiplied
-/// by their coverage alpha (partly covered MSAA pixels, blended surfaces
+/// Exposure (the frame's, `Frame::exposure`), tone map and sRGB encoding
+/// (the data views are written as their values, without a transfer
+/// curve). Frame colors are premultiplied by their coverage alpha (partly covered MSAA pixels, blended surfaces
 /// over a transparent background); an RGBA image gets straight alpha.
 pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
     let mut image = Image8::empty();
@@ -53,7 +53,7 @@ pub fn resolve(frame: &Frame, s: &RenderSettings) -> Image8 {
 
 /// `*image = resolve(frame, s)`, reusing `image`'s memory.
 pub fn resolve_into(frame: &Frame, s: &RenderSettings, image: &mut Image8) {
-    let enc = Encoder::new(s);
+    let enc = Encoder::new(s, frame.exposure);
     enc.shape(frame.width, frame.height, image);
     let (w, c) = (frame.width as usize, enc.channels);
     if w == 0 {
@@ -89,14 +89,15 @@ pub(super) struct Encoder {
 }
 
 impl Encoder {
-    pub(super) fn new(s: &RenderSettings) -> Encoder {
+    /// The encoder of settings `s` at `exposure` stops.
+    pub(super) fn new(s: &RenderSettings, exposure: f32) -> Encoder {
         let alpha = s.background == Background::Transparent;
         Encoder {
             alpha,
             channels: if alpha { 4 } else { 3 },
             data_view: s.shading.is_data_view(),
             tonemap: s.tonemap,
-            scale: s.exposure.exp2(),
+            scale: exposure.exp2(),
         }
     }
 

@@ -1,6 +1,6 @@
-//! `render.exposure = "auto"`: one exposure for the whole sequence, so a
-//! turntable does not flicker and every shard of a farm run gets the same
-//! value. Up to 8 frames spread over the animation, of every camera, are
+//! `render.exposure = "auto"` (`Renderer::exposure`): one exposure for the
+//! whole sequence, so a turntable does not flicker and every shard of a
+//! farm run gets the same value. Up to 8 frames spread over the animation, of every camera, are
 //! rendered at most 96 pixels wide (no AO, no supersampling), and the
 //! log-average luminance of the pixels showing the models (all pixels when
 //! none do) is mapped to middle grey, 0.18.
@@ -11,9 +11,11 @@ use crate::scene::settings::AoMethod;
 
 /// Stops that bring the scene's log-average luminance to 0.18, within
 /// [-16, 16]. Depends on the scene only.
-pub fn auto_exposure(scene: &Scene) -> f32 {
+pub(super) fn auto_exposure(scene: &Scene) -> f32 {
     let mut small = scene.clone();
     let s = &mut small.settings;
+    // The small frames' linear colour does not depend on the exposure.
+    (s.auto_exposure, s.exposure) = (false, 0.0);
     let scale = 96.0 / s.width.max(s.height) as f32;
     if scale < 1.0 {
         s.width = ((s.width as f32 * scale).round() as u32).max(1);

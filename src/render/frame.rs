@@ -25,6 +25,9 @@ pub struct Frame {
     /// The surface data passes (normal, albedo, position, ids) of the
     /// nearest fragment per pixel; empty unless the scene writes one.
     pub aov: Vec<AovPixel>,
+    /// Stops the display transform applies (`display::resolve`): the
+    /// exposure of the shot rendered into the frame.
+    pub exposure: f32,
 }
 
 /// What the data passes record of a pixel's nearest fragment: the one its
@@ -107,6 +110,7 @@ impl Frame {
             depth: vec![f32::INFINITY; n],
             ao: Vec::new(),
             aov: Vec::new(),
+            exposure: 0.0,
         }
     }
 

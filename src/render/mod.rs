@@ -52,7 +52,6 @@ use rayon::prelude::*;
 
 pub use display::{Image8, resolve};
 pub use draw_list::DrawList;
-pub use exposure::auto_exposure;
 pub use frame::{AovPixel, Frame, FrameSequence};
 
 use crate::assets::mesh::Mesh;
@@ -75,20 +74,58 @@ use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
 use geometry::Geometry;
 
+/// Where `render.msaa = samples` samples each pixel: offsets from the
+/// pixel's center in 1/16 pixel, x right and y down, the standard
+/// Direct3D (and Vulkan) positions for 1, 2, 4, 8 and 16 samples; None for
+/// other counts. For checking coverage against a known shape.
+pub fn msaa_sample_positions(samples: u32) -> Option<&'static [(i8, i8)]> {
+    sample_pattern(samples)
+}
+
+/// The lane widths this build shades with (each frame is the same bytes at
+/// every one): 1, 4 and 8 where it targets AVX (x86-64-v3, the default
+/// x86-64 build), else 1 and 4.
+pub fn lane_widths() -> &'static [usize] {
+    crate::simd::widths()
+}
+
+/// The lane width the `SOFTRASTER_LANES` variable forces (1, 4 or 8, for
+/// tests and bug reports), or None without it. A width this build lacks
+/// is an `Error::Argument` naming the variable and the widths it has.
+pub fn forced_lane_width() -> Result<Option<usize>, Error> {
+    crate::simd::lane_width().map_err(Error::Argument)
+}
+
 /// What one call renders: a camera of the scene (its index in
-/// `Scene::cameras`) and a frame of its animation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// `Scene::cameras`), a frame of its animation, and the exposure its
+/// display image takes.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Shot {
     /// The camera's index in `Scene::cameras`.
     pub camera: usize,
     /// The frame of the animation, from 0.
     pub frame: u32,
+    /// Stops (`2^exposure` scales the radiance before the tone map); None:
+    /// the scene's `render.exposure` (`Renderer::exposure`).
+    pub exposure: Option<f32>,
 }
 
 impl Shot {
-    /// Camera `camera` at frame `frame`.
+    /// Camera `camera` at frame `frame`, at the scene's exposure.
     pub fn new(camera: usize, frame: u32) -> Shot {
-        Shot { camera, frame }
+        Shot {
+            camera,
+            frame,
+            exposure: None,
+        }
+    }
+
+    /// The same shot at `stops` of exposure.
+    pub fn with_exposure(self, stops: f32) -> Shot {
+        Shot {
+            exposure: Some(stops),
+            ..self
+        }
     }
 }
 
@@ -122,6 +159,8 @@ pub struct Renderer<'s> {
     light_culling: bool,
     /// Lanes per lane call: 1, 4 or 8 (`simd::lane_width`).
     lane_width: usize,
+    /// `render.exposure = "auto"`, computed on first need.
+    auto_exposure: OnceLock<f32>,
 }
 
 impl<'s> Renderer<'s> {
@@ -155,12 +194,28 @@ impl<'s> Renderer<'s> {
                 .ok()
                 .flatten()
                 .unwrap_or(crate::simd::widest()),
+            auto_exposure: OnceLock::new(),
         }
     }
 
     /// The scene this renderer draws.
     pub fn scene(&self) -> &'s Scene {
         self.scene
+    }
+
+    /// The scene's exposure in stops: `render.exposure`, and for "auto"
+    /// the one value of the whole sequence (every camera, every frame),
+    /// computed here on first need, so a turntable does not flicker and
+    /// every shard of a farm run gets the same value. It does not depend
+    /// on the renderer's other settings.
+    pub fn exposure(&self) -> f32 {
+        let s = &self.scene.settings;
+        if !s.auto_exposure {
+            return s.exposure;
+        }
+        *self
+            .auto_exposure
+            .get_or_init(|| exposure::auto_exposure(self.scene))
     }
 
     /// Shades `width` lanes at a time (1, 4 or 8; a width this build
@@ -189,7 +244,7 @@ impl<'s> Renderer<'s> {
     /// box-filtered down. A camera the scene does not have is an error
     /// naming it.
     pub fn render(&self, shot: Shot, out: &mut Frame) -> Result<(), Error> {
-        self.render_frame(self.setup(shot)?, out, None);
+        self.render_frame(self.setup(shot, out)?, out, None);
         Ok(())
     }
 
@@ -203,7 +258,7 @@ impl<'s> Renderer<'s> {
         out: &mut Frame,
         image: &mut Image8,
     ) -> Result<(), Error> {
-        self.render_frame(self.setup(shot)?, out, Some(image));
+        self.render_frame(self.setup(shot, out)?, out, Some(image));
         Ok(())
     }
 
@@ -216,8 +271,8 @@ impl<'s> Renderer<'s> {
         seq: &mut FrameSequence,
         image: Option<&mut Image8>,
     ) -> Result<(), Error> {
-        let setup = self.setup(shot)?;
         let (out, known) = seq.parts();
+        let setup = self.setup(shot, out)?;
         let s = &self.scene.settings;
         if (out.width, out.height) != (s.width, s.height) || s.ssaa.max(1) > 1 {
             // Another size, or a filter over a larger frame: nothing of
@@ -232,9 +287,9 @@ impl<'s> Renderer<'s> {
         Ok(())
     }
 
-    /// The frame's draw list for `shot`, or an error naming a camera the
-    /// scene does not have.
-    fn setup(&self, shot: Shot) -> Result<DrawList<'s>, Error> {
+    /// The frame's draw list for `shot` (and `out`'s exposure, the shot's),
+    /// or an error naming a camera the scene does not have.
+    fn setup(&self, shot: Shot, out: &mut Frame) -> Result<DrawList<'s>, Error> {
         let n = self.scene.cameras.len();
         if shot.camera >= n {
             return Err(Error::Argument(format!(
@@ -242,6 +297,7 @@ impl<'s> Renderer<'s> {
                 shot.camera
             )));
         }
+        out.exposure = shot.exposure.unwrap_or_else(|| self.exposure());
         Ok(DrawList::new(self.scene, shot.camera, shot.frame))
     }
 
@@ -292,22 +348,48 @@ impl<'s> Renderer<'s> {
     /// The environment's lighting, prefiltered once per process
     /// (`env_cache`).
     fn env_light(&self) -> Option<&EnvLight> {
-        let scene = self.scene;
         self.env
             .get_or_init(|| {
-                let e = scene.environment.as_ref()?;
-                // The Blinn-Phong exponents that may meet the environment.
-                let all = scene.settings.shading == ShadingMode::BlinnPhong;
-                let phong = scene
-                    .models
-                    .iter()
-                    .flat_map(|m| &m.materials)
-                    .filter(|m| (all || m.native == Native::BlinnPhong) && m.illum > 0)
-                    .map(|m| roughness_from_ns(m.ns));
+                let e = self.scene.environment.as_ref()?;
                 let params = (e.intensity, e.rotation, e.prefilter_size);
-                Some(env_cache::env_light(&e.image, params, phong.collect()))
+                Some(env_cache::env_light(
+                    &e.image,
+                    params,
+                    self.phong_roughness(),
+                ))
             })
             .as_deref()
+    }
+
+    /// Prefilters the scene's environment as the first frame of a process
+    /// does, but past the process's cache of prefiltered lighting, and
+    /// returns the seconds it took (0 without an environment): for
+    /// charting `prefilter_size` against time. The renderer's frames are
+    /// unchanged.
+    pub fn time_environment_prefilter(&self) -> f64 {
+        let Some(e) = &self.scene.environment else {
+            return 0.0;
+        };
+        let t = std::time::Instant::now();
+        let light = EnvLight::with_size(&e.image, e.intensity, e.rotation, e.prefilter_size)
+            .with_phong_roughness(self.phong_roughness());
+        let seconds = t.elapsed().as_secs_f64();
+        drop(light);
+        seconds
+    }
+
+    /// The roughness of every Blinn-Phong exponent that may meet the
+    /// environment.
+    fn phong_roughness(&self) -> Vec<f32> {
+        let scene = self.scene;
+        let all = scene.settings.shading == ShadingMode::BlinnPhong;
+        scene
+            .models
+            .iter()
+            .flat_map(|m| &m.materials)
+            .filter(|m| (all || m.native == Native::BlinnPhong) && m.illum > 0)
+            .map(|m| roughness_from_ns(m.ns))
+            .collect()
     }
 
     /// `method = "sampled"`: the sampling tables (built once) and the
@@ -495,7 +577,7 @@ impl<'s> Renderer<'s> {
         // band without one.
         let (encoder, bytes): (_, Vec<&mut [u8]>) = match display {
             Some(image) => {
-                let e = display::Encoder::new(&data.setup.scene.settings);
+                let e = display::Encoder::new(&data.setup.scene.settings, out.exposure);
                 e.shape(out.width, out.height, image);
                 (
                     Some(e),

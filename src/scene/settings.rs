@@ -140,10 +140,11 @@ pub struct RenderSettings {
     pub depth: DepthMode,
     /// Linear radiance to display range.
     pub tonemap: Tonemap,
-    /// Stops (`2^exposure` scales the radiance before the tone map).
+    /// Stops (`2^exposure` scales the radiance before the tone map); 0
+    /// with `auto_exposure`.
     pub exposure: f32,
-    /// `render.exposure = "auto"`: the batch sets `exposure` once for the
-    /// whole sequence (`render::auto_exposure`) before the first frame.
+    /// `render.exposure = "auto"`: the renderer computes one exposure for
+    /// the whole sequence (`Renderer::exposure`).
     pub auto_exposure: bool,
     /// What shows where no model is.
     pub background: Background,

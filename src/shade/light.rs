@@ -111,7 +111,7 @@ impl LightMask {
     }
 
     /// Whether light `i` is in the set.
-    #[inline]
+    #[cfg(test)]
     pub fn has(self, i: usize) -> bool {
         self.0 & 1 << (i as u32).min(Self::REST) != 0
     }

@@ -127,6 +127,13 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_head_on_albedo_at_roughness_half_is_the_value_the_render_test_expects() {
+        // `tests/it/gltf.rs` (KHR_materials_sheen) checks a rendered cube
+        // face against this number.
+        assert!((albedo(1.0, 0.5) - 0.031_526_58).abs() < 1e-7);
+    }
+
+    #[test]
     fn albedo_is_bounded_and_grows_towards_grazing_views() {
         for r in [0.1, 0.3, 0.6, 1.0] {
             let head_on = albedo(1.0, r);

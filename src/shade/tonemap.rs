@@ -6,6 +6,9 @@ use glam::{Mat3, Vec3};
 
 use crate::scene::settings::Tonemap;
 
+/// Linear radiance `c` scaled by `exposure_scale` (2^stops) and mapped by
+/// `op` to display-linear values (in [0, 1] for every map but `clamp`,
+/// which the sRGB encoding clamps).
 #[inline]
 pub fn tonemap(c: Vec3, op: Tonemap, exposure_scale: f32) -> Vec3 {
     let c = c * exposure_scale;

@@ -278,7 +278,7 @@ impl Lane for Vec4 {
     }
 }
 
-pub use f8::{F8, M8};
+pub use f8::F8;
 
 /// Eight lanes as one AVX register (x86-64 builds with AVX: the
 /// x86-64-v3 default).

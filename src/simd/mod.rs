@@ -19,7 +19,7 @@ use glam::{Vec3, Vec4};
 
 mod lane;
 
-pub use lane::{F8, Lane, M8, Mask};
+pub use lane::{F8, Lane, Mask};
 
 /// The most lanes any width has (`F8`).
 pub const MAX_WIDTH: usize = 8;

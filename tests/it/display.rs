@@ -88,6 +88,47 @@ fn band_by_band_bytes_equal_the_resolve_of_the_frame() {
 }
 
 #[test]
+fn a_shots_exposure_scales_the_display_and_not_the_linear_frame() {
+    let showcase = common::root().join("scenes/showcase.toml");
+    let sets = [
+        "output.width=64",
+        "output.height=48",
+        "render.tonemap=\"clamp\"",
+        "render.exposure=0.5",
+        "render.ao.method=\"off\"",
+    ];
+    let scene = load_with(&showcase, &sets);
+    let r = Renderer::new(&scene);
+    assert_eq!(r.exposure(), 0.5);
+    let (mut scene_own, mut brighter) = (Frame::new(0, 0), Frame::new(0, 0));
+    let (mut a, mut b) = (Image8::empty(), Image8::empty());
+    r.render_display(Shot::new(0, 0), &mut scene_own, &mut a)
+        .unwrap();
+    let shot = Shot::new(0, 0).with_exposure(1.5);
+    r.render_display(shot, &mut brighter, &mut b).unwrap();
+    assert_eq!((scene_own.exposure, brighter.exposure), (0.5, 1.5));
+    // The same linear frame; the bytes of each are its own exposure's.
+    assert!(scene_own.color == brighter.color);
+    assert!(a.data == resolve(&scene_own, &scene.settings).data);
+    assert!(b.data == resolve(&brighter, &scene.settings).data);
+    // One stop more doubles the radiance before the clamp: a pixel well
+    // inside the range doubles its linear value.
+    let lin = |v: u8| {
+        let c = v as f32 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let mid = (0..a.data.len())
+        .find(|&i| (40..100).contains(&a.data[i]))
+        .expect("a mid-grey channel");
+    let ratio = lin(b.data[mid]) / lin(a.data[mid]);
+    assert!((ratio - 2.0).abs() < 0.1, "{ratio}");
+}
+
+#[test]
 fn a_transparent_background_gives_the_same_rgba() {
     let dir = scratch("display-transparent");
     let assets = common::root().join("assets/showcase");

@@ -352,12 +352,14 @@ fn a_skinned_bar_follows_its_joints_through_the_clip() {
 fn the_default_pose_of_the_rig_is_the_loaded_mesh() {
     let dir = common::scratch("anim_rest");
     std::fs::write(dir.join("bar.gltf"), bar()).unwrap();
-    let m = softraster::assets::gltf::load(
-        &dir.join("bar.gltf"),
-        &softraster::assets::input::Input::default(),
+    std::fs::write(
+        dir.join("s.toml"),
+        "[[model]]\npath = \"bar.gltf\"\nanimation = \"Bend\"\n",
     )
     .unwrap();
-    let rig = m.rig.unwrap().unwrap();
+    let scene = softraster::scene::Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let m = &scene.models[0];
+    let rig = &m.playback.as_ref().expect("the clip plays").rig;
     let posed = rig.place(
         &rig.node_pose(None),
         &m.mesh,

@@ -130,8 +130,7 @@ fn a_skinned_bar_takes_its_joints_default_pose() {
     let dir = common::scratch("gltf_skin");
     let path = dir.join("bar.gltf");
     std::fs::write(&path, bent_bar()).unwrap();
-    let m = softraster::assets::gltf::load(&path, &softraster::assets::input::Input::default())
-        .unwrap_or_else(|e| panic!("{e}"));
+    let m = loaded_model(&path);
     // Without normals each triangle corner is its own vertex: compare the
     // distinct positions.
     let mut got: Vec<Vec3> = m
@@ -187,8 +186,7 @@ fn morph_targets_blend_with_the_default_weights() {
     for (node, shift) in [("", 0.5f32), (", \"weights\": [0.25]", 0.25)] {
         let path = dir.join("quad.gltf");
         std::fs::write(&path, morphing_quad(node)).unwrap();
-        let m = softraster::assets::gltf::load(&path, &softraster::assets::input::Input::default())
-            .unwrap_or_else(|e| panic!("{e}"));
+        let m = loaded_model(&path);
         let xs: Vec<f32> = m.mesh.positions.iter().map(|p| p.x).collect();
         let (lo, hi) = xs
             .iter()
@@ -200,4 +198,11 @@ fn morph_targets_blend_with_the_default_weights() {
             "{node}: {xs:?}"
         );
     }
+}
+
+/// The one model of the model file at `path`, loaded as a one-line scene.
+fn loaded_model(path: &std::path::Path) -> softraster::scene::Model {
+    let scene =
+        softraster::scene::Scene::load(path, &Default::default()).unwrap_or_else(|e| panic!("{e}"));
+    scene.models.into_iter().next().expect("one model")
 }

@@ -204,12 +204,9 @@ fn tangent_and_object_space_maps_of_diablo3_agree() {
     use softraster::assets::texture::Texture;
     use softraster::scene::settings::AddressMode;
     let d3 = assets.join("tinyrenderer/diablo3_pose");
-    let mut mesh = softraster::assets::obj::load(
-        &d3.join("diablo3_pose.obj"),
-        &softraster::assets::input::Input::default(),
-    )
-    .unwrap()
-    .mesh;
+    let scene =
+        softraster::scene::Scene::load(&d3.join("diablo3_pose.obj"), &Default::default()).unwrap();
+    let mut mesh = (*scene.models[0].mesh).clone();
     mesh.compute_tangents(0);
     let tangent_map = Texture::load(
         &d3.join("diablo3_pose_nm_tangent.tga"),

@@ -29,7 +29,7 @@ const LIT_CUBES: &str = "[output]\nwidth = 64\nheight = 64\n[render]\ncull = \"n
 /// any bit.
 fn same_at_every_width(scene: &Scene, frames: &[u32], what: &str) {
     let single = Renderer::new(scene).with_lane_width(1);
-    for &width in &softraster::simd::widths()[1..] {
+    for &width in &softraster::render::lane_widths()[1..] {
         let lanes = Renderer::new(scene).with_lane_width(width);
         same_frames(&lanes, &single, frames, &format!("{what}, {width} lanes"));
     }

@@ -181,13 +181,13 @@ fn render_one(
     let load_s = t0.elapsed().as_secs_f64();
     let one = input.is_none();
     if auto && args.progress == Progress::Json {
-        let stops = scene.settings.exposure;
+        let stops = job.exposure();
         println!(
             "{}",
             serde_json::json!({ "event": "exposure", "stops": stops })
         );
     } else if auto && !args.quiet && one {
-        eprintln!("exposure: auto, {:+.2} stops", scene.settings.exposure);
+        eprintln!("exposure: auto, {:+.2} stops", job.exposure());
     }
     // Warnings are shown with --quiet too: it silences progress only.
     for w in &scene.warnings {

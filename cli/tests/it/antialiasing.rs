@@ -9,8 +9,8 @@ use crate::common;
 use std::path::Path;
 
 use common::render_frame;
-use softraster::raster::coverage::sample_pattern;
 use softraster::render::Frame;
+use softraster::render::msaa_sample_positions;
 use softraster::scene::Scene;
 use softraster_cli::tools::accuracy;
 
@@ -53,7 +53,7 @@ fn msaa_coverage_is_the_fraction_of_standard_samples_inside() {
     for n in [1u32, 2, 4, 8, 16] {
         let scene = rect_scene(&dir, &format!("msaa = {n}"));
         let f = render_frame(&scene, 0, 0);
-        let pattern = sample_pattern(n).unwrap();
+        let pattern = msaa_sample_positions(n).unwrap();
         let mut partial = 0;
         let (mut sum, mut worst) = (0.0f64, 0.0f32);
         for py in 0..48 {
@@ -275,7 +275,7 @@ fn msaa_resolves_alpha_cutout_edges_per_sample() {
             &[],
         );
         let f = render_frame(&scene, 0, 0);
-        let pattern = sample_pattern(n).unwrap();
+        let pattern = msaa_sample_positions(n).unwrap();
         let mut worst = 0.0f32;
         let mut partial = 0;
         for py in 10..38 {

@@ -707,7 +707,7 @@ fn every_lane_width_gives_the_same_bytes_and_others_exit_2() {
     for bad in ["3", "16", "0", "eight", ""] {
         let (code, err) = run_with(bad, &dir.join("bad"), &[]);
         assert_eq!(code, 2, "SOFTRASTER_LANES={bad}: {err}");
-        let widths = softraster::simd::widths();
+        let widths = softraster::render::lane_widths();
         assert!(
             err.contains(&format!("SOFTRASTER_LANES={bad}:"))
                 && err.contains("lane width")
@@ -728,7 +728,7 @@ fn every_lane_width_gives_the_same_bytes_and_others_exit_2() {
         ),
     ] {
         let mut frames: Vec<Vec<Vec<u8>>> = Vec::new();
-        for &w in softraster::simd::widths() {
+        for &w in softraster::render::lane_widths() {
             let out = dir.join(variant).join(w.to_string());
             let (code, err) = run_with(&w.to_string(), &out, &extra);
             assert_eq!(code, 0, "{variant}, {w} lanes: {err}");
@@ -744,7 +744,7 @@ fn every_lane_width_gives_the_same_bytes_and_others_exit_2() {
             assert!(
                 *f == frames[0],
                 "{variant}: {} lanes differ from 1",
-                softraster::simd::widths()[k]
+                softraster::render::lane_widths()[k]
             );
         }
     }

@@ -297,7 +297,7 @@ fn auto_exposure_maps_the_models_log_average_to_middle_grey() {
         .replace("[[model]]", "[animation]\nframes = 12\n[[model]]");
     let s = load(&dir, &text);
     assert!(s.settings.auto_exposure);
-    let stops = softraster::render::auto_exposure(&s);
+    let stops = softraster::render::Renderer::new(&s).exposure();
     assert!((stops - 0.18f32.log2()).abs() < 0.01, "{stops}");
     // Every shard of a farm run gets the same value.
     std::fs::write(dir.join("s.toml"), &text).unwrap();

@@ -49,7 +49,6 @@ pub(super) fn lights(scene: &ufbx::Scene, warnings: &mut Vec<String>) -> Vec<Glt
             continue;
         }
         out.push(GltfLight {
-            name: node.element.name.to_string(),
             kind,
             color,
             intensity,

@@ -5,7 +5,6 @@ use super::*;
 /// A KHR_lights_punctual light placed by its node (in the file's space).
 #[derive(Debug, Clone)]
 pub struct GltfLight {
-    pub name: String,
     pub kind: GltfLightKind,
     /// Linear RGB.
     pub color: Vec3,
@@ -65,18 +64,9 @@ impl GltfLight {
     }
 }
 
-pub(super) fn light(
-    l: &gltf::khr_lights_punctual::Light,
-    node: &gltf::Node,
-    world: Mat4,
-) -> GltfLight {
+pub(super) fn light(l: &gltf::khr_lights_punctual::Light, world: Mat4) -> GltfLight {
     use gltf::khr_lights_punctual::Kind;
     GltfLight {
-        name: l
-            .name()
-            .or(node.name())
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("light{}", l.index())),
         kind: match l.kind() {
             Kind::Directional => GltfLightKind::Directional,
             Kind::Point => GltfLightKind::Point,

@@ -413,7 +413,7 @@ fn walk_nodes(
             }
         }
         if let Some(l) = node.light() {
-            lights.push(light(&l, &node, world));
+            lights.push(light(&l, world));
             placed.light_nodes.push(node.index());
         }
         if let Some(c) = node.camera() {

@@ -123,7 +123,6 @@ mod tests {
     #[test]
     fn gltf_lights_follow_their_model() {
         let g = GltfLight {
-            name: "sun".into(),
             kind: GltfLightKind::Point,
             color: Vec3::ONE,
             intensity: 5.0,

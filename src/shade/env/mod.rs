@@ -260,6 +260,7 @@ impl EnvLight {
     /// Prefilters `image`, seen turned by `rotation_deg` about +Y
     /// (counter-clockwise seen from above) and scaled by `intensity`, with
     /// the default level sizes.
+    #[cfg(test)]
     pub fn new(image: &EnvImage, intensity: f32, rotation_deg: f32) -> EnvLight {
         EnvLight::with_size(image, intensity, rotation_deg, 128)
     }

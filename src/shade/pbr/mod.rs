@@ -51,7 +51,6 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::env::{EnvLight, dominant_direction_lanes};
-pub use super::iridescence::Iridescence;
 pub use super::sheen::Sheen;
 use crate::simd::{Lane, MAX_WIDTH, Mask, V3, clamp01};
 
@@ -374,7 +373,7 @@ pub fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
 
 /// Specular albedo under uniform light for reflectance `f0`, from the
 /// analytic fit of the split-sum environment BRDF (clamped to [0, 1]).
-#[inline]
+#[cfg(test)]
 pub fn specular_albedo(f0: Vec3, f90: f32, roughness: f32, ndv: f32) -> Vec3 {
     let (a, b) = env_brdf(roughness, ndv);
     (f0 * a + Vec3::splat(b * f90)).clamp(Vec3::ZERO, Vec3::ONE)

@@ -30,7 +30,6 @@ use softraster::render::{Frame, Renderer, Shot};
 use softraster::scene::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod};
 use softraster::scene::settings::{AoMethod, DepthMode, ShadowMethod, TextureFilter};
 use softraster::scene::{AoSettings, Scene};
-use softraster::shade::env::EnvLight;
 
 /// The knobs, in chart order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -420,11 +419,7 @@ fn sweep_env(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Res
     };
     for &size in sizes {
         set(scene, EnvMethod::Prefiltered, size);
-        let prefilter = scene.environment.as_ref().map_or(0.0, |e| {
-            let t = Instant::now();
-            let _ = EnvLight::with_size(&e.image, e.intensity, e.rotation, size);
-            t.elapsed().as_secs_f64() * 1e3
-        });
+        let prefilter = Renderer::new(scene).time_environment_prefilter() * 1e3;
         let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
         let e = flip(&reference_img, &img, None)?;
         // Once per run, not per frame: printed beside the table (the
