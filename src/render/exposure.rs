@@ -5,7 +5,7 @@
 //! log-average luminance of the pixels showing the models (all pixels when
 //! none do) is mapped to middle grey, 0.18.
 
-use super::{Frame, Renderer, Shot};
+use super::{DrawList, Frame, Renderer};
 use crate::scene::Scene;
 use crate::scene::settings::AoMethod;
 
@@ -29,11 +29,9 @@ pub(super) fn auto_exposure(scene: &Scene) -> f32 {
     let (mut models, mut all) = ((0.0f64, 0u64), (0.0f64, 0u64));
     for cam in 0..small.cameras.len() {
         for k in 0..count {
-            // The cameras are the scene's own: in range.
-            let shot = Shot::new(cam, k * total / count);
-            if renderer.render(shot, &mut frame).is_err() {
-                continue;
-            }
+            // The scene's own cameras: no index to check.
+            let list = DrawList::new(&small, cam, k * total / count);
+            renderer.render_frame(list, &mut frame, None);
             for (c, d) in frame.color.iter().zip(&frame.depth) {
                 let lum = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
                 let l = (lum.max(0.0) as f64 + 1e-4).ln();
