@@ -86,6 +86,10 @@ pub enum Tonemap {
     Reinhard,
     /// Narkowicz's fit of the ACES filmic curve.
     Aces,
+    /// three.js's `ACESFilmicToneMapping` (also model-viewer's and
+    /// Babylon's ACES): Stephen Hill's fit of the ACES RRT and ODT, the
+    /// radiance first scaled by 1/0.6 as three.js does.
+    AcesHill,
     /// Khronos PBR Neutral: colours under 0.76 unchanged.
     PbrNeutral,
     /// AgX: a filmic curve that desaturates highlights toward white.

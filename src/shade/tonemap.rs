@@ -1,6 +1,6 @@
 //! From linear radiance to display values: exposure and a tone map (clamp,
-//! Reinhard, ACES, Khronos PBR Neutral, AgX); the sRGB encoding that
-//! follows is `color::encode_srgb`.
+//! Reinhard, ACES as Narkowicz and as Hill fit it, Khronos PBR Neutral,
+//! AgX); the sRGB encoding that follows is `color::encode_srgb`.
 
 use glam::{Mat3, Vec3};
 
@@ -20,10 +20,34 @@ pub fn tonemap(c: Vec3, op: Tonemap, exposure_scale: f32) -> Vec3 {
             let (a, b, cc, d, e) = (2.51, 0.03, 2.43, 0.59, 0.14);
             (c * (c * a + b)) / (c * (c * cc + d) + e)
         }
+        Tonemap::AcesHill => aces_hill(c),
         Tonemap::PbrNeutral => pbr_neutral(c),
         Tonemap::Agx => agx(c),
     }
     .clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// three.js's `ACESFilmicToneMapping` (tonemapping_pars_fragment.glsl):
+/// the radiance scaled by 1/0.6 ("a brighter viewing environment"), taken
+/// from sRGB primaries to ACES AP1 with the RRT's saturation, through
+/// Stephen Hill's rational fit of the RRT and ODT, and back to sRGB with
+/// the ODT's saturation.
+fn aces_hill(c: Vec3) -> Vec3 {
+    // By column, as the GLSL source writes them.
+    let input = Mat3::from_cols(
+        Vec3::new(0.597_19, 0.076_00, 0.028_40),
+        Vec3::new(0.354_58, 0.908_34, 0.133_83),
+        Vec3::new(0.048_23, 0.015_66, 0.837_77),
+    );
+    let output = Mat3::from_cols(
+        Vec3::new(1.604_75, -0.102_08, -0.003_27),
+        Vec3::new(-0.531_08, 1.108_13, -0.072_76),
+        Vec3::new(-0.073_67, -0.006_05, 1.076_02),
+    );
+    let v = input * (c / 0.6);
+    let a = v * (v + Vec3::splat(0.024_578_6)) - Vec3::splat(0.000_090_537);
+    let b = v * (v * 0.983_729 + Vec3::splat(0.432_951)) + Vec3::splat(0.238_081);
+    output * (a / b)
 }
 
 /// Khronos PBR Neutral (2024): identity below 0.76, then a soft compression
@@ -91,6 +115,7 @@ mod tests {
             Tonemap::Clamp,
             Tonemap::Reinhard,
             Tonemap::Aces,
+            Tonemap::AcesHill,
             Tonemap::PbrNeutral,
             Tonemap::Agx,
         ] {
@@ -126,5 +151,77 @@ mod tests {
         }
         let mid = tonemap(Vec3::splat(0.18), Tonemap::Agx, 1.0).x;
         assert!(mid > 0.1 && mid < 0.35, "{mid}");
+    }
+
+    /// `op` of each input against the values its source gives, to 1e-5.
+    fn matches_source(op: Tonemap, cases: &[([f32; 3], [f32; 3])]) {
+        for (input, want) in cases {
+            let got = tonemap(Vec3::from(*input), op, 1.0);
+            assert!(
+                (got - Vec3::from(*want)).abs().max_element() < 1e-5,
+                "{op:?} {input:?}: {got} against {want:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn aces_hill_is_threejs_aces_filmic() {
+        // three.js src/renderers/shaders/ShaderChunk/
+        // tonemapping_pars_fragment.glsl.js, `ACESFilmicToneMapping` at
+        // toneMappingExposure 1 (the input times 1/0.6, ACESInputMat,
+        // RRTAndODTFit, ACESOutputMat, saturate), evaluated in double
+        // precision from the source's constants.
+        matches_source(
+            Tonemap::AcesHill,
+            &[
+                ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
+                ([0.18, 0.18, 0.18], [0.213_105, 0.213_105, 0.213_103]),
+                ([0.5, 0.5, 0.5], [0.557_586, 0.557_586, 0.557_581]),
+                ([1.0, 1.0, 1.0], [0.763_397, 0.763_397, 0.763_390]),
+                ([4.0, 4.0, 4.0], [0.952_237, 0.952_237, 0.952_227]),
+                ([16.0, 16.0, 16.0], [1.0, 1.0, 1.0]),
+                ([1.0, 0.0, 0.0], [0.957_333, 0.005_324, 0.007_158]),
+                ([0.0, 1.0, 0.0], [0.293_359, 0.774_607, 0.099_434]),
+                ([0.0, 0.0, 1.0], [0.0, 0.0, 0.772_830]),
+                ([0.8, 0.2, 0.05], [0.781_403, 0.274_796, 0.064_413]),
+            ],
+        );
+    }
+
+    #[test]
+    fn aces_is_narkowiczs_fit() {
+        // Krzysztof Narkowicz, "ACES Filmic Tone Mapping Curve" (2016):
+        // x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14), per channel, clamped.
+        let grey = |x: f32, y: f32| ([x; 3], [y; 3]);
+        matches_source(
+            Tonemap::Aces,
+            &[
+                grey(0.0, 0.0),
+                grey(0.18, 0.266_899),
+                grey(0.5, 0.616_307),
+                grey(1.0, 0.803_797),
+                grey(4.0, 0.973_417),
+                grey(16.0, 1.0),
+            ],
+        );
+    }
+
+    #[test]
+    fn pbr_neutral_is_the_khronos_specification() {
+        // KhronosGroup/ToneMapping, PBR_Neutral/README.md, "PBR Neutral
+        // Specification" (F90 = 0.04, Ks = 0.76, Kd = 0.15), evaluated in
+        // double precision.
+        matches_source(
+            Tonemap::PbrNeutral,
+            &[
+                ([0.18, 0.18, 0.18], [0.14, 0.14, 0.14]),
+                ([0.5, 0.3, 0.2], [0.46, 0.26, 0.16]),
+                ([1.0, 1.0, 1.0], [0.869_091, 0.869_091, 0.869_091]),
+                ([4.0, 4.0, 4.0], [0.983_256, 0.983_256, 0.983_256]),
+                ([1.0, 0.0, 0.0], [0.88, 0.015_560, 0.015_560]),
+                ([0.8, 0.2, 0.05], [0.765_496, 0.165_609, 0.015_637]),
+                ([5.0, 1.0, 0.2], [0.987_027, 0.488_270, 0.388_518]),
+            ],
+        );
     }
 }

@@ -76,6 +76,10 @@ fn band_by_band_bytes_equal_the_resolve_of_the_frame() {
             ],
         ),
         ("agx", &["render.tonemap=\"agx\"", "render.msaa=1"]),
+        (
+            "aces-hill",
+            &["render.tonemap=\"aces-hill\"", "render.msaa=1"],
+        ),
         ("normals view", &["render.shading=\"normals\""]),
         ("wide", &["output.width=131", "output.height=37"]),
     ];

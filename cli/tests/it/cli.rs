@@ -158,6 +158,35 @@ fn malformed_toml_exits_2_naming_file_and_line() {
 }
 
 #[test]
+fn a_misspelt_tone_map_exits_2_naming_the_key_and_the_names() {
+    let dir = common::scratch("bad_tonemap");
+    let s = write(
+        &dir,
+        "t.toml",
+        "[render]\ntonemap = \"aces-hil\"\n[[model]]\npath = \"a.obj\"\n",
+    );
+    let err = exit_2(&s, &dir);
+    assert!(
+        err.contains("t.toml:2:") && err.contains("tonemap = \"aces-hil\""),
+        "{err}"
+    );
+    assert!(err.contains("`aces-hill`"), "{err}");
+    let (code, err) = run(&[
+        "render",
+        root().join("scenes/showcase.toml").to_str().unwrap(),
+        "--set",
+        "render.tonemap=\"aces-hil\"",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("render.tonemap") && err.contains("`aces-hill`"),
+        "{err}"
+    );
+}
+
+#[test]
 fn missing_model_exits_2_naming_the_resolved_path() {
     let dir = common::scratch("missing_model");
     let s = write(&dir, "s.toml", "[[model]]\npath = \"nowhere/gone.obj\"\n");

@@ -50,8 +50,8 @@ file_names!(ShadowMethod {
 // The screen-space method is GTAO; the file calls it `ssao`.
 file_names!(AoMethod { "off" => Off, "ssao" => Gtao, "raytraced" => Raytraced });
 file_names!(Tonemap {
-    "clamp" => Clamp, "reinhard" => Reinhard, "aces" => Aces, "pbr-neutral" => PbrNeutral,
-    "agx" => Agx,
+    "clamp" => Clamp, "reinhard" => Reinhard, "aces" => Aces, "aces-hill" => AcesHill,
+    "pbr-neutral" => PbrNeutral, "agx" => Agx,
 });
 file_names!(GifDither {
     "none" => None, "ordered" => Ordered, "floyd-steinberg" => FloydSteinberg,
