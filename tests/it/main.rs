@@ -8,6 +8,7 @@ mod display;
 mod framing;
 mod gltf;
 mod gltf_animation;
+mod gltf_materials;
 mod gltf_pose;
 mod known_answers;
 mod points_lines;

@@ -612,3 +612,64 @@ pub(super) fn transmission(
             .unwrap_or(f32::INFINITY),
     })
 }
+
+/// A primitive that KHR_materials_variants maps: the material slot it
+/// draws with (a copy of its default material, its own), and per variant
+/// (its index in `GltfModel::variants`) the material the slot takes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct VariantSlot {
+    pub slot: usize,
+    pub mappings: Vec<(usize, usize)>,
+}
+
+/// The names of the file's KHR_materials_variants, in order.
+pub(super) fn variant_names(doc: &gltf::Document) -> Vec<String> {
+    doc.variants()
+        .map(|v| v.map(|v| v.name().to_string()).collect())
+        .unwrap_or_default()
+}
+
+/// The material slot of primitive `prim` of mesh `mesh`, whose default
+/// material is `mat`:
+/// `mat` itself, or, where KHR_materials_variants maps the primitive, a
+/// slot of its own (recorded in `slots`). A mapping that names a material
+/// or a variant the file lacks is an error.
+pub(super) fn variant_slot(
+    doc: &gltf::Document,
+    (mesh, prim): (usize, usize),
+    mat: usize,
+    materials: &mut Vec<GltfMaterial>,
+    slots: &mut Vec<VariantSlot>,
+) -> Result<usize, String> {
+    let json = &doc.as_json().meshes[mesh].primitives[prim];
+    let Some(v) = json
+        .extensions
+        .as_ref()
+        .and_then(|e| e.khr_materials_variants.as_ref())
+    else {
+        return Ok(mat);
+    };
+    let (n_materials, n_variants) = (doc.materials().count(), variant_names(doc).len());
+    let mut mappings = Vec::new();
+    for m in &v.mappings {
+        let material = m.material as usize;
+        if material >= n_materials {
+            return Err(format!(
+                "KHR_materials_variants maps material {material}; the file has {n_materials}"
+            ));
+        }
+        for &variant in &m.variants {
+            let variant = variant as usize;
+            if variant >= n_variants {
+                return Err(format!(
+                    "KHR_materials_variants maps variant {variant}; the file has {n_variants}"
+                ));
+            }
+            mappings.push((variant, material));
+        }
+    }
+    let slot = materials.len();
+    materials.push(materials[mat].clone());
+    slots.push(VariantSlot { slot, mappings });
+    Ok(slot)
+}

@@ -53,6 +53,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_materials_unlit",
+    "KHR_materials_variants",
     "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_basisu",
@@ -94,6 +95,10 @@ pub struct GltfModel {
     /// Files with animations: what posing the mesh at other times takes,
     /// or why it cannot be done.
     pub rig: Option<Result<Arc<Rig>, String>>,
+    /// KHR_materials_variants: the variants' names, in the file's order.
+    pub variants: Vec<String>,
+    /// The material slots the variants change (`VariantSlot`).
+    pub variant_slots: Vec<VariantSlot>,
 }
 
 /// The top-level collections of a glTF file: arrays in 2.0, objects keyed
@@ -220,6 +225,8 @@ pub fn load(path: &Path, input: &Input) -> Result<GltfModel, Error> {
         cameras: placed.cameras,
         warnings,
         rig,
+        variants: variant_names(doc),
+        variant_slots: placed.variant_slots,
     })
 }
 
@@ -331,6 +338,8 @@ struct Placed {
     /// Per light: its node.
     light_nodes: Vec<usize>,
     cameras: Vec<GltfCamera>,
+    /// The primitives KHR_materials_variants maps.
+    variant_slots: Vec<VariantSlot>,
 }
 
 /// Walks the default scene's nodes (or the first scene's; without scenes,
@@ -401,6 +410,9 @@ fn walk_nodes(
                         materials.len() - 1
                     }),
                 };
+                let at = (mesh.index(), prim.index());
+                let mat = variant_slot(doc, at, mat, materials, &mut placed.variant_slots)
+                    .map_err(|m| format!("mesh {} primitive {}: {m}", at.0, at.1))?;
                 let pose = Pose {
                     node: node.index(),
                     world,

@@ -343,8 +343,7 @@ fn source_materials(
                 ));
             }
         }
-        let mats = src
-            .materials
+        let mats = variant_materials(md, ctx, src)?
             .iter()
             .map(|mm| {
                 let mut mm = mm.clone();
@@ -360,6 +359,46 @@ fn source_materials(
         out.push(mats);
     }
     Ok(out)
+}
+
+/// The model file's materials with `model.variant` applied: each slot a
+/// KHR_materials_variants mapping names for that variant takes the
+/// variant's material. A name the file lacks is an error listing the
+/// variants it has.
+fn variant_materials(
+    md: &desc::ModelDesc,
+    ctx: &Ctx,
+    src: &SourceModel,
+) -> Result<Vec<SourceMaterial>, Error> {
+    let mut mats = src.materials.clone();
+    let Some(want) = &md.variant else {
+        return Ok(mats);
+    };
+    let (names, slots) = src.gltf.as_ref().map_or((&[][..], &[][..]), |g| {
+        (&g.variants[..], &g.variant_slots[..])
+    });
+    let Some(v) = names.iter().position(|n| n == want.get_ref()) else {
+        let path = md.path.get_ref();
+        let has = if names.is_empty() {
+            "no variants (KHR_materials_variants)".to_string()
+        } else {
+            let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+            format!("the variants {}", quoted.join(", "))
+        };
+        return Err(ctx.err(
+            want.span(),
+            format!(
+                "model.variant = \"{}\": {path} has no variant of that name; it has {has}",
+                want.get_ref()
+            ),
+        ));
+    };
+    for s in slots {
+        if let Some(&(_, m)) = s.mappings.iter().find(|(variant, _)| *variant == v) {
+            mats[s.slot] = src.materials[m].clone();
+        }
+    }
+    Ok(mats)
 }
 
 /// In the sandbox, every image a material names (and every displacement

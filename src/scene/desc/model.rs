@@ -24,6 +24,8 @@ pub struct ModelDesc {
     pub materials: std::collections::BTreeMap<String, Spanned<MaterialOverride>>,
     /// Version 2: a glTF animation to play, by name or index.
     pub animation: Option<Spanned<ClipRef>>,
+    /// Version 3: a glTF file's KHR_materials_variants variant, by name.
+    pub variant: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]

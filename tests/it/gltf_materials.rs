@@ -1,0 +1,390 @@
+//! glTF materials end to end: KHR_materials_unlit, ior, specular,
+//! clearcoat, transmission, volume, sheen and iridescence against their
+//! models' values on a cube face, and KHR_materials_variants picking each
+//! primitive's material by the model's `variant`.
+
+use crate::common;
+
+use common::render_frame;
+use common::{cube, gltf_text};
+use glam::Vec3;
+use softraster::scene::Scene;
+
+/// A unit cube with `material` (JSON) seen face-on from +Z, lit by the
+/// neutral environment (radiance 1) and `lights` (TOML): the linear colour
+/// at the center of its front face.
+fn cube_face_color(name: &str, material: &str, used: &str, lights: &str) -> Vec3 {
+    cube_face_color_over(name, material, used, lights, "")
+}
+
+/// `cube_face_color` with more `[output]` keys (e.g. the background).
+fn cube_face_color_over(
+    name: &str,
+    material: &str,
+    used: &str,
+    lights: &str,
+    output: &str,
+) -> Vec3 {
+    let dir = common::scratch(name);
+    let (text, _) = gltf_text(
+        &cube(),
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": [{used}], "materials": [{material}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+    let scene = format!(
+        "[output]\nwidth = 32\nheight = 32\n{output}[render]\nshading = \"pbr\"\n\
+         [environment]\npreset = \"neutral\"\n{lights}[[model]]\npath = \"c.gltf\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n"
+    );
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    render_frame(&s, 0, 0).color[16 * 32 + 16].truncate()
+}
+
+#[test]
+fn khr_materials_unlit_ior_and_specular() {
+    // Unlit: the base colour, whatever lights the scene.
+    let base = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5}"#;
+    let unlit = cube_face_color(
+        "gltf_unlit",
+        &format!(r#"{base}, "extensions": {{"KHR_materials_unlit": {{}}}}}}"#),
+        r#""KHR_materials_unlit""#,
+        "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 5.0\n",
+    );
+    assert!(
+        (unlit - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 1e-5,
+        "{unlit}"
+    );
+    // specularFactor 0: no specular lobe at all, so a uniform environment
+    // of radiance 1 shows the base colour exactly (Lambertian).
+    let matte = cube_face_color(
+        "gltf_specular0",
+        &format!(
+            r#"{base}, "extensions": {{"KHR_materials_specular": {{"specularFactor": 0.0}}}}}}"#
+        ),
+        r#""KHR_materials_specular""#,
+        "",
+    );
+    assert!(
+        (matte - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 2e-3,
+        "{matte}"
+    );
+    // The default dielectric (ior 1.5) reflects more than that, and a
+    // higher ior more still.
+    let plain = cube_face_color("gltf_ior15", &format!("{base}}}"), "", "");
+    let ior2 = cube_face_color(
+        "gltf_ior2",
+        &format!(r#"{base}, "extensions": {{"KHR_materials_ior": {{"ior": 2.0}}}}}}"#),
+        r#""KHR_materials_ior""#,
+        "",
+    );
+    assert!(
+        plain.x > matte.x + 0.01 && ior2.x > plain.x + 0.02,
+        "{matte} {plain} {ior2}"
+    );
+}
+
+/// tex.png and plain.gltf (the textured cube) in `dir`; the cube.
+
+#[test]
+fn khr_materials_clearcoat_transmission_and_volume() {
+    // A matte base (specularFactor 0) shows its base colour exactly in the
+    // uniform environment; a smooth clearcoat seen head-on reflects
+    // F0 = 0.04 of the light and takes that share from the base.
+    let matte = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5}, "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}"#;
+    let used = r#""KHR_materials_specular", "KHR_materials_clearcoat""#;
+    let coated = cube_face_color(
+        "gltf_clearcoat",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.0}}}}}}"#
+        ),
+        used,
+        "",
+    );
+    let expect = Vec3::new(0.2, 0.4, 0.6) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (coated - expect).abs().max_element() < 4e-3,
+        "{coated} vs {expect}"
+    );
+    // The sampled reference (Monte Carlo over the environment, with the
+    // coat as a lobe of its own) agrees.
+    let sampled = cube_face_color(
+        "gltf_clearcoat_sampled",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.0}}}}}}"#
+        ),
+        used,
+        "method = \"sampled\"\nsamples = 64\n",
+    );
+    assert!(
+        (sampled - expect).abs().max_element() < 0.01,
+        "sampled {sampled} vs {expect}"
+    );
+    // A factor of 0 is no coat at all.
+    let uncoated = cube_face_color(
+        "gltf_clearcoat0",
+        &format!(r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 0.0}}}}}}"#),
+        used,
+        "",
+    );
+    assert!(
+        (uncoated - Vec3::new(0.2, 0.4, 0.6)).abs().max_element() < 2e-3,
+        "{uncoated}"
+    );
+    // Under a light straight on, the coat adds its highlight.
+    let light =
+        "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n";
+    let lit_coat = cube_face_color(
+        "gltf_clearcoat_lit",
+        &format!(
+            r#"{matte}, "KHR_materials_clearcoat": {{"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.3}}}}}}"#
+        ),
+        used,
+        light,
+    );
+    let lit_plain = cube_face_color("gltf_clearcoat_lit0", &format!("{matte}}}}}"), used, light);
+    assert!(lit_coat.x > lit_plain.x + 0.1, "{lit_coat} vs {lit_plain}");
+
+    // Transmission: a white, fully transmissive dielectric in a uniform
+    // environment in front of that environment is invisible (what it
+    // reflects plus what it lets through is all the light).
+    let clear = |name: &str, base: &str, volume: &str| {
+        cube_face_color_over(
+            name,
+            &format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorFactor": {base}, "metallicFactor": 0.0, "roughnessFactor": 0.3}}, "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1.0}}{volume}}}}}"#
+            ),
+            r#""KHR_materials_transmission", "KHR_materials_volume""#,
+            "",
+            "background = \"environment\"\n",
+        )
+    };
+    let glass = clear("gltf_transmission", "[1.0, 1.0, 1.0, 1.0]", "");
+    assert!(
+        (glass - Vec3::ONE).abs().max_element() < 0.01,
+        "white glass: {glass}"
+    );
+    // A tinted one lets its base colour through (and reflects ~0.04).
+    let tinted = clear("gltf_transmission_tint", "[0.2, 0.4, 0.6, 1.0]", "");
+    let expect = Vec3::new(0.2, 0.4, 0.6) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (tinted - expect).abs().max_element() < 0.01,
+        "{tinted} vs {expect}"
+    );
+    // A volume attenuates by attenuationColor^(thickness / distance).
+    let volume = clear(
+        "gltf_volume",
+        "[1.0, 1.0, 1.0, 1.0]",
+        r#", "KHR_materials_volume": {"thicknessFactor": 2.0, "attenuationColor": [0.5, 0.8, 1.0], "attenuationDistance": 1.0}"#,
+    );
+    let expect = Vec3::new(0.25, 0.64, 1.0) * 0.96 + Vec3::splat(0.04);
+    assert!(
+        (volume - expect).abs().max_element() < 0.01,
+        "{volume} vs {expect}"
+    );
+}
+
+#[test]
+fn khr_materials_sheen_prefiltered_agrees_with_sampled() {
+    // A black, matte base (no specular) shows the sheen alone: under the
+    // uniform environment, head-on, its albedo E(1, r) times the colour;
+    // the sampled reference integrates the lobe itself and agrees.
+    let sheen = |name: &str, env: &str, color: &str| {
+        cube_face_color(
+            name,
+            &format!(
+                r#"{{"pbrMetallicRoughness": {{"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0}}, "extensions": {{"KHR_materials_specular": {{"specularFactor": 0.0}}, "KHR_materials_sheen": {{"sheenColorFactor": {color}, "sheenRoughnessFactor": 0.5}}}}}}"#
+            ),
+            r#""KHR_materials_specular", "KHR_materials_sheen""#,
+            env,
+        )
+    };
+    let pre = sheen("gltf_sheen", "", "[1.0, 0.5, 0.25]");
+    // The Charlie sheen's directional albedo at cos 1, roughness 0.5 (the
+    // shading module's table; its unit test pins the value).
+    let expect = Vec3::new(1.0, 0.5, 0.25) * 0.031_526_58;
+    assert!(
+        (pre - expect).abs().max_element() < 2e-3,
+        "{pre} vs {expect}"
+    );
+    assert!(pre.x > 0.02, "{pre}");
+    let sampled = sheen(
+        "gltf_sheen_sampled",
+        "method = \"sampled\"\nsamples = 64\n",
+        "[1.0, 0.5, 0.25]",
+    );
+    assert!(
+        (sampled - pre).abs().max_element() < 0.01,
+        "sampled {sampled} vs prefiltered {pre}"
+    );
+    // A black sheen is none.
+    let none = sheen("gltf_sheen_black", "", "[0.0, 0.0, 0.0]");
+    assert!(none.max_element() < 1e-4, "{none}");
+}
+
+#[test]
+fn khr_materials_iridescence_colours_the_reflection_as_the_film_model_says() {
+    // A black, smooth dielectric in the uniform environment, seen head on,
+    // reflects F0 = 0.04 of the light; under a 400 nm film of index 1.3
+    // (the extension's defaults without a thickness texture) it reflects
+    // the film's Fresnel over that F0 instead.
+    let black = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0}"#;
+    let used = r#""KHR_materials_iridescence""#;
+    let plain = cube_face_color("gltf_iridescence_plain", &format!("{black}}}"), used, "");
+    let film = |name: &str, ext: &str, env: &str| {
+        cube_face_color(
+            name,
+            &format!(r#"{black}, "extensions": {{"KHR_materials_iridescence": {ext}}}}}"#),
+            used,
+            env,
+        )
+    };
+    let coloured = film(
+        "gltf_iridescence",
+        r#"{"iridescenceFactor": 1.0, "iridescenceIor": 1.3}"#,
+        "",
+    );
+    // The film's Fresnel at normal incidence over F0 = 0.04 (the shading
+    // module's model; its unit test pins these values).
+    let model = Vec3::new(0.007_456_456, 0.038_351_72, 0.016_038_207);
+    let expect = plain / 0.04 * model;
+    assert!(
+        (coloured - expect).abs().max_element() < 0.01 * expect.max_element(),
+        "{coloured} vs {expect} (plain {plain})"
+    );
+    // Coloured, not grey.
+    assert!(coloured.max_element() - coloured.min_element() > 0.2 * coloured.max_element());
+    // The thickness range: without a texture, the maximum is used.
+    let thin = film(
+        "gltf_iridescence_thin",
+        r#"{"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 250.0}"#,
+        "",
+    );
+    let model_thin = Vec3::new(0.047_993_07, 0.026_858_89, 0.004_917_93);
+    let expect_thin = plain / 0.04 * model_thin;
+    assert!(
+        (thin - expect_thin).abs().max_element() < 0.01 * expect_thin.max_element(),
+        "{thin} vs {expect_thin}"
+    );
+    // A factor of 0 is no film.
+    let off = film("gltf_iridescence_off", r#"{"iridescenceFactor": 0.0}"#, "");
+    assert!((off - plain).abs().max_element() < 1e-6, "{off} vs {plain}");
+    // The sampled reference (the film in the BRDF at v.h) agrees with the
+    // split sum (the film at n.v) on a rough film.
+    let rough = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.3}"#;
+    let rough_film = |name: &str, env: &str| {
+        cube_face_color(
+            name,
+            &format!(
+                r#"{rough}, "extensions": {{"KHR_materials_iridescence": {{"iridescenceFactor": 1.0}}}}}}"#
+            ),
+            used,
+            env,
+        )
+    };
+    let prefiltered = rough_film("gltf_iridescence_rough", "");
+    let sampled = rough_film(
+        "gltf_iridescence_rough_sampled",
+        "method = \"sampled\"\nsamples = 256\n",
+    );
+    assert!(
+        (prefiltered - sampled).abs().max_element() < 0.15 * sampled.max_element(),
+        "prefiltered {prefiltered} vs sampled {sampled}"
+    );
+}
+
+/// Unlit materials of four colours, and a cube whose primitive draws the
+/// grey one by default and KHR_materials_variants maps: "summer" to red,
+/// "winter" and "night" to blue ("plain" maps nothing).
+fn variant_cube(dir: &std::path::Path) {
+    let unlit = |rgb: &str| {
+        format!(
+            r#"{{"pbrMetallicRoughness": {{"baseColorFactor": [{rgb}, 1.0]}}, "extensions": {{"KHR_materials_unlit": {{}}}}}}"#
+        )
+    };
+    let mappings = r#", "material": 0, "extensions": {"KHR_materials_variants": {"mappings": [{"material": 1, "variants": [0]}, {"material": 2, "variants": [1, 2]}]}}"#;
+    let (text, _) = gltf_text(
+        &cube(),
+        mappings,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": ["KHR_materials_unlit", "KHR_materials_variants"],
+            "extensions": {{"KHR_materials_variants": {{"variants": [{{"name": "summer"}}, {{"name": "winter"}}, {{"name": "night"}}, {{"name": "plain"}}]}}}},
+            "materials": [{}, {}, {}, {}]"#,
+            unlit("0.5, 0.5, 0.5"),
+            unlit("0.8, 0.1, 0.1"),
+            unlit("0.1, 0.1, 0.8"),
+            unlit("0.1, 0.8, 0.1"),
+        ),
+        None,
+    );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+}
+
+/// The scene of `variant_cube` seen face-on, with `variant` (a TOML line,
+/// or nothing) in its `[[model]]`.
+fn variant_scene(variant: &str) -> String {
+    format!(
+        "[output]\nwidth = 32\nheight = 32\n[render]\nshading = \"pbr\"\n\
+         [[model]]\npath = \"c.gltf\"\n{variant}\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n"
+    )
+}
+
+#[test]
+fn khr_materials_variants_pick_each_primitives_material_by_name() {
+    let dir = common::scratch("gltf_variants");
+    variant_cube(&dir);
+    let face = |variant: &str| {
+        std::fs::write(dir.join("s.toml"), variant_scene(variant)).unwrap();
+        let s =
+            Scene::load(&dir.join("s.toml"), &Default::default()).unwrap_or_else(|e| panic!("{e}"));
+        render_frame(&s, 0, 0).color[16 * 32 + 16].truncate()
+    };
+    for (variant, want) in [
+        ("", Vec3::splat(0.5)),
+        ("variant = \"summer\"\n", Vec3::new(0.8, 0.1, 0.1)),
+        ("variant = \"winter\"\n", Vec3::new(0.1, 0.1, 0.8)),
+        ("variant = \"night\"\n", Vec3::new(0.1, 0.1, 0.8)),
+        ("variant = \"plain\"\n", Vec3::splat(0.5)),
+    ] {
+        let got = face(variant);
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "{variant:?}: {got} vs {want}"
+        );
+    }
+    // A name the file lacks: an error at the key, listing the variants.
+    std::fs::write(dir.join("s.toml"), variant_scene("variant = \"autumn\"\n")).unwrap();
+    let e = Scene::load(&dir.join("s.toml"), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("s.toml:8:")
+            && e.contains("model.variant = \"autumn\"")
+            && e.contains("\"summer\", \"winter\", \"night\", \"plain\""),
+        "{e}"
+    );
+    // A mapping to a material the file lacks.
+    let text = std::fs::read_to_string(dir.join("c.gltf"))
+        .unwrap()
+        .replace(
+            r#"{"material": 2, "variants""#,
+            r#"{"material": 9, "variants""#,
+        );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+    std::fs::write(dir.join("s.toml"), variant_scene("")).unwrap();
+    let e = Scene::load(&dir.join("s.toml"), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("c.gltf")
+            && e.contains("KHR_materials_variants maps material 9; the file has 4"),
+        "{e}"
+    );
+}
