@@ -388,3 +388,35 @@ fn khr_materials_variants_pick_each_primitives_material_by_name() {
         "{e}"
     );
 }
+
+#[test]
+fn out_of_range_volume_values_warn_naming_the_file_and_the_material() {
+    let dir = common::scratch("gltf_volume_bounds");
+    let (text, _) = gltf_text(
+        &cube(),
+        r#", "material": 0"#,
+        r#""nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+        "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+        "materials": [{"name": "glass", "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": -0.5, "attenuationDistance": -2.0}}}]"#,
+        None,
+    );
+    std::fs::write(dir.join("c.gltf"), text).unwrap();
+    let s = Scene::load(&dir.join("c.gltf"), &Default::default()).unwrap();
+    let all = s.warnings.join("\n");
+    for want in [
+        "c.gltf: material 0 (\"glass\"): KHR_materials_volume thicknessFactor -0.5 is negative; 0 (thin-walled) is used",
+        "c.gltf: material 0 (\"glass\"): KHR_materials_volume attenuationDistance -2 is not positive; the volume does not attenuate",
+    ] {
+        assert!(all.contains(want), "{all}");
+    }
+    // Errors under --strict.
+    let strict = softraster::scene::LoadOptions {
+        strict: true,
+        ..Default::default()
+    };
+    let e = Scene::load(&dir.join("c.gltf"), &strict)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("thicknessFactor -0.5 is negative"), "{e}");
+}

@@ -590,6 +590,37 @@ pub(super) fn transmission(
     }
     let volume = m.extension_value("KHR_materials_volume");
     let vol_number = |k: &str| volume.and_then(|v| json_number(v, k));
+    let material = match (m.index(), m.name()) {
+        (Some(i), Some(n)) => format!("material {i} (\"{n}\")"),
+        (Some(i), None) => format!("material {i}"),
+        (None, _) => "the default material".to_string(),
+    };
+    // The extension's bounds: a thickness of at least 0, a distance above 0.
+    let mut out_of_range = |key: &str, value: f32, bound: &str, instead: &str| {
+        warnings.push(format!(
+            "{}: {material}: KHR_materials_volume {key} {value} is {bound}; {instead}",
+            path.display()
+        ));
+    };
+    let thickness = match vol_number("thicknessFactor") {
+        Some(t) if t < 0.0 => {
+            out_of_range("thicknessFactor", t, "negative", "0 (thin-walled) is used");
+            0.0
+        }
+        t => t.unwrap_or(0.0),
+    };
+    let attenuation_distance = match vol_number("attenuationDistance") {
+        Some(d) if d <= 0.0 => {
+            out_of_range(
+                "attenuationDistance",
+                d,
+                "not positive",
+                "the volume does not attenuate",
+            );
+            f32::INFINITY
+        }
+        d => d.unwrap_or(f32::INFINITY),
+    };
     let attenuation_color = volume
         .and_then(|v| v.get("attenuationColor"))
         .and_then(|c| c.as_array())
@@ -603,13 +634,11 @@ pub(super) fn transmission(
     Some(GltfTransmission {
         factor,
         texture: json_tex(v, "transmissionTexture", doc, images, warnings, path),
-        thickness: vol_number("thicknessFactor").unwrap_or(0.0).max(0.0),
+        thickness,
         thickness_texture: volume
             .and_then(|vv| json_tex(vv, "thicknessTexture", doc, images, warnings, path)),
         attenuation_color,
-        attenuation_distance: vol_number("attenuationDistance")
-            .filter(|d| *d > 0.0)
-            .unwrap_or(f32::INFINITY),
+        attenuation_distance,
     })
 }
 
