@@ -15,3 +15,4 @@ mod points_lines;
 mod shadows;
 mod textures;
 mod widths;
+mod widths_pbr;
