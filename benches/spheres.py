@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """The red spheres of the KHR-layer measurements (docs/performance.md):
-a 36,864-triangle UV sphere as three glTF files in DIR, plain, with
-KHR_materials_clearcoat, and with clearcoat, sheen, specular and
-iridescence (constant factors, no maps). Render each as its one-line
+a 36,864-triangle UV sphere as glTF files in DIR, plain, with
+KHR_materials_clearcoat, with clearcoat, sheen, specular and
+iridescence (constant factors, no maps), and with transmission and a
+volume (`glass`; `glass-off` is the same with transmissionFactor 0). Render each as its one-line
 scene and compare the steady per-frame medians:
 
     python3 benches/spheres.py /tmp/spheres
-    for m in plain clearcoat layers; do
+    for m in plain clearcoat layers glass glass-off; do
         target/release/softraster render /tmp/spheres/$m.gltf --set animation.frames=12 \\
             --set output.width=700 --set output.height=700 --set render.msaa=4 \\
             --out /tmp/spheres/out-$m --progress json
@@ -84,6 +85,8 @@ def main():
     os.makedirs(out, exist_ok=True)
     pos, idx = sphere()
     coat = {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1}
+    volume = {"thicknessFactor": 0.5, "attenuationColor": [0.9, 0.6, 0.6],
+              "attenuationDistance": 1.0}
     cases = {
         "plain": {},
         "clearcoat": {"KHR_materials_clearcoat": coat},
@@ -96,6 +99,12 @@ def main():
             "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceIor": 1.3,
                                           "iridescenceThicknessMaximum": 400},
         },
+        # Transmission (with a volume), and the same file with
+        # transmissionFactor 0: what transmission costs.
+        "glass": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                  "KHR_materials_volume": volume},
+        "glass-off": {"KHR_materials_transmission": {"transmissionFactor": 0.0},
+                      "KHR_materials_volume": volume},
     }
     for name, ext in cases.items():
         with open(os.path.join(out, name + ".gltf"), "w") as f:

@@ -160,9 +160,12 @@ impl<'a> BandInputs<'a> {
     /// Blended triangles, farthest first (by mean depth; ties in submission
     /// order), each pixel in front of the opaque surface composited over it.
     /// With MSAA a triangle is shaded once per pixel over the samples where
-    /// it is in front of the opaque surface, and composited with its
-    /// opacity times the fraction of samples it covers (exact where the
-    /// surface behind is one color).
+    /// it is in front of the opaque surface and composited over each of
+    /// those samples, which start as the pixel's opaque colour (exact where
+    /// the surface behind is one color); the pixel is then their mean. So
+    /// two triangles that share an edge inside a pixel cover it once
+    /// between them: composited over the whole pixel by their shares, the
+    /// surface behind would show through the edge twice.
     fn blend(&self, vis: &Visibility, mut ids: Vec<u32>, color: &mut [Vec4]) {
         let far_key = |id: &u32| {
             let z = self.tris[*id as usize].z;
@@ -171,45 +174,73 @@ impl<'a> BandInputs<'a> {
             if self.reverse { -mean } else { mean }
         };
         ids.sort_by(|a, b| far_key(b).total_cmp(&far_key(a)).then(a.cmp(b)));
-        let (mut frags, mut layers) = (Vec::new(), Vec::new());
+        let n = vis.samples();
+        let full = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+        // With MSAA: per pixel its samples' colours, once a layer covers
+        // part of it.
+        let mut samples = Vec::new();
+        let mut reached = Vec::new();
+        if n > 1 {
+            samples.resize(color.len() * n, Vec4::ZERO);
+            reached.resize(color.len(), false);
+        }
+        let over = |dst: Vec4, (add, through, a): (Vec3, Vec3, f32)| {
+            (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a))
+        };
+        let (mut frags, mut masks, mut layers) = (Vec::new(), Vec::new(), Vec::new());
         for id in ids {
             let t = &self.tris[id as usize];
             let it = Interpolator::new(t);
             let lm = self.lane_material(t.draw as usize);
             frags.clear();
-            self.layer_fragments(vis, (t, &it, id), lm, &mut frags);
+            masks.clear();
+            self.layer_fragments(vis, (t, &it, id), lm, (&mut frags, &mut masks));
             layers.clear();
             self.layers(t, &frags, &mut layers);
-            for (f, &(add, through, a)) in frags.iter().zip(&layers) {
+            for ((f, &mask), &layer) in frags.iter().zip(&masks).zip(&layers) {
                 // A layer whose shading is not finite (degenerate input)
                 // is skipped.
-                if !(add.is_finite() && through.is_finite()) {
+                if !(layer.0.is_finite() && layer.1.is_finite()) {
                     continue;
                 }
-                let (add, through, a) = if vis.samples() > 1 {
-                    // Over the fraction of samples it covers.
-                    let k = f.count;
-                    (add * k, through * k + Vec3::splat(1.0 - k), a * k)
-                } else {
-                    (add, through, a)
-                };
                 let i = f.pixel as usize;
-                let dst = color[i];
-                color[i] = (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a));
+                // Until a layer covers part of a pixel, its samples are
+                // all the pixel's colour: a whole pixel is composited as one.
+                if n == 1 || (mask == full && !reached[i]) {
+                    color[i] = over(color[i], layer);
+                    continue;
+                }
+                let px = &mut samples[i * n..(i + 1) * n];
+                if !std::mem::replace(&mut reached[i], true) {
+                    px.fill(color[i]);
+                }
+                for (s, dst) in px.iter_mut().enumerate() {
+                    if mask & (1 << s) != 0 {
+                        *dst = over(*dst, layer);
+                    }
+                }
             }
+        }
+        let inv_n = 1.0 / n as f32;
+        for (i, _) in reached.iter().enumerate().filter(|(_, r)| **r) {
+            let sum = samples[i * n..(i + 1) * n]
+                .iter()
+                .fold(Vec4::ZERO, |acc, s| acc + *s);
+            color[i] = sum * inv_n;
         }
     }
 
     /// The fragments of the blended triangle `t` (id `id`) in front of the
     /// opaque surface, in raster order: per pixel its shading point, the
     /// fraction of the pixel's samples it covers there (`count`) and its
-    /// filter footprints for its material `lm`.
+    /// filter footprints for its material `lm`; and in `masks`, the
+    /// samples it covers (bit s: sample s; 1 without MSAA).
     fn layer_fragments(
         &self,
         vis: &Visibility,
         (t, it, id): (&Tri, &Interpolator, u32),
         lm: &LaneMaterial,
-        out: &mut Vec<Pending>,
+        (out, masks): (&mut Vec<Pending>, &mut Vec<u32>),
     ) {
         let rect = vis.rect;
         let tw = rect.width();
@@ -246,6 +277,7 @@ impl<'a> BandInputs<'a> {
                 let i = (py - rect.y0) as usize * tw + (px - rect.x0) as usize;
                 if in_front(z, vis.depth()[i], self.reverse) {
                     push(px, py, it.at_pixel(px, py), 1.0);
+                    masks.push(1);
                 }
             });
             return;
@@ -261,6 +293,7 @@ impl<'a> BandInputs<'a> {
             if m != 0 {
                 let frag = self.shading_point(it, px, py, m);
                 push(px, py, frag, m.count_ones() as f32 / n as f32);
+                masks.push(m);
             }
         });
     }

@@ -231,3 +231,45 @@ fn pbr_plane_under_a_point_light_matches_appendix_b_by_hand() {
     }
     assert!(checked > 2000, "{checked}");
 }
+
+#[test]
+fn a_half_transparent_quad_hides_its_diagonal_under_msaa() {
+    // Two triangles sharing a diagonal, opacity 0.5, unlit red over black,
+    // seen face-on: every covered sample is composited once, so each pixel
+    // the quad covers wholly is 0.5 red, on the diagonal too (composited
+    // over each pixel by their shares, the two triangles let the black
+    // show through the diagonal's pixels twice).
+    let dir = common::scratch("ka_blend_diagonal");
+    let obj =
+        "mtllib m.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl half\nf 1 2 3\nf 1 3 4\n";
+    let mtl = "newmtl half\nKd 1 0 0\nd 0.5\n";
+    for msaa in [1, 4, 8] {
+        let scene = common::scene_in(
+            &dir,
+            &format!(
+                "[output]\nwidth = 40\nheight = 40\nbackground = [0.0, 0.0, 0.0]\n\
+                 [render]\nshading = \"unlit\"\nmsaa = {msaa}\ncull = \"none\"\n\
+                 [ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+                 [[model]]\npath = \"q.obj\"\n\
+                 [[camera]]\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                 projection = \"orthographic\"\nheight = 2.5\n"
+            ),
+            &[("q.obj", obj), ("m.mtl", mtl)],
+        );
+        let f = render_frame(&scene, 0, 0);
+        // The quad spans pixels 4..36 on both axes; keep one pixel off
+        // its outer edges.
+        let mut diagonal = 0;
+        for y in 5..35usize {
+            for x in 5..35usize {
+                let c = f.color[y * 40 + x];
+                assert!(
+                    (c.x - 0.5).abs() < 1e-5 && c.y.abs() < 1e-6,
+                    "MSAA {msaa}, pixel ({x}, {y}): {c}"
+                );
+                diagonal += (x + y == 39 || x == y) as u32;
+            }
+        }
+        assert!(diagonal > 25);
+    }
+}

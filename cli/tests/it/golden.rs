@@ -217,8 +217,9 @@ fn african_head_blended_eye_shell_over_the_iris() {
 fn a_material_with_five_slots() {
     // Maps in five slots (two sizes, two transforms, both coordinate
     // sets): the lanes carry three footprints per fragment and compute
-    // the others per call. The golden is the one-fragment path's frame,
-    // from before the lanes took such materials (byte-identical then).
+    // the others per call. The golden was the one-fragment path's frame
+    // (byte-identical to the lanes'); its blended cube's triangle edges
+    // are now composited per MSAA sample.
     check(
         "many_slots",
         &root().join("tests/data/many_slots/scene.toml"),
