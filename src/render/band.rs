@@ -176,14 +176,16 @@ impl<'a> BandInputs<'a> {
         ids.sort_by(|a, b| far_key(b).total_cmp(&far_key(a)).then(a.cmp(b)));
         let n = vis.samples();
         let full = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
-        // With MSAA: per pixel its samples' colours, once a layer covers
-        // part of it.
-        let mut samples = Vec::new();
-        let mut reached = Vec::new();
-        if n > 1 {
-            samples.resize(color.len() * n, Vec4::ZERO);
-            reached.resize(color.len(), false);
-        }
+        // With MSAA, the pixels some layer covers in part (`split`, in the
+        // order they were reached), their samples' colours (n per pixel in
+        // `samples`) and per pixel of the band its place in `split`.
+        const NONE: u32 = u32::MAX;
+        let (mut split, mut samples) = (Vec::new(), Vec::new());
+        let mut slot = if n > 1 {
+            vec![NONE; color.len()]
+        } else {
+            Vec::new()
+        };
         let over = |dst: Vec4, (add, through, a): (Vec3, Vec3, f32)| {
             (add + dst.truncate() * through).extend(a + dst.w * (1.0 - a))
         };
@@ -206,15 +208,17 @@ impl<'a> BandInputs<'a> {
                 let i = f.pixel as usize;
                 // Until a layer covers part of a pixel, its samples are
                 // all the pixel's colour: a whole pixel is composited as one.
-                if n == 1 || (mask == full && !reached[i]) {
+                if n == 1 || (mask == full && slot[i] == NONE) {
                     color[i] = over(color[i], layer);
                     continue;
                 }
-                let px = &mut samples[i * n..(i + 1) * n];
-                if !std::mem::replace(&mut reached[i], true) {
-                    px.fill(color[i]);
+                if slot[i] == NONE {
+                    slot[i] = split.len() as u32;
+                    split.push(i);
+                    samples.extend(std::iter::repeat_n(color[i], n));
                 }
-                for (s, dst) in px.iter_mut().enumerate() {
+                let k = slot[i] as usize;
+                for (s, dst) in samples[k * n..(k + 1) * n].iter_mut().enumerate() {
                     if mask & (1 << s) != 0 {
                         *dst = over(*dst, layer);
                     }
@@ -222,11 +226,8 @@ impl<'a> BandInputs<'a> {
             }
         }
         let inv_n = 1.0 / n as f32;
-        for (i, _) in reached.iter().enumerate().filter(|(_, r)| **r) {
-            let sum = samples[i * n..(i + 1) * n]
-                .iter()
-                .fold(Vec4::ZERO, |acc, s| acc + *s);
-            color[i] = sum * inv_n;
+        for (&i, px) in split.iter().zip(samples.chunks_exact(n.max(1))) {
+            color[i] = px.iter().fold(Vec4::ZERO, |acc, s| acc + *s) * inv_n;
         }
     }
 
