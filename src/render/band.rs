@@ -166,7 +166,7 @@ impl<'a> BandInputs<'a> {
     /// two triangles that share an edge inside a pixel cover it once
     /// between them: composited over the whole pixel by their shares, the
     /// surface behind would show through the edge twice.
-    fn blend(&self, vis: &Visibility, mut ids: Vec<u32>, color: &mut [Vec4]) {
+    pub(super) fn blend(&self, vis: &Visibility, mut ids: Vec<u32>, color: &mut [Vec4]) {
         let far_key = |id: &u32| {
             let z = self.tris[*id as usize].z;
             let mean = (z[0] + z[1] + z[2]) / 3.0;

@@ -128,6 +128,16 @@ impl<'a> BandInputs<'a> {
         }
     }
 
+    /// Whether some blended draw transmits light (KHR_materials_transmission
+    /// shaded as metallic-roughness): it refracts the opaque frame, so the
+    /// frame's blended triangles wait for every band's opaque surfaces.
+    pub(super) fn refracts(&self) -> bool {
+        self.draws.iter().zip(&self.alpha).any(|(d, a)| {
+            let m = &self.setup.scene.models[d.model].materials[d.material];
+            *a == AlphaMode::Blend && m.pbr.transmission.is_some() && self.ctx.shades_pbr(m)
+        })
+    }
+
     /// Draw `draw`'s material prepared for the lanes, if it is.
     #[inline]
     pub(super) fn lane_material(&self, draw: usize) -> &LaneMaterial<'a> {

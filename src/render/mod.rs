@@ -58,7 +58,7 @@ use crate::assets::mesh::Mesh;
 use crate::assets::mip;
 use crate::assets::texture::Level;
 use crate::error::Error;
-use crate::raster::coverage::sample_pattern;
+use crate::raster::coverage::{Visibility, sample_pattern};
 use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
 use crate::raytrace::{Placed, Tracer};
@@ -70,6 +70,7 @@ use crate::scene::{Light, Scene};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
 use crate::shade::env::sampled::EnvSampler;
+use crate::shade::refraction::{self, OpaqueFrame};
 use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
 use geometry::Geometry;
@@ -575,7 +576,7 @@ impl<'s> Renderer<'s> {
         known.resize(bands, None);
         // The display image in band-sized chunks, or an empty chunk per
         // band without one.
-        let (encoder, bytes): (_, Vec<&mut [u8]>) = match display {
+        let (encoder, mut bytes): (_, Vec<&mut [u8]>) = match display {
             Some(image) => {
                 let e = display::Encoder::new(&data.setup.scene.settings, out.exposure);
                 e.shape(out.width, out.height, image);
@@ -592,59 +593,93 @@ impl<'s> Renderer<'s> {
                 e.band(color, width, plain, bytes);
             }
         };
-        if data.setup.scene.settings.ao.method == AoMethod::Off {
+        // With transmissive surfaces, a band's blended triangles wait until
+        // every band's opaque surfaces are shaded: they refract that frame.
+        let refracts = data.refracts();
+        let first = |(vis, blended): (Visibility, Vec<u32>),
+                     ao: Option<&[f32]>,
+                     known: &mut Option<display::PlainBackground>,
+                     (color, depth): (&mut [glam::Vec4], &mut [f32]),
+                     bytes: &mut [u8]| {
+            if refracts && !blended.is_empty() {
+                data.shade_band(&vis, Vec::new(), ao, *known, color, depth);
+                *known = None;
+                return Some((vis, blended));
+            }
+            let plain = data.shade_band(&vis, blended, ao, *known, color, depth);
+            *known = plain;
+            show(color, plain, bytes);
+            None
+        };
+        let later: Vec<_> = if data.setup.scene.settings.ao.method == AoMethod::Off {
             out.ao.clear();
             let chunks = aov_chunks(&mut out.aov, band, bands);
             out.color
                 .par_chunks_mut(band)
                 .zip(out.depth.par_chunks_mut(band))
                 .zip(chunks)
-                .zip(bytes)
+                .zip(bytes.par_iter_mut())
                 .zip(known.par_iter_mut())
                 .enumerate()
-                .for_each(|(ti, ((((color, depth), aov), bytes), known))| {
+                .map(|(ti, ((((color, depth), aov), bytes), known))| {
+                    let visible = data.visibility(grid.rect(ti), ti, &bins);
+                    if !aov.is_empty() {
+                        data.aovs(&visible.0, aov);
+                    }
+                    first(visible, None, known, (color, depth), bytes)
+                })
+                .collect()
+        } else {
+            // With ambient occlusion: visibility and the geometry buffer
+            // of every band, the AO of the whole frame, then shading.
+            let mut gbuf = vec![GPixel::EMPTY; out.color.len()];
+            let visible: Vec<_> = gbuf
+                .par_chunks_mut(band)
+                .enumerate()
+                .map(|(ti, g)| {
                     let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
+                    data.gbuffer(&vis, g);
+                    (vis, blended)
+                })
+                .collect();
+            out.ao = ao_pass::occlusion(data.setup, &gbuf, out.width, out.height, tracer);
+            let chunks = aov_chunks(&mut out.aov, band, bands);
+            out.color
+                .par_chunks_mut(band)
+                .zip(out.depth.par_chunks_mut(band))
+                .zip(out.ao.par_chunks(band))
+                .zip(visible)
+                .zip(chunks)
+                .zip(bytes.par_iter_mut())
+                .zip(known.par_iter_mut())
+                .map(|((((((color, depth), ao), visible), aov), bytes), known)| {
                     if !aov.is_empty() {
-                        data.aovs(&vis, aov);
+                        data.aovs(&visible.0, aov);
                     }
-                    let plain = data.shade_band(&vis, blended, None, *known, color, depth);
-                    *known = plain;
-                    show(color, plain, bytes);
+                    first(visible, Some(ao), known, (color, depth), bytes)
+                })
+                .collect()
+        };
+        if refracts {
+            let camera = refraction::Camera {
+                clip_from_world: data.setup.clip_from_world,
+                eye: data.ctx.eye,
+                forward: data.ctx.forward,
+            };
+            let opaque = OpaqueFrame::new((&out.color, &out.depth), out.width, out.height, camera);
+            // One `bands` call per frame's inputs: set here only.
+            let _ = data.ctx.refraction.set(opaque);
+            out.color
+                .par_chunks_mut(band)
+                .zip(later)
+                .zip(bytes.par_iter_mut())
+                .for_each(|((color, later), bytes)| {
+                    if let Some((vis, blended)) = later {
+                        data.blend(&vis, blended, color);
+                        show(color, None, bytes);
+                    }
                 });
-            return;
         }
-        // With ambient occlusion: visibility and the geometry buffer of
-        // every band, the AO of the whole frame, then shading.
-        let mut gbuf = vec![GPixel::EMPTY; out.color.len()];
-        let visible: Vec<_> = gbuf
-            .par_chunks_mut(band)
-            .enumerate()
-            .map(|(ti, g)| {
-                let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
-                data.gbuffer(&vis, g);
-                (vis, blended)
-            })
-            .collect();
-        out.ao = ao_pass::occlusion(data.setup, &gbuf, out.width, out.height, tracer);
-        let chunks = aov_chunks(&mut out.aov, band, bands);
-        out.color
-            .par_chunks_mut(band)
-            .zip(out.depth.par_chunks_mut(band))
-            .zip(out.ao.par_chunks(band))
-            .zip(visible)
-            .zip(chunks)
-            .zip(bytes)
-            .zip(known.par_iter_mut())
-            .for_each(
-                |((((((color, depth), ao), (vis, blended)), aov), bytes), known)| {
-                    if !aov.is_empty() {
-                        data.aovs(&vis, aov);
-                    }
-                    let plain = data.shade_band(&vis, blended, Some(ao), *known, color, depth);
-                    *known = plain;
-                    show(color, plain, bytes);
-                },
-            );
     }
 
     /// Per texture: the mip chain this frame may read, built on the first
@@ -720,5 +755,6 @@ fn shade_context<'a>(
         env,
         env_sampled: None,
         pixel_scale: 1.0,
+        refraction: Default::default(),
     }
 }

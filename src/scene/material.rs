@@ -149,9 +149,9 @@ pub struct Clearcoat {
     pub normal_map: Option<NormalMap>,
 }
 
-/// Light passing through a thin dielectric surface (no refraction offset),
-/// tinted by the base colour and, with a volume, attenuated along the
-/// thickness by Beer's law.
+/// Light passing through a dielectric surface, tinted by the base colour,
+/// refracted through the volume's thickness (none for a thin wall) and,
+/// with a volume, attenuated along the thickness by Beer's law.
 #[derive(Debug, Clone)]
 pub struct Transmission {
     /// The share of light transmitted, 0..1.
@@ -160,6 +160,9 @@ pub struct Transmission {
     pub map: Option<TextureRef>,
     /// Path length through the volume in the model's units (0: thin).
     pub thickness: f32,
+    /// The volume's index of refraction (KHR_materials_ior; 1.5 without
+    /// it): how far the view ray bends into it.
+    pub ior: f32,
     /// Linear; green multiplies `thickness`.
     pub thickness_map: Option<TextureRef>,
     /// Colour that white light becomes after `attenuation_distance`.

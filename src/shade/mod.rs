@@ -9,6 +9,7 @@ pub mod iridescence;
 pub mod lanes;
 pub mod light;
 pub mod pbr;
+pub mod refraction;
 pub mod shadow;
 pub mod sheen;
 pub mod tonemap;
@@ -52,6 +53,10 @@ pub struct ShadeContext<'a> {
     /// Rendered pixels per output pixel along an axis (the supersampling
     /// factor): wireframe lines keep their width in output pixels.
     pub pixel_scale: f32,
+    /// The shaded opaque frame that transmissive surfaces refract
+    /// (`refraction`), set once the frame's opaque surfaces are shaded;
+    /// empty until then and in frames without transmission.
+    pub refraction: std::sync::OnceLock<refraction::OpaqueFrame>,
 }
 
 impl ShadeContext<'_> {
@@ -66,7 +71,7 @@ impl ShadeContext<'_> {
     }
 
     /// Whether a point of `m` is shaded with metallic-roughness.
-    fn shades_pbr(&self, m: &Material) -> bool {
+    pub(crate) fn shades_pbr(&self, m: &Material) -> bool {
         match self.mode {
             ShadingMode::Pbr => true,
             ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
@@ -182,6 +187,7 @@ pub(crate) mod testing {
             env: None,
             env_sampled: None,
             pixel_scale: 1.0,
+            refraction: Default::default(),
         }
     }
 }

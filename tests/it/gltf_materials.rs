@@ -420,3 +420,78 @@ fn out_of_range_volume_values_warn_naming_the_file_and_the_material() {
         .to_string();
     assert!(e.contains("thicknessFactor -0.5 is negative"), "{e}");
 }
+
+/// The linear colours across the middle row of a 64x64 frame: a glass
+/// ball (radius 0.5, ior 1.5, `volume`: its KHR_materials_volume JSON)
+/// 2 in front of a backdrop that glows red left of x = 0 and blue right
+/// of it, seen from 4 in front of the ball. No light and no environment:
+/// what the ball shows is what it lets through.
+fn ball_over_backdrop(name: &str, volume: &str) -> Vec<Vec3> {
+    let dir = common::scratch(name);
+    let b = softraster::procedural::sphere(0.5, 96, 48);
+    let ball = common::Prim {
+        positions: b.v.clone(),
+        normals: b.vn.clone(),
+        indices: b.f.iter().flatten().map(|&i| i as u32 - 1).collect(),
+        ..Default::default()
+    };
+    let (text, _) = gltf_text(
+        &ball,
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+            "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0, "roughnessFactor": 0.0}},
+                "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1.0}}{volume}}}}}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("ball.gltf"), text).unwrap();
+    let obj = "mtllib b.mtl\nv -3 -3 -2\nv 0 -3 -2\nv 0 3 -2\nv -3 3 -2\nv 3 -3 -2\nv 3 3 -2\n\
+               usemtl red\nf 1 2 3\nf 1 3 4\nusemtl blue\nf 2 5 6\nf 2 6 3\n";
+    let mtl =
+        "newmtl red\nKd 0 0 0\nKs 0 0 0\nKe 1 0 0\nnewmtl blue\nKd 0 0 0\nKs 0 0 0\nKe 0 0 1\n";
+    std::fs::write(dir.join("b.obj"), obj).unwrap();
+    std::fs::write(dir.join("b.mtl"), mtl).unwrap();
+    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 1\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+         [[model]]\npath = \"b.obj\"\n[[model]]\npath = \"ball.gltf\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 30.0\n";
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let f = render_frame(&s, 0, 0);
+    (0..64).map(|x| f.color[32 * 64 + x].truncate()).collect()
+}
+
+#[test]
+fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
+    // The ball covers x = 32 +- 15 pixels. Left of its centre, a solid
+    // ball (thickness = its diameter) is a lens that shows the backdrop's
+    // right half, and right of its centre the left half; the backdrop
+    // beside it keeps its own colour.
+    let solid = ball_over_backdrop(
+        "gltf_refraction_ball",
+        r#", "KHR_materials_volume": {"thicknessFactor": 1.0}"#,
+    );
+    let red = |c: Vec3| c.x > 0.5 && c.z < 0.1;
+    let blue = |c: Vec3| c.z > 0.5 && c.x < 0.1;
+    assert!(
+        red(solid[5]) && blue(solid[58]),
+        "{} {}",
+        solid[5],
+        solid[58]
+    );
+    for x in [24, 27] {
+        assert!(blue(solid[x]), "solid ball at x = {x}: {}", solid[x]);
+    }
+    for x in [36, 39] {
+        assert!(red(solid[x]), "solid ball at x = {x}: {}", solid[x]);
+    }
+    // A thin wall (no volume) lets the backdrop straight through.
+    let thin = ball_over_backdrop("gltf_refraction_thin", "");
+    for x in [24, 27] {
+        assert!(red(thin[x]), "thin wall at x = {x}: {}", thin[x]);
+    }
+    for x in [36, 39] {
+        assert!(blue(thin[x]), "thin wall at x = {x}: {}", thin[x]);
+    }
+}

@@ -507,6 +507,7 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             factor: t.factor,
             map: tex(&t.texture, false),
             thickness: t.thickness,
+            ior: g.ior,
             thickness_map: tex(&t.thickness_texture, false),
             attenuation_color: t.attenuation_color,
             attenuation_distance: t.attenuation_distance,

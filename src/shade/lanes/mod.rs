@@ -22,6 +22,7 @@
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
 use super::light::{LightMask, LightSet};
+use super::refraction::RefractedRay;
 use super::{Fetch, ShadeContext};
 use crate::assets::texture::Footprint;
 use crate::scene::light::{Light, LightKind};
@@ -258,23 +259,48 @@ impl<'a> ShadeContext<'a> {
         out: &mut [Layer; MAX_LANES],
     ) {
         let m = lm.material;
-        let c = self.shade_fetched(lm, f, fetch);
         if m.pbr.transmission.is_some() && self.shades_pbr(m) {
-            // Thin transmission: the base colour lets the light through,
-            // less what the surface reflects (`layer`).
+            // Transmission: the base colour lets the light through, less
+            // what the surface reflects (`layer`).
             let pc = self.pbr_color(m, fetch, f);
+            let c = match lm.kind {
+                LaneShading::Pbr => self.shade_pbr_color(m, fetch, f, &pc),
+                _ => self.shade_fetched(lm, f, fetch),
+            };
             let n = match &m.normal_map {
                 Some(map) => fetch.normal(map),
                 None => f.normal,
             };
             let v = self.view_lanes(f.position);
+            let behind = self.refraction.get();
             for (k, o) in out.iter_mut().enumerate().take(L::WIDTH) {
-                let t = pc.at(k).transmittance(n.lane(k), v.lane(k));
-                let t = t.clamp(Vec3::ZERO, Vec3::ONE);
-                *o = (c.lane(k), t, 1.0 - (t.x + t.y + t.z) / 3.0);
+                let p = pc.at(k);
+                let (n, v) = (n.lane(k), v.lane(k));
+                let t = p.transmittance(n, v).clamp(Vec3::ZERO, Vec3::ONE);
+                let opacity = 1.0 - (t.x + t.y + t.z) / 3.0;
+                *o = match behind {
+                    // What the refracted ray meets replaces the colour
+                    // directly behind.
+                    Some(frame) => {
+                        let ray = RefractedRay {
+                            position: f.position.lane(k),
+                            // Towards the eye, as the back of a
+                            // two-sided surface is seen.
+                            normal: if n.dot(v) < 0.0 { -n } else { n },
+                            view: v,
+                            ior: p.volume.1,
+                            thickness: p.volume.0,
+                            roughness: p.roughness,
+                        };
+                        let seen = frame.through(&ray, self.env);
+                        (c.lane(k) + t * seen, Vec3::ZERO, opacity)
+                    }
+                    None => (c.lane(k), t, opacity),
+                };
             }
             return;
         }
+        let c = self.shade_fetched(lm, f, fetch);
         let a = clamp01(self.opacity_of(m, |t| fetch.rgba(t), alpha));
         let (add, through) = (c.scale(a), L::splat(1.0) - a);
         for (k, o) in out.iter_mut().enumerate().take(L::WIDTH) {

@@ -28,6 +28,7 @@ impl<L: Lane> PbrColor<L> {
             a2: self.a2.lane(k),
             transmission: self.transmission.lane(k),
             attenuation: v(self.attenuation),
+            volume: (self.volume.0.lane(k), self.volume.1),
             coat: self.coat.map(|c| Coat {
                 factor: c.factor.lane(k),
                 roughness: c.roughness.lane(k),
@@ -123,16 +124,21 @@ impl ShadeContext<'_> {
             let factor = clamp01(times(t.factor, fetch.rgb_of(&t.map), |c| c.x));
             let thickness = times(t.thickness, fetch.rgb_of(&t.thickness_map), |c| c.y);
             let (color, distance) = (t.attenuation_color, t.attenuation_distance);
-            let attenuation = V3::from_fn(|k| {
-                let thickness = thickness.lane(k);
+            let beer = |thickness: f32| {
                 if distance.is_finite() && thickness > 0.0 {
                     let k = thickness / distance;
                     Vec3::new(color.x.powf(k), color.y.powf(k), color.z.powf(k))
                 } else {
                     Vec3::ONE
                 }
-            });
+            };
+            // Without a thickness map every lane has the same thickness.
+            let attenuation = match t.thickness_map {
+                None => V3::splat(beer(thickness.lane(0))),
+                Some(_) => V3::from_fn(|k| beer(thickness.lane(k))),
+            };
             c.set_transmission(factor, attenuation);
+            c.volume = (thickness, t.ior);
         }
         if let Some(k) = &p.sheen {
             let mut color = V3::splat(k.color);
@@ -175,6 +181,20 @@ impl ShadeContext<'_> {
         f: &Lanes<L>,
     ) -> V3<L> {
         let c = self.pbr_color(m, fetch, f);
+        self.shade_pbr_color(m, fetch, f, &c)
+    }
+
+    /// `shade_pbr` of the material's colour `c` (`pbr_color`), already
+    /// read.
+    #[inline(always)]
+    pub(crate) fn shade_pbr_color<L: Lane>(
+        &self,
+        m: &Material,
+        fetch: &mut impl Fetch<L>,
+        f: &Lanes<L>,
+        c: &PbrColor<L>,
+    ) -> V3<L> {
+        let c = *c;
         let v = self.view_lanes(f.position);
         let n = match &m.normal_map {
             Some(map) => fetch.normal(map),
