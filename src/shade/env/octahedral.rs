@@ -46,7 +46,7 @@ pub(super) fn encode<L: Lane>(d: V3<L>) -> (L, L) {
 }
 
 /// The unit direction at map coordinates `uv` (the inverse of `encode`).
-fn decode(uv: Vec2) -> Vec3 {
+pub(super) fn decode(uv: Vec2) -> Vec3 {
     let (mut px, mut pz) = (uv.x * 2.0 - 1.0, uv.y * 2.0 - 1.0);
     let y = 1.0 - px.abs() - pz.abs();
     if y < 0.0 {
