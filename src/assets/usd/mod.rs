@@ -53,7 +53,7 @@ const MAX_PRIMS: usize = 1 << 20;
 /// the crate, and in the sandbox each must lie in the file's folder).
 pub fn load(path: &Path, input: &Input) -> Result<UsdModel, Error> {
     let bytes = input.read(path, None, None)?;
-    trial::survives(input.budget(), || {
+    trial::survives(input.budget(), bytes.len(), || {
         let _ = read(path, input, &bytes);
     })
     .map_err(|m| Error::asset(path, None, m))?;

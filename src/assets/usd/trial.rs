@@ -9,10 +9,23 @@
 //! stopped by a sanitizer in fuzzing builds, which keep their huge address
 //! space unlimited) makes the file an error. The child never returns into
 //! the caller: it ends with `_exit`.
+//!
+//! The child also has a CPU-time limit (`cpu_seconds`): openusd loops
+//! forever on some damaged text files (found by CI's fuzzing smoke,
+//! 2026-11-28), and a farm must not wait on such a file for ever. Past the
+//! limit the kernel stops the child (SIGXCPU) and the file is an error.
+
+/// CPU seconds the trial read may take for a file of `bytes` bytes: 20,
+/// and one more per 8 MiB (openusd reads well over 100 MiB a second).
+fn cpu_seconds(bytes: usize) -> u64 {
+    20 + (bytes as u64 >> 23)
+}
 
 /// Runs `f` in a child process; Err where the child did not end normally.
+/// `bytes`: the file's size, for the CPU-time limit.
 #[cfg(unix)]
-pub(super) fn survives(budget: u64, f: impl FnOnce()) -> Result<(), String> {
+pub(super) fn survives(budget: u64, bytes: usize, f: impl FnOnce()) -> Result<(), String> {
+    let seconds = cpu_seconds(bytes);
     // SAFETY: the child only runs `f` (the read, which takes no lock that
     // another thread of the parent may hold: glibc's allocator is
     // prepared for fork) and then `_exit`, without unwinding into the
@@ -34,7 +47,13 @@ pub(super) fn survives(budget: u64, f: impl FnOnce()) -> Result<(), String> {
                 };
                 libc::setrlimit(libc::RLIMIT_AS, &limit);
             }
+            let cpu = libc::rlimit {
+                rlim_cur: seconds,
+                rlim_max: seconds + 1,
+            };
+            libc::setrlimit(libc::RLIMIT_CPU, &cpu);
             for sig in [
+                libc::SIGXCPU,
                 libc::SIGABRT,
                 libc::SIGSEGV,
                 libc::SIGBUS,
@@ -59,14 +78,20 @@ pub(super) fn survives(budget: u64, f: impl FnOnce()) -> Result<(), String> {
     if libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0 {
         return Ok(());
     }
-    let how = if libc::WIFSIGNALED(status) {
-        format!("stopped by signal {}", libc::WTERMSIG(status))
+    let how = if libc::WIFSIGNALED(status) && libc::WTERMSIG(status) == libc::SIGXCPU {
+        format!("stopped after {seconds} s of CPU time (it does not end)")
+    } else if libc::WIFSIGNALED(status) {
+        format!(
+            "stopped by signal {} (the file asks for more memory than the budget, or the reader crashed)",
+            libc::WTERMSIG(status)
+        )
     } else {
-        format!("stopped with status {}", libc::WEXITSTATUS(status))
+        format!(
+            "stopped with status {} (the file asks for more memory than the budget, or the reader crashed)",
+            libc::WEXITSTATUS(status)
+        )
     };
-    Err(format!(
-        "the USD reader was {how} on this file (it asks for more memory than the budget, or the reader crashed)"
-    ))
+    Err(format!("the USD reader was {how} on this file"))
 }
 
 /// This process's address space in bytes (`/proc/self/statm`'s size; 0
@@ -84,7 +109,7 @@ fn address_space() -> u64 {
 
 /// Without fork: read in this process.
 #[cfg(not(unix))]
-pub(super) fn survives(_budget: u64, _f: impl FnOnce()) -> Result<(), String> {
+pub(super) fn survives(_budget: u64, _bytes: usize, _f: impl FnOnce()) -> Result<(), String> {
     Ok(())
 }
 
@@ -98,15 +123,18 @@ mod tests {
     /// is a child that exits with another status.
     #[test]
     fn an_abort_in_the_child_is_an_error_not_the_end_of_the_process() {
-        assert!(survives(1 << 30, || {}).is_ok());
-        assert!(survives(1 << 30, || panic!("caught")).is_ok());
-        let e = survives(1 << 30, || {
+        assert!(survives(1 << 30, 0, || {}).is_ok());
+        assert!(survives(1 << 30, 0, || panic!("caught")).is_ok());
+        let e = survives(1 << 30, 0, || {
             let v = vec![1u8; 1 << 40];
             std::hint::black_box(&v);
         })
         .unwrap_err();
         assert!(e.contains("stopped by signal"), "{e}");
-        let e = survives(1 << 30, || std::process::exit(7)).unwrap_err();
+        let e = survives(1 << 30, 0, || std::process::exit(7)).unwrap_err();
         assert!(e.contains("status 7"), "{e}");
+        // The CPU-time limit grows with the file: 20 s, one more per 8 MiB.
+        assert_eq!(cpu_seconds(1000), 20);
+        assert_eq!(cpu_seconds(80 << 20), 30);
     }
 }
