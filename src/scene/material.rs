@@ -100,6 +100,21 @@ pub struct Pbr {
     pub sheen: Option<SheenLayer>,
     /// KHR_materials_iridescence.
     pub iridescence: Option<IridescenceLayer>,
+    /// KHR_materials_anisotropy.
+    pub anisotropy: Option<Anisotropy>,
+}
+
+/// A lobe rougher along one direction of the surface than across it
+/// (KHR_materials_anisotropy): brushed metal.
+#[derive(Debug, Clone)]
+pub struct Anisotropy {
+    /// 0..1: alpha along the direction is lerp(alpha, 1, strength^2).
+    pub strength: f32,
+    /// Radians, counter-clockwise from the tangent, in the tangent plane.
+    pub rotation: f32,
+    /// Linear: red and green the direction in tangent space (times two
+    /// minus one), blue multiplies `strength`.
+    pub map: Option<TextureRef>,
 }
 
 /// A thin film over the material (KHR_materials_iridescence).
@@ -205,6 +220,7 @@ impl Pbr {
             transmission: None,
             sheen: None,
             iridescence: None,
+            anisotropy: None,
         }
     }
 }
@@ -315,7 +331,17 @@ impl Material {
 impl Material {
     /// Whether shading needs per-corner tangents.
     pub fn needs_tangents(&self) -> bool {
-        self.tangent_map().is_some()
+        self.tangent_set().is_some()
+    }
+
+    /// The texture-coordinate set whose tangents shading needs: that of
+    /// `tangent_map`, else an anisotropy's map's (set 0 without a map).
+    pub fn tangent_set(&self) -> Option<usize> {
+        let set = |t: &TextureRef| t.texcoord as usize;
+        self.tangent_map().map(set).or_else(|| {
+            let a = self.pbr.anisotropy.as_ref()?;
+            Some(a.map.as_ref().map_or(0, set))
+        })
     }
 
     /// The first map read in the surface's tangent frame (the normal or
@@ -390,6 +416,7 @@ impl Material {
                 .iter()
                 .flat_map(|t| [t.map.as_ref(), t.thickness_map.as_ref()]),
         )
+        .chain(p.anisotropy.iter().map(|a| a.map.as_ref()))
         .flatten()
     }
 }

@@ -134,6 +134,12 @@ pub(crate) trait Fetch<L: Lane> {
     /// The lanes' interpolated normals perturbed by `map`, unit.
     fn normal(&mut self, map: &NormalMap) -> V3<L>;
 
+    /// The lanes' interpolated tangents and their bitangent signs, where
+    /// the mesh has them.
+    fn tangents(&self) -> Option<(V3<L>, L)> {
+        None
+    }
+
     /// Red, green and blue of `t` (`rgba`).
     #[inline(always)]
     fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {

@@ -1,7 +1,8 @@
 //! glTF materials end to end: KHR_materials_unlit, ior, specular,
 //! clearcoat, transmission, volume, sheen and iridescence against their
-//! models' values on a cube face, and KHR_materials_variants picking each
-//! primitive's material by the model's `variant`.
+//! models' values on a cube face, anisotropy's stretched highlight, and
+//! KHR_materials_variants picking each primitive's material by the
+//! model's `variant`.
 
 use crate::common;
 
@@ -494,4 +495,86 @@ fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
     for x in [36, 39] {
         assert!(blue(thin[x]), "thin wall at x = {x}: {}", thin[x]);
     }
+}
+
+/// A 2x2 metal plate (z = 0, facing the camera; u along +x, so its
+/// tangents run along +x) with `aniso` (JSON of KHR_materials_anisotropy,
+/// or empty), seen straight on, lit by a point light 1.5 in front of its
+/// centre and nothing else: the spread of its highlight (the second
+/// moments of the luminance about the centre, in pixels) along x and y.
+fn plate_highlight(name: &str, aniso: &str) -> (f32, f32) {
+    let dir = common::scratch(name);
+    let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+    let plate = common::Prim {
+        positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
+        normals: vec![[0.0, 0.0, 1.0]; 4],
+        uv0: corners
+            .iter()
+            .map(|c| [(c[0] + 1.0) / 2.0, (1.0 - c[1]) / 2.0])
+            .collect(),
+        indices: vec![0, 1, 2, 0, 2, 3],
+        ..Default::default()
+    };
+    let ext = if aniso.is_empty() {
+        String::new()
+    } else {
+        format!(r#", "extensions": {{"KHR_materials_anisotropy": {aniso}}}"#)
+    };
+    let (text, _) = gltf_text(
+        &plate,
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": ["KHR_materials_anisotropy"],
+            "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1.0, "roughnessFactor": 0.3}}{ext}}}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("plate.gltf"), text).unwrap();
+    let scene = "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 1\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 0.0, 1.5]\nintensity = 2.0\n\
+         [[model]]\npath = \"plate.gltf\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n";
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let f = render_frame(&s, 0, 0);
+    let (mut sum, mut xx, mut yy) = (0.0f32, 0.0f32, 0.0f32);
+    for y in 0..64 {
+        for x in 0..64 {
+            let l = f.color[y * 64 + x].truncate().dot(Vec3::splat(1.0 / 3.0));
+            let (dx, dy) = (x as f32 - 31.5, y as f32 - 31.5);
+            sum += l;
+            xx += l * dx * dx;
+            yy += l * dy * dy;
+        }
+    }
+    assert!(sum > 0.0, "{name}: the plate is black");
+    ((xx / sum).sqrt(), (yy / sum).sqrt())
+}
+
+#[test]
+fn khr_materials_anisotropy_stretches_the_highlight_along_its_direction() {
+    // Without the extension (and at strength 0) the highlight is round.
+    let (x, y) = plate_highlight("gltf_aniso_none", "");
+    assert!((x / y - 1.0).abs() < 0.02, "isotropic: {x} x {y}");
+    let zero = plate_highlight("gltf_aniso_zero", r#"{"anisotropyStrength": 0.0}"#);
+    assert_eq!(zero, (x, y));
+    // Rougher along the tangent (+x): wider along x than along y.
+    let (ax, ay) = plate_highlight("gltf_aniso_x", r#"{"anisotropyStrength": 0.8}"#);
+    assert!(ax > 1.5 * ay, "along the tangent: {ax} x {ay}");
+    assert!((ay / y - 1.0).abs() < 0.25, "across: {ay} against {y}");
+    // Turned a quarter turn counter-clockwise: along y instead.
+    let (bx, by) = plate_highlight(
+        "gltf_aniso_y",
+        r#"{"anisotropyStrength": 0.8, "anisotropyRotation": 1.5707964}"#,
+    );
+    assert!((bx / ay - 1.0).abs() < 0.02, "turned: {bx} x {by}");
+    assert!((by / ax - 1.0).abs() < 0.02, "turned: {bx} x {by}");
+    // An eighth of a turn: as wide along x as along y, between the two.
+    let (cx, cy) = plate_highlight(
+        "gltf_aniso_diagonal",
+        r#"{"anisotropyStrength": 0.8, "anisotropyRotation": 0.7853982}"#,
+    );
+    assert!((cx / cy - 1.0).abs() < 0.02, "diagonal: {cx} x {cy}");
+    assert!(cx > ay && cx < ax, "diagonal: {cx} x {cy}");
 }

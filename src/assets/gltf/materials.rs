@@ -60,6 +60,21 @@ pub struct GltfMaterial {
     pub sheen: Option<GltfSheen>,
     /// KHR_materials_iridescence (None without it, or with a factor of 0).
     pub iridescence: Option<GltfIridescence>,
+    /// KHR_materials_anisotropy (None without it, or with a strength of 0
+    /// and no texture).
+    pub anisotropy: Option<GltfAnisotropy>,
+}
+
+/// KHR_materials_anisotropy.
+#[derive(Debug, Clone)]
+pub struct GltfAnisotropy {
+    /// 0..1.
+    pub strength: f32,
+    /// Radians, counter-clockwise from the tangent.
+    pub rotation: f32,
+    /// Red and green: the direction in tangent space; blue multiplies
+    /// `strength`.
+    pub texture: Option<TexInfo>,
 }
 
 /// KHR_materials_iridescence.
@@ -151,6 +166,7 @@ impl GltfMaterial {
             transmission: None,
             sheen: None,
             iridescence: None,
+            anisotropy: None,
         }
     }
 
@@ -216,6 +232,10 @@ impl GltfMaterial {
                 self.iridescence
                     .as_ref()
                     .and_then(|t| t.thickness_texture.as_ref()),
+                false,
+            ),
+            (
+                self.anisotropy.as_ref().and_then(|t| t.texture.as_ref()),
                 false,
             ),
         ]
@@ -428,7 +448,35 @@ pub(super) fn material(
         transmission: transmission(m, doc, images, warnings, path),
         sheen: sheen(m, doc, images, warnings, path),
         iridescence: iridescence(m, doc, images, warnings, path),
+        anisotropy: anisotropy(m, doc, images, warnings, path),
     }
+}
+
+/// KHR_materials_anisotropy: strength clamped to 0..1, a rotation that is
+/// not a finite number read as 0.
+pub(super) fn anisotropy(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfAnisotropy> {
+    let v = m.extension_value("KHR_materials_anisotropy")?;
+    let strength = json_number(v, "anisotropyStrength")
+        .unwrap_or(0.0)
+        .clamp(0.0, 1.0);
+    let texture = json_tex(v, "anisotropyTexture", doc, images, warnings, path);
+    if strength <= 0.0 {
+        // Zero strength is an isotropic lobe, whatever the texture says.
+        return None;
+    }
+    Some(GltfAnisotropy {
+        strength,
+        rotation: json_number(v, "anisotropyRotation")
+            .filter(|r| r.is_finite())
+            .unwrap_or(0.0),
+        texture,
+    })
 }
 
 pub(super) fn iridescence(

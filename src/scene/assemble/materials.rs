@@ -14,8 +14,8 @@ use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, Spanned};
 use crate::scene::material::{
-    AlphaMode, Clearcoat, DielectricSpecular, IridescenceLayer, Material, Native, NormalMap,
-    NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
+    AlphaMode, Anisotropy, Clearcoat, DielectricSpecular, IridescenceLayer, Material, Native,
+    NormalMap, NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -403,6 +403,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         specular: None,
         sheen: None,
         iridescence: None,
+        anisotropy: None,
         clearcoat: m.pc.map(unit).filter(|c| *c > 0.0).map(|factor| Clearcoat {
             factor,
             map: None,
@@ -525,6 +526,11 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             thickness_min: t.thickness_min,
             thickness_max: t.thickness_max,
             thickness_map: tex(&t.thickness_texture, false),
+        }),
+        anisotropy: g.anisotropy.as_ref().map(|a| Anisotropy {
+            strength: a.strength,
+            rotation: a.rotation,
+            map: tex(&a.texture, false),
         }),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the

@@ -513,10 +513,7 @@ fn decode_textures(
 /// The texture-coordinate set of the first material whose normal or bump
 /// map needs per-corner tangents (None: no material needs them).
 fn tangent_set(materials: &[Material]) -> Option<usize> {
-    materials
-        .iter()
-        .find_map(|m| m.tangent_map())
-        .map(|map| map.texcoord as usize)
+    materials.iter().find_map(|m| m.tangent_set())
 }
 
 /// `model.lights` and `model.cameras`: glTF and FBX files only; an import

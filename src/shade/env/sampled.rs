@@ -171,6 +171,26 @@ fn alpha(roughness: f32) -> f32 {
     (roughness * roughness).max(2e-3)
 }
 
+/// Anisotropic GGX about frame `m` (tangent, bitangent, normal) with
+/// alphas `ax` and `ay` along its first two axes: D(h).
+fn ggx_d_aniso(m: Mat3, ax: f32, ay: f32, h: Vec3) -> f32 {
+    let local = m.transpose() * h;
+    if local.z <= 0.0 {
+        return 0.0;
+    }
+    let s = (local.x / ax).powi(2) + (local.y / ay).powi(2) + local.z * local.z;
+    1.0 / (PI * ax * ay * s * s)
+}
+
+/// A half vector drawn from D(h) (n.h) of `ggx_d_aniso`: the slopes of
+/// the alpha-1 lobe stretched by the alphas.
+fn ggx_sample_aniso(m: Mat3, ax: f32, ay: f32, u: Vec2) -> Vec3 {
+    let phi = 2.0 * PI * u.x;
+    let r = (u.y / (1.0 - u.y).max(1e-7)).sqrt();
+    let slope = Vec2::new(ax * r * phi.cos(), ay * r * phi.sin());
+    (m * Vec3::new(-slope.x, -slope.y, 1.0)).normalize_or(m.z_axis)
+}
+
 fn ggx_d(ndh: f32, a: f32) -> f32 {
     if ndh <= 0.0 {
         return 0.0;
@@ -227,13 +247,29 @@ pub fn radiance(
         let h = (l + v).normalize_or_zero();
         ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
     };
+    // An anisotropic base lobe: its frame and alphas.
+    let aniso = match lobes {
+        Lobes::Pbr(c) => c.aniso.map(|k| {
+            let m = Mat3::from_cols(Vec3::from(k.t), Vec3::from(k.b), n);
+            (m, k.at, k.ab)
+        }),
+        Lobes::BlinnPhong { .. } => None,
+    };
+    // The base lobe's distribution of reflected directions.
+    let base_pdf = |l: Vec3| match aniso {
+        Some((m, ax, ay)) => {
+            let h = (l + v).normalize_or_zero();
+            ggx_d_aniso(m, ax, ay, h) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
+        }
+        None => ggx_pdf(n, a, l),
+    };
     let brdf_pdf = |l: Vec3| {
         let ndl = n.dot(l);
         if ndl <= 0.0 {
             return 0.0;
         }
         let coat = coat_frame.map_or(0.0, |(_, nc, ac)| qc * ggx_pdf(nc, ac, l));
-        q * ndl / PI + (1.0 - q - qc) * ggx_pdf(n, a, l) + coat
+        q * ndl / PI + (1.0 - q - qc) * base_pdf(l) + coat
     };
     // f(l) cos(l): the integrand without radiance and visibility.
     let f_cos = |l: Vec3| -> Vec3 {
@@ -280,7 +316,13 @@ pub fn radiance(
             m * Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
         } else if xi.x < 1.0 - qc {
             let u = Vec2::new((xi.x - q) / (1.0 - q - qc).max(1e-6), xi.y);
-            ggx_sample(m, a, u)
+            match aniso {
+                Some((m, ax, ay)) => {
+                    let h = ggx_sample_aniso(m, ax, ay, u);
+                    h * (2.0 * v.dot(h)) - v
+                }
+                None => ggx_sample(m, a, u),
+            }
         } else {
             let (mc, _, ac) = coat_frame.unwrap_or((m, n, a));
             let u = Vec2::new((xi.x - (1.0 - qc)) / qc.max(1e-6), xi.y);

@@ -91,6 +91,12 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
 
 impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     #[inline(always)]
+    fn tangents(&self) -> Option<(V3<L>, L)> {
+        let f = self.lookups.coords;
+        self.lm.tangents.then_some((f.tangent, f.sign))
+    }
+
+    #[inline(always)]
     fn rgb(&mut self, t: &TextureRef) -> Option<V3<L>> {
         let maps = &self.lm.maps;
         let i = match maps.get(self.next) {
@@ -196,7 +202,7 @@ pub(in crate::shade) fn tangent_space<L: Lane>(
 /// orthogonal to `n` (any such vector where it has no length left), and
 /// n x t, negated where the sign is negative.
 #[inline(always)]
-fn tangent_frame<L: Lane>(n: V3<L>, (t, sign): (V3<L>, L)) -> (V3<L>, V3<L>) {
+pub(in crate::shade) fn tangent_frame<L: Lane>(n: V3<L>, (t, sign): (V3<L>, L)) -> (V3<L>, V3<L>) {
     let one = L::splat(1.0);
     let (tt, ok) = (t - n.scale(n.dot(t))).try_normalize();
     let tt = if ok.all() {

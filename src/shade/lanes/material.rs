@@ -394,6 +394,9 @@ impl<'a> MapSet<'_, 'a> {
             self.optional(&k.map);
             self.optional(&k.thickness_map);
         }
+        if let Some(k) = &p.anisotropy {
+            self.optional(&k.map);
+        }
         self.normal(&m.normal_map)
     }
 

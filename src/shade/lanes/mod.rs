@@ -31,6 +31,7 @@ use crate::scene::settings::ShadingMode;
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 mod fetch;
+pub(in crate::shade) use fetch::tangent_frame;
 mod material;
 
 use fetch::{LaneFetch, Lookups};

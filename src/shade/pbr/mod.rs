@@ -29,6 +29,13 @@
 //!   KHR_materials_volume). Thin-walled: no refraction offset.
 //! - sheen (`shade::sheen`): a Charlie lobe over the base, which it
 //!   scales by 1 - max(C) E (under the clearcoat; emission is not scaled).
+//! - anisotropy (`pbr::anisotropy`): the GGX lobe rougher along a
+//!   direction t of the tangent plane (the tangent turned by the rotation,
+//!   or the map's direction) than across it (b = n x t), alpha_t =
+//!   lerp(alpha, 1, strength^2) and alpha_b = alpha; its D and separable
+//!   Smith visibility are the isotropic ones at strength 0. The
+//!   environment reflects about a normal bent towards the plane across b,
+//!   as the extension's sample viewer does.
 //! - iridescence (`shade::iridescence`): a thin film whose Fresnel
 //!   (at v.h for lights, n.v for the split sum, over the base's F0)
 //!   replaces Schlick's by its factor, in the specular lobe and in the
@@ -44,7 +51,10 @@
 //! lane by lane. `shading` reads a material into a `PbrColor` and sums
 //! the lights.
 
+mod anisotropy;
 pub mod shading;
+
+pub use anisotropy::Aniso;
 
 use std::f32::consts::PI;
 
@@ -96,6 +106,8 @@ pub struct PbrColor<L: Lane = f32> {
     pub sheen: Option<Sheens<L>>,
     /// A thin film over the material (KHR_materials_iridescence).
     pub iridescence: Option<Films<L>>,
+    /// An anisotropic lobe (KHR_materials_anisotropy).
+    pub aniso: Option<Aniso<L>>,
 }
 
 impl<L: Lane> PbrColor<L> {
@@ -122,6 +134,7 @@ impl<L: Lane> PbrColor<L> {
             coat: None,
             sheen: None,
             iridescence: None,
+            aniso: None,
         }
     }
 
@@ -339,7 +352,11 @@ pub fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> V
     if let Some(film) = &c.iridescence {
         fresnel = film.blend(fresnel, vdh, c.f0);
     }
-    (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(d_vis(n, v, h, ndl, c.a2))
+    let dv = match &c.aniso {
+        Some(a) => a.d_vis(n, v, l, h, ndl),
+        None => d_vis(n, v, h, ndl, c.a2),
+    };
+    (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(dv)
 }
 
 /// The whole material's f(v, l) cos for n.l = `ndl` > 0: the base
@@ -457,8 +474,13 @@ fn base_environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &PbrColor<L>
     let spec = c.split_sum(ndv, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
     let one = V3::splat(Vec3::ONE);
     let diffuse = (c.c_diff * (one - spec) * env.irradiance_lanes(n)).scale(ao / L::splat(PI));
-    let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
-    let r = dominant_direction_lanes(n, r, c.roughness);
+    // The reflection about the normal (bent by an anisotropic lobe).
+    let nr = match &c.aniso {
+        Some(a) => a.bent_normal(n, v, c.roughness),
+        None => n,
+    };
+    let r = nr.scale(L::splat(2.0) * nr.dot(v)) - v;
+    let r = dominant_direction_lanes(nr, r, c.roughness);
     let light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
     let specular = (light * spec).scale(so);

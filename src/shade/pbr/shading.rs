@@ -5,7 +5,9 @@
 
 use glam::Vec3;
 
-use super::{COAT_F0, Coat, Films, PbrColor, Sheens, brdf, env_brdf, environment, f_cos, splat3};
+use super::{
+    Aniso, COAT_F0, Coat, Films, PbrColor, Sheens, brdf, env_brdf, environment, f_cos, splat3,
+};
 use crate::scene::Material;
 use crate::shade::env::sampled::{self as env_sampled, Lobes};
 use crate::shade::lanes::{Lanes, Lit};
@@ -43,6 +45,14 @@ impl<L: Lane> PbrColor<L> {
                 ior: f.ior,
                 thickness: f.thickness.lane(k),
             }),
+            aniso: self.aniso.map(|a| Aniso {
+                dir: (a.dir.0.lane(k), a.dir.1.lane(k)),
+                strength: a.strength.lane(k),
+                t: v(a.t),
+                b: v(a.b),
+                at: a.at.lane(k),
+                ab: a.ab.lane(k),
+            }),
         }
     }
 }
@@ -54,6 +64,36 @@ fn times<L: Lane>(factor: f32, texel: Option<V3<L>>, channel: fn(V3<L>) -> L) ->
         Some(c) => L::splat(factor) * channel(c),
         None => L::splat(factor),
     }
+}
+
+/// KHR_materials_anisotropy at the lanes' points: the direction (the
+/// map's red and green times two minus one, unit; (1, 0) without a map or
+/// where the map's is zero) turned by the rotation, and the strength
+/// times the map's blue.
+#[inline(always)]
+fn anisotropy<L: Lane>(
+    a: &crate::scene::material::Anisotropy,
+    texel: Option<V3<L>>,
+    roughness: L,
+) -> Aniso<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    let (x, y, strength) = match texel {
+        Some(t) => {
+            let (x, y) = (t.x * two - one, t.y * two - one);
+            let len = (x * x + y * y).sqrt();
+            let some = len.cmpgt(L::splat(1e-6));
+            let inv = one / L::select(some, len, one);
+            (
+                L::select(some, x * inv, one),
+                L::select(some, y * inv, L::splat(0.0)),
+                L::splat(a.strength) * t.z,
+            )
+        }
+        None => (one, L::splat(0.0), L::splat(a.strength)),
+    };
+    let (cos, sin) = (L::splat(a.rotation.cos()), L::splat(a.rotation.sin()));
+    let dir = (cos * x - sin * y, sin * x + cos * y);
+    Aniso::new(dir, clamp01(strength), roughness)
 }
 
 impl ShadeContext<'_> {
@@ -170,6 +210,9 @@ impl ShadeContext<'_> {
                 thickness,
             });
         }
+        if let Some(a) = &m.pbr.anisotropy {
+            c.aniso = Some(anisotropy(a, fetch.rgb_of(&a.map), c.roughness));
+        }
         c
     }
 
@@ -194,12 +237,20 @@ impl ShadeContext<'_> {
         f: &Lanes<L>,
         c: &PbrColor<L>,
     ) -> V3<L> {
-        let c = *c;
+        let mut c = *c;
         let v = self.view_lanes(f.position);
         let n = match &m.normal_map {
             Some(map) => fetch.normal(map),
             None => f.normal,
         };
+        if let Some(a) = &mut c.aniso {
+            // Without tangents (no texture coordinates) the lobe has no
+            // direction: isotropic.
+            match fetch.tangents() {
+                Some(tangents) => a.orient(n, tangents),
+                None => c.aniso = None,
+            }
+        }
         let direct = if c.coat.is_some() || c.sheen.is_some() {
             self.layered_radiance(f, [n, v], &c)
         } else {
