@@ -30,6 +30,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mitsuba_env import flip, srgb8  # noqa: E402  (the same display transform and metric)
 DISCS = [(0, 0.8), (45, 0.8), (90, 0.8), (0, 0.0)]
 RADIUS, SEGMENTS, TILT, ROUGH = 0.55, 96, -35.0, 0.35
 BASE = (0.95, 0.93, 0.88)
@@ -92,18 +94,7 @@ def render_mitsuba(a, hdri, rotation, png):
             },
         }
     img = mi.render(mi.load_dict(scene))
-    x = np.clip(np.array(img), 0.0, 1.0)
-    s = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-    Image.fromarray(np.round(s * 255).astype(np.uint8)).save(png)
-
-
-def flip(a, ref, test):
-    r = subprocess.run([a.softraster, "compare", ref, test, "--metric", "flip",
-                        "--threshold", "1"], capture_output=True, text=True)
-    m = re.search(r"flip=([0-9.]+)", r.stdout + r.stderr)
-    if not m:
-        sys.exit(f"compare printed no flip value:\n{r.stdout}{r.stderr}")
-    return float(m.group(1))
+    Image.fromarray(srgb8(np.array(img))).save(png)
 
 
 def main():
