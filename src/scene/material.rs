@@ -102,6 +102,22 @@ pub struct Pbr {
     pub iridescence: Option<IridescenceLayer>,
     /// KHR_materials_anisotropy.
     pub anisotropy: Option<Anisotropy>,
+    /// KHR_materials_diffuse_transmission.
+    pub diffuse_transmission: Option<DiffuseTransmission>,
+}
+
+/// Light let through diffusely, as by a leaf or paper
+/// (KHR_materials_diffuse_transmission).
+#[derive(Debug, Clone)]
+pub struct DiffuseTransmission {
+    /// The share of the diffuse lobe that is transmitted, 0..1.
+    pub factor: f32,
+    /// Linear; alpha multiplies `factor`.
+    pub map: Option<TextureRef>,
+    /// Linear colour of the light let through.
+    pub color: Vec3,
+    /// sRGB; RGB multiplies `color`.
+    pub color_map: Option<TextureRef>,
 }
 
 /// A lobe rougher along one direction of the surface than across it
@@ -221,6 +237,7 @@ impl Pbr {
             sheen: None,
             iridescence: None,
             anisotropy: None,
+            diffuse_transmission: None,
         }
     }
 }
@@ -417,6 +434,11 @@ impl Material {
                 .flat_map(|t| [t.map.as_ref(), t.thickness_map.as_ref()]),
         )
         .chain(p.anisotropy.iter().map(|a| a.map.as_ref()))
+        .chain(
+            p.diffuse_transmission
+                .iter()
+                .flat_map(|t| [t.map.as_ref(), t.color_map.as_ref()]),
+        )
         .flatten()
     }
 }

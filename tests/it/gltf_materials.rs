@@ -578,3 +578,112 @@ fn khr_materials_anisotropy_stretches_the_highlight_along_its_direction() {
     assert!((cx / cy - 1.0).abs() < 0.02, "diagonal: {cx} x {cy}");
     assert!(cx > ay && cx < ax, "diagonal: {cx} x {cy}");
 }
+
+/// The centre of a plate (z = 0, facing the camera at +z) with
+/// KHR_materials_diffuse_transmission `dt` (JSON, or empty) over a base
+/// colour (0.2, 0.5, 0.2), lit only by a directional light of irradiance 1
+/// shining along `direction` (`shadows`: whether it casts them, onto a
+/// shadow map the plate itself is drawn in).
+fn leaf_centre(name: &str, dt: &str, direction: [f32; 3], shadows: bool) -> Vec3 {
+    let light = format!(
+        "[ambient]\ncolor = [0.0, 0.0, 0.0]\n[[light]]\nkind = \"directional\"\n\
+         direction = {direction:?}\nirradiance = 1.0\nshadows = {shadows}\n"
+    );
+    leaf_lit_by(name, dt, &light)
+}
+
+/// `leaf_centre` lit by `light` (TOML: lights, ambient, environment).
+fn leaf_lit_by(name: &str, dt: &str, light: &str) -> Vec3 {
+    let dir = common::scratch(name);
+    let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+    let plate = common::Prim {
+        positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
+        normals: vec![[0.0, 0.0, 1.0]; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        ..Default::default()
+    };
+    let ext = if dt.is_empty() {
+        String::new()
+    } else {
+        format!(r#", "extensions": {{"KHR_materials_diffuse_transmission": {dt}}}"#)
+    };
+    let (text, _) = gltf_text(
+        &plate,
+        r#", "material": 0"#,
+        &format!(
+            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
+            "extensionsUsed": ["KHR_materials_diffuse_transmission"],
+            "materials": [{{"doubleSided": true, "pbrMetallicRoughness": {{"baseColorFactor": [0.2, 0.5, 0.2, 1], "metallicFactor": 0.0, "roughnessFactor": 0.5}}{ext}}}]"#
+        ),
+        None,
+    );
+    std::fs::write(dir.join("leaf.gltf"), text).unwrap();
+    let scene = format!(
+        "[output]\nwidth = 32\nheight = 32\n[render]\nmsaa = 1\nshadows = \"pcf\"\n{light}\
+         [[model]]\npath = \"leaf.gltf\"\n\
+         [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nprojection = \"orthographic\"\nheight = 2.0\n"
+    );
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    render_frame(&s, 0, 0).color[16 * 32 + 16].truncate()
+}
+
+#[test]
+fn khr_materials_diffuse_transmission_lets_light_through_from_behind() {
+    let behind = [0.0, 0.0, 1.0];
+    // Without the extension a light behind the plate leaves its front dark.
+    let opaque = leaf_centre("gltf_dt_none", "", behind, false);
+    assert_eq!(opaque, Vec3::ZERO);
+    // With it: the colour x the share / pi, times 1 - F (F0 = 0.04 at the
+    // mirrored light's half vector, here the view itself).
+    let dt =
+        r#"{"diffuseTransmissionFactor": 0.6, "diffuseTransmissionColorFactor": [1.0, 0.8, 0.2]}"#;
+    let lit = leaf_centre("gltf_dt_behind", dt, behind, false);
+    let want = Vec3::new(1.0, 0.8, 0.2) * 0.6 * 0.96 / std::f32::consts::PI;
+    assert!(
+        (lit - want).abs().max_element() < 1e-4,
+        "{lit} against {want}"
+    );
+    // The plate's own shadow does not hide the light it lets through.
+    let shadowed = leaf_centre("gltf_dt_shadows", dt, behind, true);
+    assert!(
+        (shadowed - lit).abs().max_element() < 1e-4,
+        "{shadowed} against {lit}"
+    );
+    // Lit from the front, the diffuse reflection keeps 1 - 0.6 of itself.
+    let front = [0.0, 0.0, -1.0];
+    let full = leaf_centre("gltf_dt_front_none", "", front, false);
+    let kept = leaf_centre("gltf_dt_front", dt, front, false);
+    let base = Vec3::new(0.2, 0.5, 0.2);
+    // Both carry the same specular term: the difference is 0.6 of the
+    // diffuse lobe, base x 0.96 / pi.
+    let lost = full - kept;
+    let want = base * 0.6 * 0.96 / std::f32::consts::PI;
+    assert!(
+        (lost - want).abs().max_element() < 1e-4,
+        "{lost} against {want}"
+    );
+}
+
+#[test]
+fn diffuse_transmission_under_an_environment_sampled_agrees_with_prefiltered() {
+    // Under uniform light (radiance 1 from every direction) the front
+    // shows the base's diffuse reflection plus what the back lets through.
+    let dt =
+        r#"{"diffuseTransmissionFactor": 0.6, "diffuseTransmissionColorFactor": [1.0, 0.8, 0.2]}"#;
+    let env = |method: &str| {
+        format!(
+            "[ambient]\ncolor = [0.0, 0.0, 0.0]\n[environment]\npreset = \"neutral\"\n\
+             method = \"{method}\"\nsamples = 512\n"
+        )
+    };
+    let none = leaf_lit_by("gltf_dt_env_none", "", &env("prefiltered"));
+    let pre = leaf_lit_by("gltf_dt_env_prefiltered", dt, &env("prefiltered"));
+    let sampled = leaf_lit_by("gltf_dt_env_sampled", dt, &env("sampled"));
+    // The transmitted colour's red outweighs the base's lost red.
+    assert!(pre.x > none.x + 0.2, "{pre} against {none}");
+    assert!(
+        (sampled - pre).abs().max_element() < 0.02,
+        "sampled {sampled} against prefiltered {pre}"
+    );
+}

@@ -407,21 +407,19 @@ fn bad_gltf_files_exit_2_with_a_clear_message() {
     let (text, _) = common::gltf_text(
         &tri,
         "",
-        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_anisotropy"]"#),
+        &format!(r#"{nodes}, "extensionsUsed": ["KHR_materials_sss"]"#),
         None,
     );
-    write(&dir, "anisotropy.gltf", &text);
+    write(&dir, "sss.gltf", &text);
     let (code, err) = run(&[
         "render",
-        scene("anisotropy.gltf").to_str().unwrap(),
+        scene("sss.gltf").to_str().unwrap(),
         "--out",
         dir.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("warning:")
-            && err.contains("`KHR_materials_anisotropy`")
-            && err.contains("ignores"),
+        err.contains("warning:") && err.contains("`KHR_materials_sss`") && err.contains("ignores"),
         "{err}"
     );
 

@@ -63,6 +63,21 @@ pub struct GltfMaterial {
     /// KHR_materials_anisotropy (None without it, or with a strength of 0
     /// and no texture).
     pub anisotropy: Option<GltfAnisotropy>,
+    /// KHR_materials_diffuse_transmission (None without it, or with a
+    /// factor of 0).
+    pub diffuse_transmission: Option<GltfDiffuseTransmission>,
+}
+
+/// KHR_materials_diffuse_transmission.
+#[derive(Debug, Clone)]
+pub struct GltfDiffuseTransmission {
+    /// 0..1.
+    pub factor: f32,
+    /// Alpha multiplies `factor`.
+    pub texture: Option<TexInfo>,
+    pub color: Vec3,
+    /// sRGB; RGB multiplies `color`.
+    pub color_texture: Option<TexInfo>,
 }
 
 /// KHR_materials_anisotropy.
@@ -167,6 +182,7 @@ impl GltfMaterial {
             sheen: None,
             iridescence: None,
             anisotropy: None,
+            diffuse_transmission: None,
         }
     }
 
@@ -237,6 +253,18 @@ impl GltfMaterial {
             (
                 self.anisotropy.as_ref().and_then(|t| t.texture.as_ref()),
                 false,
+            ),
+            (
+                self.diffuse_transmission
+                    .as_ref()
+                    .and_then(|t| t.texture.as_ref()),
+                false,
+            ),
+            (
+                self.diffuse_transmission
+                    .as_ref()
+                    .and_then(|t| t.color_texture.as_ref()),
+                true,
             ),
         ]
         .into_iter()
@@ -449,7 +477,48 @@ pub(super) fn material(
         sheen: sheen(m, doc, images, warnings, path),
         iridescence: iridescence(m, doc, images, warnings, path),
         anisotropy: anisotropy(m, doc, images, warnings, path),
+        diffuse_transmission: diffuse_transmission(m, doc, images, warnings, path),
     }
+}
+
+/// KHR_materials_diffuse_transmission: factor clamped to 0..1, colour to
+/// 0..1 per channel.
+pub(super) fn diffuse_transmission(
+    m: &gltf::Material,
+    doc: &gltf::Document,
+    images: &[ImageSource],
+    warnings: &mut Vec<String>,
+    path: &Path,
+) -> Option<GltfDiffuseTransmission> {
+    let v = m.extension_value("KHR_materials_diffuse_transmission")?;
+    let factor = json_number(v, "diffuseTransmissionFactor")
+        .unwrap_or(0.0)
+        .clamp(0.0, 1.0);
+    if factor <= 0.0 {
+        return None;
+    }
+    Some(GltfDiffuseTransmission {
+        factor,
+        texture: json_tex(v, "diffuseTransmissionTexture", doc, images, warnings, path),
+        color: json_rgb(v, "diffuseTransmissionColorFactor")
+            .unwrap_or(Vec3::ONE)
+            .clamp(Vec3::ZERO, Vec3::ONE),
+        color_texture: json_tex(
+            v,
+            "diffuseTransmissionColorTexture",
+            doc,
+            images,
+            warnings,
+            path,
+        ),
+    })
+}
+
+/// Three finite numbers at `key` of `v`, as a colour.
+pub(super) fn json_rgb(v: &gltf::json::Value, key: &str) -> Option<Vec3> {
+    let c = v.get(key)?.as_array().filter(|c| c.len() == 3)?;
+    let ch = |i: usize| c[i].as_f64().map(|x| x as f32).filter(|x| x.is_finite());
+    Some(Vec3::new(ch(0)?, ch(1)?, ch(2)?))
 }
 
 /// KHR_materials_anisotropy: strength clamped to 0..1, a rotation that is
@@ -524,14 +593,7 @@ pub(super) fn sheen(
     path: &Path,
 ) -> Option<GltfSheen> {
     let v = m.extension_value("KHR_materials_sheen")?;
-    let color = v
-        .get("sheenColorFactor")
-        .and_then(|c| c.as_array())
-        .filter(|c| c.len() == 3)
-        .and_then(|c| {
-            let ch = |i: usize| c[i].as_f64().map(|x| x as f32).filter(|x| x.is_finite());
-            Some(Vec3::new(ch(0)?, ch(1)?, ch(2)?))
-        })
+    let color = json_rgb(v, "sheenColorFactor")
         .unwrap_or(Vec3::ZERO)
         .clamp(Vec3::ZERO, Vec3::ONE);
     if color == Vec3::ZERO {
@@ -670,13 +732,7 @@ pub(super) fn transmission(
         d => d.unwrap_or(f32::INFINITY),
     };
     let attenuation_color = volume
-        .and_then(|v| v.get("attenuationColor"))
-        .and_then(|c| c.as_array())
-        .filter(|c| c.len() == 3)
-        .and_then(|c| {
-            let ch = |i: usize| c[i].as_f64().map(|x| x as f32).filter(|x| x.is_finite());
-            Some(Vec3::new(ch(0)?, ch(1)?, ch(2)?))
-        })
+        .and_then(|v| json_rgb(v, "attenuationColor"))
         .unwrap_or(Vec3::ONE)
         .clamp(Vec3::ZERO, Vec3::ONE);
     Some(GltfTransmission {

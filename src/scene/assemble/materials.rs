@@ -14,8 +14,9 @@ use crate::assets::texture::{AddressMode, TextureRef, Wrap};
 use crate::error::Error;
 use crate::scene::desc::{AlphaModeDesc, Ctx, MaterialOverride, Spanned};
 use crate::scene::material::{
-    AlphaMode, Anisotropy, Clearcoat, DielectricSpecular, IridescenceLayer, Material, Native,
-    NormalMap, NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness, roughness_from_ns,
+    AlphaMode, Anisotropy, Clearcoat, DielectricSpecular, DiffuseTransmission, IridescenceLayer,
+    Material, Native, NormalMap, NormalSpace, Pbr, SheenLayer, Transmission, ns_from_roughness,
+    roughness_from_ns,
 };
 
 /// A material as its file states it, overrides applied.
@@ -404,6 +405,7 @@ fn mtl_material(x: &MtlSource, textures: &TextureLookup) -> Material {
         sheen: None,
         iridescence: None,
         anisotropy: None,
+        diffuse_transmission: None,
         clearcoat: m.pc.map(unit).filter(|c| *c > 0.0).map(|factor| Clearcoat {
             factor,
             map: None,
@@ -532,6 +534,15 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             rotation: a.rotation,
             map: tex(&a.texture, false),
         }),
+        diffuse_transmission: g
+            .diffuse_transmission
+            .as_ref()
+            .map(|t| DiffuseTransmission {
+                factor: t.factor,
+                map: tex(&t.texture, false),
+                color: t.color,
+                color_map: tex(&t.color_texture, true),
+            }),
     };
     // glTF as Blinn-Phong: the diffuse part of the base color as Kd, the
     // specular color at normal incidence (0.04 for dielectrics, the base

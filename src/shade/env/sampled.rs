@@ -199,6 +199,177 @@ fn ggx_d(ndh: f32, a: f32) -> f32 {
     a * a / (PI * t * t)
 }
 
+/// The lobes a point's estimate draws directions from (`Mixture::sample`)
+/// and their combined density (`Mixture::pdf`): diffuse (cosine about n,
+/// probability `q`), diffuse transmission (cosine about -n, `qb`), the
+/// base's GGX (isotropic about frame `m` with alpha `a`, or anisotropic),
+/// and a clearcoat's GGX (`qc`).
+struct Mixture {
+    n: Vec3,
+    v: Vec3,
+    m: Mat3,
+    a: f32,
+    aniso: Option<(Mat3, f32, f32)>,
+    coat: Option<(Mat3, Vec3, f32)>,
+    q: f32,
+    qb: f32,
+    qc: f32,
+}
+
+impl Mixture {
+    fn new(n: Vec3, v: Vec3, lobes: &Lobes) -> Mixture {
+        let (c_diff, spec_weight, roughness, behind) = match lobes {
+            Lobes::Pbr(c) => {
+                let s = c.specular_albedo(n.dot(v).abs()).into();
+                // The diffuse lobe before the transmitted share.
+                let c_diff = Vec3::from(c.base) * (1.0 - c.metallic);
+                let behind = c.behind.map_or(0.0, |b| luminance(b.into()));
+                (c_diff, luminance(s), c.roughness, behind)
+            }
+            Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness, 0.0),
+        };
+        let a = alpha(roughness);
+        // A clearcoat is a third, sharper lobe about its own normal: drawn
+        // with probability COAT_SHARE.
+        const COAT_SHARE: f32 = 0.3;
+        let coat = match lobes {
+            Lobes::Pbr(c) => c.coat.filter(|k| k.factor > 0.0),
+            Lobes::BlinnPhong { .. } => None,
+        };
+        let qc = if coat.is_some() { COAT_SHARE } else { 0.0 };
+        // Probabilities of drawing the diffuse lobe and the transmitted one.
+        let d = luminance(c_diff);
+        let total = d + spec_weight + behind;
+        let (q, qb) = if total <= 0.0 {
+            (1.0, 0.0)
+        } else {
+            (d / total, behind / total)
+        };
+        // An anisotropic base lobe: its frame and alphas.
+        let aniso = match lobes {
+            Lobes::Pbr(c) => c.aniso.map(|k| {
+                let m = Mat3::from_cols(Vec3::from(k.t), Vec3::from(k.b), n);
+                (m, k.at, k.ab)
+            }),
+            Lobes::BlinnPhong { .. } => None,
+        };
+        Mixture {
+            n,
+            v,
+            m: frame(n),
+            a,
+            aniso,
+            coat: coat.map(|k| {
+                let nc = Vec3::from(k.normal);
+                (frame(nc), nc, alpha(k.roughness))
+            }),
+            q: q * (1.0 - qc),
+            qb: qb * (1.0 - qc),
+            qc,
+        }
+    }
+
+    /// GGX's distribution of reflected directions about normal `n`.
+    fn ggx_pdf(&self, n: Vec3, a: f32, l: Vec3) -> f32 {
+        let v = self.v;
+        let h = (l + v).normalize_or_zero();
+        ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
+    }
+
+    /// The base lobe's distribution of reflected directions.
+    fn base_pdf(&self, l: Vec3) -> f32 {
+        let (n, v) = (self.n, self.v);
+        match self.aniso {
+            Some((m, ax, ay)) => {
+                let h = (l + v).normalize_or_zero();
+                ggx_d_aniso(m, ax, ay, h) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
+            }
+            None => self.ggx_pdf(n, self.a, l),
+        }
+    }
+
+    /// The density of drawing `l` (`sample`).
+    fn pdf(&self, l: Vec3) -> f32 {
+        let (q, qb, qc) = (self.q, self.qb, self.qc);
+        let ndl = self.n.dot(l);
+        if ndl <= 0.0 {
+            return qb * -ndl / PI;
+        }
+        let coat = self
+            .coat
+            .map_or(0.0, |(_, nc, ac)| qc * self.ggx_pdf(nc, ac, l));
+        q * ndl / PI + (1.0 - q - qb - qc) * self.base_pdf(l) + coat
+    }
+
+    /// A direction drawn from the lobes by `xi` (uniform in [0, 1)^2).
+    fn sample(&self, xi: Vec2) -> Vec3 {
+        let (v, m, a) = (self.v, self.m, self.a);
+        let (q, qb, qc) = (self.q, self.qb, self.qc);
+        // A reflected direction from GGX about frame `m` (alpha `a`).
+        let ggx_sample = |m: Mat3, a: f32, u: Vec2| {
+            let phi = 2.0 * PI * u.x;
+            let cos_t = ((1.0 - u.y) / (1.0 + (a * a - 1.0) * u.y)).max(0.0).sqrt();
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let h = m * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+            h * (2.0 * v.dot(h)) - v
+        };
+        // A cosine-distributed direction about m's third axis, or the
+        // opposite one.
+        let cosine = |u: Vec2, side: f32| {
+            let r = u.x.sqrt();
+            let phi = 2.0 * PI * u.y;
+            m * Vec3::new(
+                r * phi.cos(),
+                r * phi.sin(),
+                side * (1.0 - u.x).max(0.0).sqrt(),
+            )
+        };
+        if xi.x < q {
+            cosine(Vec2::new(xi.x / q.max(1e-6), xi.y), 1.0)
+        } else if xi.x < q + qb {
+            cosine(Vec2::new((xi.x - q) / qb.max(1e-6), xi.y), -1.0)
+        } else if xi.x < 1.0 - qc {
+            let u = Vec2::new((xi.x - q - qb) / (1.0 - q - qb - qc).max(1e-6), xi.y);
+            match self.aniso {
+                Some((m, ax, ay)) => {
+                    let h = ggx_sample_aniso(m, ax, ay, u);
+                    h * (2.0 * v.dot(h)) - v
+                }
+                None => ggx_sample(m, a, u),
+            }
+        } else {
+            let (mc, _, ac) = self.coat.unwrap_or((m, self.n, a));
+            let u = Vec2::new((xi.x - (1.0 - qc)) / qc.max(1e-6), xi.y);
+            ggx_sample(mc, ac, u)
+        }
+    }
+}
+
+/// f(l) cos(l) of `lobes` towards `v` at unit normal `n`: the integrand
+/// without radiance and visibility (`a`: the Blinn-Phong lobe's alpha).
+fn f_cos(lobes: &Lobes, n: Vec3, v: Vec3, a: f32, l: Vec3) -> Vec3 {
+    let ndl = n.dot(l);
+    if ndl <= 0.0 {
+        // Only a diffuse transmission lets light through from behind.
+        return match lobes {
+            Lobes::Pbr(c) => c.behind.map_or(Vec3::ZERO, |b| {
+                let f: Vec3 = pbr::btdf(n.into(), v.into(), l.into(), b, c).into();
+                f * -ndl
+            }),
+            Lobes::BlinnPhong { .. } => Vec3::ZERO,
+        };
+    }
+    match lobes {
+        Lobes::Pbr(c) => pbr::f_cos(n.into(), v.into(), l.into(), ndl, c).into(),
+        Lobes::BlinnPhong { kd, ks, .. } => {
+            // The normalized lobe: D (n.h) / (4 v.h) integrates to ~1.
+            let h = (l + v).normalize_or_zero();
+            let lobe = ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6));
+            *kd * (ndl / PI) + *ks * lobe
+        }
+    }
+}
+
 /// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
 /// `ng` for the rays' offset) from the environment, `samples` pairs of
 /// directions, with visibility through `tracer`.
@@ -210,84 +381,14 @@ pub fn radiance(
     lobes: &Lobes,
     samples: u32,
 ) -> Vec3 {
-    let (c_diff, spec_weight, roughness) = match lobes {
-        Lobes::Pbr(c) => {
-            let s = c.specular_albedo(n.dot(v).abs()).into();
-            // The diffuse lobe before the transmitted share.
-            let c_diff = Vec3::from(c.base) * (1.0 - c.metallic);
-            (c_diff, luminance(s), c.roughness)
-        }
-        Lobes::BlinnPhong { kd, ks, roughness } => (*kd, luminance(*ks), *roughness),
+    let mix = Mixture::new(n, v, lobes);
+    let f_cos = |l: Vec3| f_cos(lobes, n, v, mix.a, l);
+    // Rays towards the front leave off the front; those of a diffuse
+    // transmission, behind the surface, off the back.
+    let visible = |l: Vec3| {
+        let off = if n.dot(l) < 0.0 { -ng } else { ng };
+        !tracer.occluded(p + off * tracer.epsilon, l, f32::INFINITY)
     };
-    let a = alpha(roughness);
-    // A clearcoat is a third, sharper lobe about its own normal: drawn
-    // with probability COAT_SHARE.
-    const COAT_SHARE: f32 = 0.3;
-    let coat = match lobes {
-        Lobes::Pbr(c) => c.coat.filter(|k| k.factor > 0.0),
-        Lobes::BlinnPhong { .. } => None,
-    };
-    let qc = if coat.is_some() { COAT_SHARE } else { 0.0 };
-    // Probability of drawing the diffuse lobe.
-    let q = {
-        let d = luminance(c_diff);
-        if d + spec_weight <= 0.0 {
-            1.0
-        } else {
-            d / (d + spec_weight)
-        }
-    } * (1.0 - qc);
-    let m = frame(n);
-    let coat_frame = coat.map(|k| {
-        let nc = Vec3::from(k.normal);
-        (frame(nc), nc, alpha(k.roughness))
-    });
-    // GGX's distribution of reflected directions about normal `n`.
-    let ggx_pdf = |n: Vec3, a: f32, l: Vec3| {
-        let h = (l + v).normalize_or_zero();
-        ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
-    };
-    // An anisotropic base lobe: its frame and alphas.
-    let aniso = match lobes {
-        Lobes::Pbr(c) => c.aniso.map(|k| {
-            let m = Mat3::from_cols(Vec3::from(k.t), Vec3::from(k.b), n);
-            (m, k.at, k.ab)
-        }),
-        Lobes::BlinnPhong { .. } => None,
-    };
-    // The base lobe's distribution of reflected directions.
-    let base_pdf = |l: Vec3| match aniso {
-        Some((m, ax, ay)) => {
-            let h = (l + v).normalize_or_zero();
-            ggx_d_aniso(m, ax, ay, h) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6))
-        }
-        None => ggx_pdf(n, a, l),
-    };
-    let brdf_pdf = |l: Vec3| {
-        let ndl = n.dot(l);
-        if ndl <= 0.0 {
-            return 0.0;
-        }
-        let coat = coat_frame.map_or(0.0, |(_, nc, ac)| qc * ggx_pdf(nc, ac, l));
-        q * ndl / PI + (1.0 - q - qc) * base_pdf(l) + coat
-    };
-    // f(l) cos(l): the integrand without radiance and visibility.
-    let f_cos = |l: Vec3| -> Vec3 {
-        let ndl = n.dot(l);
-        if ndl <= 0.0 {
-            return Vec3::ZERO;
-        }
-        match lobes {
-            Lobes::Pbr(c) => pbr::f_cos(n.into(), v.into(), l.into(), ndl, c).into(),
-            Lobes::BlinnPhong { kd, ks, .. } => {
-                // The normalized lobe: D (n.h) / (4 v.h) integrates to ~1.
-                let h = (l + v).normalize_or_zero();
-                let lobe = ggx_d(n.dot(h), a) * n.dot(h) / (4.0 * v.dot(h).abs().max(1e-6));
-                *kd * (ndl / PI) + *ks * lobe
-            }
-        }
-    };
-    let visible = |l: Vec3| !tracer.occluded(p + ng * tracer.epsilon, l, f32::INFINITY);
     let shift = position_hash(p);
     let mut sum = Vec3::ZERO;
     for i in 0..samples {
@@ -297,40 +398,14 @@ pub fn radiance(
         let fc = f_cos(l);
         if fc != Vec3::ZERO && visible(l) {
             let pe = env.pdf(l);
-            sum += fc * env.radiance(l) / (pe + brdf_pdf(l)).max(1e-12);
+            sum += fc * env.radiance(l) / (pe + mix.pdf(l)).max(1e-12);
         }
         // From the BRDF.
         let xi = point(i, samples, Vec2::new(shift.y, shift.x));
-        // A reflected direction from GGX about frame `m` (alpha `a`).
-        let ggx_sample = |m: Mat3, a: f32, u: Vec2| {
-            let phi = 2.0 * PI * u.x;
-            let cos_t = ((1.0 - u.y) / (1.0 + (a * a - 1.0) * u.y)).max(0.0).sqrt();
-            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-            let h = m * Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
-            h * (2.0 * v.dot(h)) - v
-        };
-        let l = if xi.x < q {
-            let u = Vec2::new(xi.x / q.max(1e-6), xi.y);
-            let r = u.x.sqrt();
-            let phi = 2.0 * PI * u.y;
-            m * Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
-        } else if xi.x < 1.0 - qc {
-            let u = Vec2::new((xi.x - q) / (1.0 - q - qc).max(1e-6), xi.y);
-            match aniso {
-                Some((m, ax, ay)) => {
-                    let h = ggx_sample_aniso(m, ax, ay, u);
-                    h * (2.0 * v.dot(h)) - v
-                }
-                None => ggx_sample(m, a, u),
-            }
-        } else {
-            let (mc, _, ac) = coat_frame.unwrap_or((m, n, a));
-            let u = Vec2::new((xi.x - (1.0 - qc)) / qc.max(1e-6), xi.y);
-            ggx_sample(mc, ac, u)
-        };
+        let l = mix.sample(xi);
         let fc = f_cos(l);
         if fc != Vec3::ZERO && visible(l) {
-            let pb = brdf_pdf(l);
+            let pb = mix.pdf(l);
             sum += fc * env.radiance(l) / (env.pdf(l) + pb).max(1e-12);
         }
     }

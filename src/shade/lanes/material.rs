@@ -397,6 +397,10 @@ impl<'a> MapSet<'_, 'a> {
         if let Some(k) = &p.anisotropy {
             self.optional(&k.map);
         }
+        if let Some(k) = &p.diffuse_transmission {
+            self.optional(&k.map);
+            self.optional(&k.color_map);
+        }
         self.normal(&m.normal_map)
     }
 

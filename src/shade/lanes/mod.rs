@@ -388,6 +388,32 @@ impl<'a> ShadeContext<'a> {
         f: &Lanes<L>,
         n: V3<L>,
     ) -> Lit<L> {
+        self.lit_side(i, light, f, n, false)
+    }
+
+    /// `lit_lanes` of the surfaces' far sides (`n` the normals turned
+    /// round): a light behind the surface, its shadow looked up off the
+    /// far side (KHR_materials_diffuse_transmission).
+    #[inline(always)]
+    pub(in crate::shade) fn lit_behind<L: Lane>(
+        &self,
+        i: usize,
+        light: &Light,
+        f: &Lanes<L>,
+        n: V3<L>,
+    ) -> Lit<L> {
+        self.lit_side(i, light, f, -n, true)
+    }
+
+    #[inline(always)]
+    fn lit_side<L: Lane>(
+        &self,
+        i: usize,
+        light: &Light,
+        f: &Lanes<L>,
+        n: V3<L>,
+        behind: bool,
+    ) -> Lit<L> {
         let p = f.position;
         let (l, e, reaches) = incidence(light, p);
         let ndl = n.dot(l);
@@ -407,8 +433,11 @@ impl<'a> ShadeContext<'a> {
                 } else {
                     bits >> (4 * q) & 0xf
                 };
-                self.shadows
-                    .visibility4(i, quad(p), &f.geo_normal4(q), quad(l), mask)
+                let mut ng = f.geo_normal4(q);
+                if behind {
+                    ng = ng.map(|g| -g);
+                }
+                self.shadows.visibility4(i, quad(p), &ng, quad(l), mask)
             });
             lit = lit & s.cmpgt(L::splat(0.0));
         }
@@ -422,7 +451,7 @@ impl<'a> ShadeContext<'a> {
 }
 
 /// A light's contribution at the lanes' points (`ShadeContext::lit_lanes`).
-pub(super) struct Lit<L: Lane> {
+pub(in crate::shade) struct Lit<L: Lane> {
     pub l: V3<L>,
     pub ndl: L,
     /// Irradiance times n.l times the shadow.

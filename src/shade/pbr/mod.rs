@@ -108,6 +108,10 @@ pub struct PbrColor<L: Lane = f32> {
     pub iridescence: Option<Films<L>>,
     /// An anisotropic lobe (KHR_materials_anisotropy).
     pub aniso: Option<Aniso<L>>,
+    /// What of the light behind the surface its diffuse transmission lets
+    /// through (KHR_materials_diffuse_transmission: the colour times the
+    /// share, times (1 - metallic) (1 - transmission)), before Fresnel.
+    pub behind: Option<V3<L>>,
 }
 
 impl<L: Lane> PbrColor<L> {
@@ -135,6 +139,7 @@ impl<L: Lane> PbrColor<L> {
             sheen: None,
             iridescence: None,
             aniso: None,
+            behind: None,
         }
     }
 
@@ -154,6 +159,17 @@ impl<L: Lane> PbrColor<L> {
         self.transmission = t;
         self.attenuation = attenuation;
         self.c_diff = self.c_diff.scale(L::splat(1.0) - t);
+    }
+
+    /// KHR_materials_diffuse_transmission: `share` (0..1) of the diffuse
+    /// lobe transmits light of `color` from behind (after
+    /// `set_transmission`).
+    #[inline(always)]
+    pub fn set_diffuse_transmission(&mut self, share: L, color: V3<L>) {
+        let one = L::splat(1.0);
+        let keep = (one - self.metallic) * (one - self.transmission);
+        self.behind = Some(color.scale(share * keep));
+        self.c_diff = self.c_diff.scale(one - share);
     }
 
     /// The split sum's specular albedo f0 a + f90 b, with a film blended
@@ -359,6 +375,20 @@ pub fn brdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> V
     (one - fresnel) * c.c_diff / L::splat(PI) + fresnel.scale(dv)
 }
 
+/// The diffuse transmission's f(v, l) (no cosine) for light from `l`
+/// behind the surface (n.l < 0), `behind` its colour (`PbrColor::behind`):
+/// behind / pi times 1 - F, Fresnel at the half vector of v and l
+/// mirrored to the front (the extension's sample viewer).
+#[inline(always)]
+pub fn btdf<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, behind: V3<L>, c: &PbrColor<L>) -> V3<L> {
+    let mirrored = l - n.scale(L::splat(2.0) * n.dot(l));
+    let h = (mirrored + v).normalize_or(V3::zero());
+    let vdh = v.dot(h).abs();
+    let one = V3::splat(Vec3::ONE);
+    let fresnel = c.f0 + (splat3(c.f90) - c.f0).scale(pow5(L::splat(1.0) - vdh));
+    (one - fresnel) * behind / L::splat(PI)
+}
+
 /// The whole material's f(v, l) cos for n.l = `ndl` > 0: the base
 /// layer's BRDF times n.l, with the sheen, under the clearcoat.
 #[inline(always)]
@@ -473,7 +503,12 @@ fn base_environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &PbrColor<L>
     }
     let spec = c.split_sum(ndv, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
     let one = V3::splat(Vec3::ONE);
-    let diffuse = (c.c_diff * (one - spec) * env.irradiance_lanes(n)).scale(ao / L::splat(PI));
+    let mut diffuse = c.c_diff * (one - spec) * env.irradiance_lanes(n);
+    if let Some(behind) = c.behind {
+        // The light from behind, let through diffusely.
+        diffuse = diffuse + behind * (one - spec) * env.irradiance_lanes(-n);
+    }
+    let diffuse = diffuse.scale(ao / L::splat(PI));
     // The reflection about the normal (bent by an anisotropic lobe).
     let nr = match &c.aniso {
         Some(a) => a.bent_normal(n, v, c.roughness),

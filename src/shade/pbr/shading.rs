@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::{
-    Aniso, COAT_F0, Coat, Films, PbrColor, Sheens, brdf, env_brdf, environment, f_cos, splat3,
+    Aniso, COAT_F0, Coat, Films, PbrColor, Sheens, brdf, btdf, env_brdf, environment, f_cos, splat3,
 };
 use crate::scene::Material;
 use crate::shade::env::sampled::{self as env_sampled, Lobes};
@@ -45,6 +45,7 @@ impl<L: Lane> PbrColor<L> {
                 ior: f.ior,
                 thickness: f.thickness.lane(k),
             }),
+            behind: self.behind.map(v),
             aniso: self.aniso.map(|a| Aniso {
                 dir: (a.dir.0.lane(k), a.dir.1.lane(k)),
                 strength: a.strength.lane(k),
@@ -63,6 +64,16 @@ fn times<L: Lane>(factor: f32, texel: Option<V3<L>>, channel: fn(V3<L>) -> L) ->
     match texel {
         Some(c) => L::splat(factor) * channel(c),
         None => L::splat(factor),
+    }
+}
+
+/// The diffuse lobe's albedo under light from every direction: c_diff,
+/// plus what the diffuse transmission lets through from behind.
+#[inline(always)]
+fn diffuse_albedo<L: Lane>(c: &PbrColor<L>) -> V3<L> {
+    match c.behind {
+        Some(behind) => c.c_diff + behind,
+        None => c.c_diff,
     }
 }
 
@@ -213,6 +224,17 @@ impl ShadeContext<'_> {
         if let Some(a) = &m.pbr.anisotropy {
             c.aniso = Some(anisotropy(a, fetch.rgb_of(&a.map), c.roughness));
         }
+        if let Some(d) = &p.diffuse_transmission {
+            let share = match fetch.rgba_of(&d.map) {
+                Some((_, a)) => L::splat(d.factor) * a,
+                None => L::splat(d.factor),
+            };
+            let mut color = V3::splat(d.color);
+            if let Some(t) = fetch.rgb_of(&d.color_map) {
+                color = color * t;
+            }
+            c.set_diffuse_transmission(clamp01(share), color);
+        }
         c
     }
 
@@ -283,14 +305,39 @@ impl ShadeContext<'_> {
                 out = V3::select(lit, added, out);
             }
         });
+        if let Some(behind) = c.behind {
+            out = out + self.behind_radiance(f, [n, v], c, behind);
+        }
         let ambient = V3::splat(self.ambient).scale(f.ao);
         let some_ambient = !(ambient.x.cmpeq(zero) & ambient.y.cmpeq(zero) & ambient.z.cmpeq(zero));
         if some_ambient.any() {
             let spec = c.specular_albedo(n.dot(v).abs());
             let ones = V3::splat(Vec3::ONE);
-            let added = out + ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
+            let added =
+                out + ambient.scale(c.occlusion) * (diffuse_albedo(c) * (ones - spec) + spec);
             out = V3::select(some_ambient, added, out);
         }
+        out
+    }
+
+    /// The lights behind the surface, let through by its diffuse
+    /// transmission of colour `behind`.
+    #[inline(always)]
+    fn behind_radiance<L: Lane>(
+        &self,
+        f: &Lanes<L>,
+        [n, v]: [V3<L>; 2],
+        c: &PbrColor<L>,
+        behind: V3<L>,
+    ) -> V3<L> {
+        let mut out = V3::zero();
+        f.light_set(self.lights).for_each(|i, light| {
+            let Lit { l, e, lit, .. } = self.lit_behind(i, light, f, n);
+            if lit.any() {
+                let added = out + e * btdf(n, v, l, behind, c);
+                out = V3::select(lit, added, out);
+            }
+        });
         out
     }
 
@@ -322,13 +369,16 @@ impl ShadeContext<'_> {
         if some_ambient.any() {
             let spec = c.specular_albedo(ndv);
             let ones = V3::splat(Vec3::ONE);
-            let mut lit = ambient.scale(c.occlusion) * (c.c_diff * (ones - spec) + spec);
+            let mut lit = ambient.scale(c.occlusion) * (diffuse_albedo(c) * (ones - spec) + spec);
             if let Some(s) = &c.sheen {
                 let e = s.albedo(ndv);
                 let (k, own) = (s.keep(e), s.reflectance(e));
                 lit = lit.scale(k) + ambient.scale(c.occlusion) * own;
             }
             under = V3::select(some_ambient, lit, under);
+        }
+        if let Some(behind) = c.behind {
+            under = under + self.behind_radiance(f, [n, v], c, behind);
         }
         under = under + c.emissive;
         if let Some(coat) = &c.coat {
