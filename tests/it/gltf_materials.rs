@@ -497,13 +497,10 @@ fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
     }
 }
 
-/// A 2x2 metal plate (z = 0, facing the camera; u along +x, so its
-/// tangents run along +x) with `aniso` (JSON of KHR_materials_anisotropy,
-/// or empty), seen straight on, lit by a point light 1.5 in front of its
-/// centre and nothing else: the spread of its highlight (the second
-/// moments of the luminance about the centre, in pixels) along x and y.
-fn plate_highlight(name: &str, aniso: &str) -> (f32, f32) {
-    let dir = common::scratch(name);
+/// Writes `dir/file`: a 2x2 plate (z = 0, facing +z; u along +x, v down
+/// y) of one material, `material` (JSON members), with extension
+/// `ext.0` whose JSON is `ext.1` (none where it is empty).
+fn write_plate(dir: &std::path::Path, file: &str, material: &str, ext: (&str, &str)) {
     let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
     let plate = common::Prim {
         positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
@@ -515,22 +512,38 @@ fn plate_highlight(name: &str, aniso: &str) -> (f32, f32) {
         indices: vec![0, 1, 2, 0, 2, 3],
         ..Default::default()
     };
-    let ext = if aniso.is_empty() {
+    let (name, json) = ext;
+    let extension = if json.is_empty() {
         String::new()
     } else {
-        format!(r#", "extensions": {{"KHR_materials_anisotropy": {aniso}}}"#)
+        format!(r#", "extensions": {{"{name}": {json}}}"#)
     };
     let (text, _) = gltf_text(
         &plate,
         r#", "material": 0"#,
         &format!(
             r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-            "extensionsUsed": ["KHR_materials_anisotropy"],
-            "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1.0, "roughnessFactor": 0.3}}{ext}}}]"#
+            "extensionsUsed": ["{name}"], "materials": [{{{material}{extension}}}]"#
         ),
         None,
     );
-    std::fs::write(dir.join("plate.gltf"), text).unwrap();
+    std::fs::write(dir.join(file), text).unwrap();
+}
+
+/// A 2x2 metal plate (z = 0, facing the camera; u along +x, so its
+/// tangents run along +x) with `aniso` (JSON of KHR_materials_anisotropy,
+/// or empty), seen straight on, lit by a point light 1.5 in front of its
+/// centre and nothing else: the spread of its highlight (the second
+/// moments of the luminance about the centre, in pixels) along x and y.
+fn plate_highlight(name: &str, aniso: &str) -> (f32, f32) {
+    let dir = common::scratch(name);
+    let material = r#""pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1.0, "roughnessFactor": 0.3}"#;
+    write_plate(
+        &dir,
+        "plate.gltf",
+        material,
+        ("KHR_materials_anisotropy", aniso),
+    );
     let scene = "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 1\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
          [[light]]\nkind = \"point\"\nposition = [0.0, 0.0, 1.5]\nintensity = 2.0\n\
          [[model]]\npath = \"plate.gltf\"\n\
@@ -595,29 +608,13 @@ fn leaf_centre(name: &str, dt: &str, direction: [f32; 3], shadows: bool) -> Vec3
 /// `leaf_centre` lit by `light` (TOML: lights, ambient, environment).
 fn leaf_lit_by(name: &str, dt: &str, light: &str) -> Vec3 {
     let dir = common::scratch(name);
-    let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
-    let plate = common::Prim {
-        positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
-        normals: vec![[0.0, 0.0, 1.0]; 4],
-        indices: vec![0, 1, 2, 0, 2, 3],
-        ..Default::default()
-    };
-    let ext = if dt.is_empty() {
-        String::new()
-    } else {
-        format!(r#", "extensions": {{"KHR_materials_diffuse_transmission": {dt}}}"#)
-    };
-    let (text, _) = gltf_text(
-        &plate,
-        r#", "material": 0"#,
-        &format!(
-            r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-            "extensionsUsed": ["KHR_materials_diffuse_transmission"],
-            "materials": [{{"doubleSided": true, "pbrMetallicRoughness": {{"baseColorFactor": [0.2, 0.5, 0.2, 1], "metallicFactor": 0.0, "roughnessFactor": 0.5}}{ext}}}]"#
-        ),
-        None,
+    let material = r#""doubleSided": true, "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.2, 1], "metallicFactor": 0.0, "roughnessFactor": 0.5}"#;
+    write_plate(
+        &dir,
+        "leaf.gltf",
+        material,
+        ("KHR_materials_diffuse_transmission", dt),
     );
-    std::fs::write(dir.join("leaf.gltf"), text).unwrap();
     let scene = format!(
         "[output]\nwidth = 32\nheight = 32\n[render]\nmsaa = 1\nshadows = \"pcf\"\n{light}\
          [[model]]\npath = \"leaf.gltf\"\n\
