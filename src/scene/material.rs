@@ -201,6 +201,9 @@ pub struct Transmission {
     /// The distance at which white light becomes `attenuation_color`
     /// (infinite: no attenuation).
     pub attenuation_distance: f32,
+    /// KHR_materials_dispersion: 20 / the Abbe number (0: none); the
+    /// indices of red and blue spread about `ior` by it.
+    pub dispersion: f32,
 }
 
 /// A dielectric's reflectance when the file gives it.

@@ -109,6 +109,8 @@ pub struct RefractedRay {
     pub view: Vec3,
     /// Index of refraction of the volume.
     pub ior: f32,
+    /// KHR_materials_dispersion: 20 / the Abbe number (0: none).
+    pub dispersion: f32,
     /// The volume's thickness (0: thin wall).
     pub thickness: f32,
     /// Perceptual roughness of the surface.
@@ -217,6 +219,22 @@ impl OpaqueFrame {
         } else {
             1.5
         };
+        let solid = r.thickness > 0.0 && r.thickness.is_finite();
+        if r.dispersion > 0.0 && r.dispersion.is_finite() && solid {
+            // Red bends least, blue most: each channel through its own
+            // index, (ior - 1) / 40 x dispersion either side of green's (the
+            // extension's sample viewer).
+            let half = (ior - 1.0) * 0.025 * r.dispersion;
+            let red = self.through_at(r, (ior - half).max(1.0), env);
+            let green = self.through_at(r, ior, env);
+            let blue = self.through_at(r, ior + half, env);
+            return Vec3::new(red.x, green.y, blue.z);
+        }
+        self.through_at(r, ior, env)
+    }
+
+    /// `through` at index of refraction `ior`.
+    fn through_at(&self, r: &RefractedRay, ior: f32, env: Option<&EnvLight>) -> Vec3 {
         let (exit, out) = bend(r, ior);
         let l0 = &self.levels[0];
         let blur = r.roughness.clamp(0.0, 1.0) * (2.0 * ior - 2.0).clamp(0.0, 1.0);
@@ -339,6 +357,7 @@ mod tests {
             normal: n,
             view: -p.normalize(),
             ior,
+            dispersion: 0.0,
             thickness,
             roughness,
         }
@@ -383,6 +402,7 @@ mod tests {
                 normal: -p.normalize(),
                 view: -p.normalize(),
                 ior,
+                dispersion: 0.0,
                 thickness: 0.0,
                 roughness,
             };
@@ -406,9 +426,37 @@ mod tests {
             normal: -p.normalize(),
             view: -p.normalize(),
             ior: 1.5,
+            dispersion: 0.0,
             thickness: 0.0,
             roughness: 0.0,
         };
         assert_eq!(f.through(&r, None).x, 7.0);
+    }
+
+    #[test]
+    fn dispersion_sends_each_channel_through_its_own_index() {
+        // Every channel holds the column.
+        let color: Vec<Vec4> = frame(64, 64, |x, _| x as f32)
+            .iter()
+            .map(|c| Vec4::new(c.x, c.x, c.x, 1.0))
+            .collect();
+        let f = OpaqueFrame::new((&color, &[3.0; 64 * 64]), 64, 64, camera());
+        let left = Vec3::new(-0.6, 0.0, 0.8);
+        let plain = f.through(&on_ball(left, 0.5, 0.0, 1.5), None);
+        let mut r = on_ball(left, 0.5, 0.0, 1.5);
+        r.dispersion = 4.0;
+        let spread = f.through(&r, None);
+        // Green keeps the index; red and blue, (1.5 - 1) / 40 x 4 = 0.05
+        // below and above it, land on columns of their own.
+        assert_eq!(spread.y, plain.y);
+        let at = |ior: f32| f.through(&on_ball(left, 0.5, 0.0, ior), None);
+        assert!((spread.x - at(1.45).x).abs() < 1e-3, "{spread}");
+        assert!((spread.z - at(1.55).z).abs() < 1e-3, "{spread}");
+        assert!((spread.x - spread.z).abs() > 0.5, "{spread}");
+        // A thin wall does not bend the ray: no spread.
+        let mut thin = on_ball(left, 0.0, 0.0, 1.5);
+        thin.dispersion = 4.0;
+        let t = f.through(&thin, None);
+        assert!(t.x == t.y && t.y == t.z, "{t}");
     }
 }

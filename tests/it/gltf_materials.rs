@@ -441,7 +441,7 @@ fn ball_over_backdrop(name: &str, volume: &str) -> Vec<Vec3> {
         r#", "material": 0"#,
         &format!(
             r#""nodes": [{{"mesh": 0}}], "scenes": [{{"nodes": [0]}}], "scene": 0,
-            "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+            "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_dispersion"],
             "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0, "roughnessFactor": 0.0}},
                 "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1.0}}{volume}}}}}]"#
         ),
@@ -683,4 +683,27 @@ fn diffuse_transmission_under_an_environment_sampled_agrees_with_prefiltered() {
         (sampled - pre).abs().max_element() < 0.02,
         "sampled {sampled} against prefiltered {pre}"
     );
+}
+
+#[test]
+fn khr_materials_dispersion_bends_red_and_blue_by_their_own_indices() {
+    // Where the ball images the backdrop's red-blue edge, red (a lower
+    // index) and blue (a higher one) move each their own way; green keeps
+    // the material's index and lands where it did without dispersion.
+    let solid = r#", "KHR_materials_volume": {"thicknessFactor": 1.0}"#;
+    let plain = ball_over_backdrop("gltf_dispersion_none", solid);
+    let spread = ball_over_backdrop(
+        "gltf_dispersion",
+        &format!(r#"{solid}, "KHR_materials_dispersion": {{"dispersion": 6.0}}"#),
+    );
+    let most = |channel: fn(&Vec3) -> f32| {
+        plain
+            .iter()
+            .zip(&spread)
+            .map(|(a, b)| (channel(a) - channel(b)).abs())
+            .fold(0.0f32, f32::max)
+    };
+    assert!(most(|c| c.y) < 1e-6, "green moved by {}", most(|c| c.y));
+    assert!(most(|c| c.x) > 0.05, "red moved by {}", most(|c| c.x));
+    assert!(most(|c| c.z) > 0.05, "blue moved by {}", most(|c| c.z));
 }

@@ -145,6 +145,8 @@ pub struct GltfTransmission {
     pub attenuation_color: Vec3,
     /// +inf: no attenuation.
     pub attenuation_distance: f32,
+    /// KHR_materials_dispersion: 20 / the Abbe number (0: none).
+    pub dispersion: f32,
 }
 
 #[derive(Debug, Clone)]
@@ -743,6 +745,12 @@ pub(super) fn transmission(
             .and_then(|vv| json_tex(vv, "thicknessTexture", doc, images, warnings, path)),
         attenuation_color,
         attenuation_distance,
+        // Negative or not a number: none.
+        dispersion: m
+            .extension_value("KHR_materials_dispersion")
+            .and_then(|d| json_number(d, "dispersion"))
+            .unwrap_or(0.0)
+            .max(0.0),
     })
 }
 

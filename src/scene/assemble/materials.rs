@@ -514,6 +514,7 @@ fn gltf_material(g: &GltfMaterial, textures: &TextureLookup) -> Material {
             thickness_map: tex(&t.thickness_texture, false),
             attenuation_color: t.attenuation_color,
             attenuation_distance: t.attenuation_distance,
+            dispersion: t.dispersion,
         }),
         sheen: g.sheen.as_ref().map(|t| SheenLayer {
             color: t.color,

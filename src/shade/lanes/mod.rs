@@ -290,6 +290,7 @@ impl<'a> ShadeContext<'a> {
                             normal: if n.dot(v) < 0.0 { -n } else { n },
                             view: v,
                             ior: p.volume.1,
+                            dispersion: p.volume.2,
                             thickness: p.volume.0,
                             roughness: p.roughness,
                         };

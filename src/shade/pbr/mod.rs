@@ -97,9 +97,10 @@ pub struct PbrColor<L: Lane = f32> {
     pub transmission: L,
     /// Volume transmittance along the thickness (1: none).
     pub attenuation: V3<L>,
-    /// The volume's thickness in model units (0: thin) and index of
-    /// refraction: how far refraction moves what shows through.
-    pub volume: (L, f32),
+    /// The volume's thickness in model units (0: thin), index of
+    /// refraction and dispersion (20 / Abbe number): how far refraction
+    /// moves what shows through, per channel.
+    pub volume: (L, f32, f32),
     /// A clearcoat layer over the material.
     pub coat: Option<Coat<L>>,
     /// A sheen layer over the base (under the clearcoat).
@@ -134,7 +135,7 @@ impl<L: Lane> PbrColor<L> {
             a2: alpha * alpha,
             transmission: L::splat(0.0),
             attenuation: V3::splat(Vec3::ONE),
-            volume: (L::splat(0.0), 1.5),
+            volume: (L::splat(0.0), 1.5, 0.0),
             coat: None,
             sheen: None,
             iridescence: None,

@@ -30,7 +30,7 @@ impl<L: Lane> PbrColor<L> {
             a2: self.a2.lane(k),
             transmission: self.transmission.lane(k),
             attenuation: v(self.attenuation),
-            volume: (self.volume.0.lane(k), self.volume.1),
+            volume: (self.volume.0.lane(k), self.volume.1, self.volume.2),
             coat: self.coat.map(|c| Coat {
                 factor: c.factor.lane(k),
                 roughness: c.roughness.lane(k),
@@ -189,7 +189,7 @@ impl ShadeContext<'_> {
                 Some(_) => V3::from_fn(|k| beer(thickness.lane(k))),
             };
             c.set_transmission(factor, attenuation);
-            c.volume = (thickness, t.ior);
+            c.volume = (thickness, t.ior, t.dispersion);
         }
         if let Some(k) = &p.sheen {
             let mut color = V3::splat(k.color);
