@@ -64,22 +64,30 @@ impl<L: Lane> Aniso<L> {
     /// lobe, for n.l = `ndl` > 0 and half vector `h`.
     #[inline(always)]
     pub fn d_vis(&self, n: V3<L>, v: V3<L>, l: V3<L>, h: V3<L>, ndl: L) -> L {
-        let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let (at, ab) = (self.at, self.ab);
         let ndv = n.dot(v).abs().max(L::splat(1e-4));
-        let ndh = n.dot(h);
-        let (x, y) = (self.t.dot(h) / at, self.b.dot(h) / ab);
-        let s = x * x + y * y + ndh * ndh;
-        let d = L::select(
-            ndh.cmpgt(zero),
-            one / (L::splat(PI) * at * ab * s * s),
-            zero,
-        );
+        let d = self.d(n, h);
         let g = |c: L, w: V3<L>| {
             let (x, y) = (at * self.t.dot(w), ab * self.b.dot(w));
             c + (x * x + y * y + c * c).sqrt()
         };
         d / (g(ndl, l) * g(ndv, v))
+    }
+
+    /// GGX's D of the anisotropic lobe at half vector `h` (zero below
+    /// the surface).
+    #[inline(always)]
+    pub fn d(&self, n: V3<L>, h: V3<L>) -> L {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let (at, ab) = (self.at, self.ab);
+        let ndh = n.dot(h);
+        let (x, y) = (self.t.dot(h) / at, self.b.dot(h) / ab);
+        let s = x * x + y * y + ndh * ndh;
+        L::select(
+            ndh.cmpgt(zero),
+            one / (L::splat(PI) * at * ab * s * s),
+            zero,
+        )
     }
 
     /// The normal the environment's reflection is taken about: the normal
@@ -151,10 +159,7 @@ mod tests {
                         theta.sin() * phi.sin(),
                         theta.cos(),
                     );
-                    // D alone: d_vis over the visibility at v = l = h.
-                    let (x, y) = (a.t.dot(h.into()) / a.at, a.b.dot(h.into()) / a.ab);
-                    let s = x * x + y * y + h.z * h.z;
-                    let d = 1.0 / (PI * a.at * a.ab * s * s);
+                    let d = a.d(n, h.into());
                     let domega = theta.sin()
                         * (std::f32::consts::FRAC_PI_2 / nt as f32)
                         * (std::f32::consts::TAU / np as f32);
@@ -162,7 +167,6 @@ mod tests {
                 }
             }
             assert!((sum - 1.0).abs() < 0.01, "{angle} {strength}: {sum}");
-            let _ = n;
         }
     }
 
