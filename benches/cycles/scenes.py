@@ -118,6 +118,24 @@ def holes(size=256):
     return png(size, size, pixel)
 
 
+def bumps(size=128, n=16):
+    """A tangent-space normal map of n x n round bumps (hemispheres that
+    fill their cells): detail that sparkles under a sharp light once a bump
+    is a pixel or two on screen."""
+    cell = size / n
+
+    def pixel(x, y):
+        dx = ((x + 0.5) % cell) / cell * 2 - 1
+        dy = ((y + 0.5) % cell) / cell * 2 - 1
+        r2 = dx * dx + dy * dy
+        if r2 >= 0.81:
+            return (128, 128, 255, 255)
+        z = math.sqrt(1 - r2)
+        # Image rows run down: +v (the bitangent) is up the image.
+        return (round((dx + 1) * 127.5), round((-dy + 1) * 127.5), round((z + 1) * 127.5), 255)
+    return png(size, size, pixel)
+
+
 # --- glTF -------------------------------------------------------------------
 
 class Gltf:
@@ -221,6 +239,15 @@ def row(n, spacing):
 
 
 # --- the scenes ---------------------------------------------------------------
+
+def bumpy_metal(g):
+    """A polished metal ball covered in small bumps (a normal map repeated
+    4 x 2 times): the specular anti-aliasing case."""
+    m = g.material("bumpy", (0.95, 0.64, 0.54, 1), 1.0, 0.15,
+                   normalTexture=g.texture(bumps(), {"scale": [4.0, 2.0]}))
+    g.mesh(sphere(1.0, 96, 192), m)
+    return (0.0, 0.0, 3.4), (0.0, 0.0, 0.0), 40.0
+
 
 def clearcoat_grid(g):
     ball = sphere(0.45)
@@ -372,6 +399,7 @@ GENERATED = {
     "texture-transform": texture_transform,
     "alpha-blend-mask": alpha_modes,
     "vertex-colors": vertex_colors,
+    "bumpy-metal": bumpy_metal,
 }
 SHARED_MODELS = {
     "flighthelmet": ("gltf/FlightHelmet/FlightHelmet.gltf",

@@ -748,6 +748,7 @@ fn shade_context<'a>(
         orthographic: matches!(cam.projection, Projection::Orthographic { .. }),
         filter: s.texture_filter,
         max_anisotropy: s.max_anisotropy,
+        specular_aa: s.specular_aa,
         address: s.address,
         mips,
         depth_range: (lo, hi),

@@ -136,6 +136,9 @@ pub struct RenderSettings {
     pub texture_filter: TextureFilter,
     /// The largest anisotropy `anisotropic` filtering takes (default 16).
     pub max_anisotropy: f32,
+    /// Specular anti-aliasing: metallic-roughness lobes widened by the
+    /// normal map's change across a pixel (Tokuyoshi and Kaplanyan).
+    pub specular_aa: bool,
     /// How texture coordinates outside 0..1 wrap.
     pub address: AddressMode,
     /// Which faces are culled (`auto`: closed meshes' back faces).

@@ -127,6 +127,14 @@ pub struct LightSet<'a> {
 }
 
 impl<'a> LightSet<'a> {
+    /// Whether the set holds no light.
+    #[inline(always)]
+    pub fn is_empty(&self) -> bool {
+        let mut none = true;
+        self.for_each(|_, _| none = false);
+        none
+    }
+
     /// Calls `f(i, light)` for each light of the set, in index order.
     #[inline(always)]
     pub fn for_each(&self, mut f: impl FnMut(usize, &'a Light)) {
@@ -274,6 +282,12 @@ mod tests {
         let m = LightMask::NONE.with(1).with(3);
         assert_eq!(visit(&few, m), vec![1, 3]);
         assert!(m.has(3) && !m.has(2));
+        // Empty: no bit, or bits only past the frame's lights.
+        let set = |lights, mask| LightSet { lights, mask };
+        assert!(set(&few, LightMask::NONE).is_empty());
+        assert!(set(&few, LightMask::NONE.with(7)).is_empty());
+        assert!(set(&[], LightMask::ALL).is_empty());
+        assert!(!set(&few, m).is_empty());
         // Beyond 63 lights the rest share one bit and are never culled.
         let many: Vec<Light> = (0..70).map(|i| l(i as f32)).collect();
         assert_eq!(visit(&many, LightMask::ALL), (0..70).collect::<Vec<_>>());

@@ -33,6 +33,8 @@ pub struct ShadeContext<'a> {
     pub orthographic: bool,
     pub filter: TextureFilter,
     pub max_anisotropy: f32,
+    /// `render.specular_aa`.
+    pub specular_aa: bool,
     pub address: AddressMode,
     /// Per texture id: the mip chain (levels 1..) this frame may read, or
     /// None where the frame never minifies the texture (level 0 only).
@@ -134,6 +136,14 @@ pub(crate) trait Fetch<L: Lane> {
     /// The lanes' interpolated normals perturbed by `map`, unit.
     fn normal(&mut self, map: &NormalMap) -> V3<L>;
 
+    /// How far the normals `n` that `map` gives (`normal`) turn across
+    /// a pixel: the squared lengths of their changes one pixel's step
+    /// along u and along v, summed (0 where not measured).
+    fn normal_spread(&mut self, map: &NormalMap, n: V3<L>) -> L {
+        let _ = (map, n);
+        L::splat(0.0)
+    }
+
     /// The lanes' interpolated tangents and their bitangent signs, where
     /// the mesh has them.
     fn tangents(&self) -> Option<(V3<L>, L)> {
@@ -186,6 +196,7 @@ pub(crate) mod testing {
             orthographic: false,
             filter: TextureFilter::Trilinear,
             max_anisotropy: 16.0,
+            specular_aa: true,
             address: AddressMode::Repeat,
             mips: &[],
             depth_range: (0.0, 1.0),

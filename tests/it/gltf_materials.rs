@@ -501,17 +501,7 @@ fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
 /// y) of one material, `material` (JSON members), with extension
 /// `ext.0` whose JSON is `ext.1` (none where it is empty).
 fn write_plate(dir: &std::path::Path, file: &str, material: &str, ext: (&str, &str)) {
-    let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
-    let plate = common::Prim {
-        positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
-        normals: vec![[0.0, 0.0, 1.0]; 4],
-        uv0: corners
-            .iter()
-            .map(|c| [(c[0] + 1.0) / 2.0, (1.0 - c[1]) / 2.0])
-            .collect(),
-        indices: vec![0, 1, 2, 0, 2, 3],
-        ..Default::default()
-    };
+    let plate = common::plate();
     let (name, json) = ext;
     let extension = if json.is_empty() {
         String::new()

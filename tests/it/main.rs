@@ -13,6 +13,7 @@ mod gltf_pose;
 mod known_answers;
 mod points_lines;
 mod shadows;
+mod specular_aa;
 mod textures;
 mod widths;
 mod widths_pbr;

@@ -219,7 +219,8 @@ fn a_material_with_five_slots() {
     // sets): the lanes carry three footprints per fragment and compute
     // the others per call. The golden was the one-fragment path's frame
     // (byte-identical to the lanes'); its blended cube's triangle edges
-    // are now composited per MSAA sample.
+    // are now composited per MSAA sample, and its noisy normal map's
+    // lobes widened by specular anti-aliasing (fewer lone bright texels).
     check(
         "many_slots",
         &root().join("tests/data/many_slots/scene.toml"),

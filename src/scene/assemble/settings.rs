@@ -54,6 +54,7 @@ pub(super) fn render(d: &SceneDesc, default_look: bool) -> RenderSettings {
         shading: pick(&r.shading),
         texture_filter: pick(&r.texture_filter),
         max_anisotropy: get(&r.max_anisotropy, 16) as f32,
+        specular_aa: get(&r.specular_aa, true),
         address: pick(&r.address),
         cull: pick(&r.cull),
         max_memory: r.max_memory.as_ref().map(|m| m.get_ref().0),

@@ -21,6 +21,9 @@ pub struct RenderDesc {
     pub ssaa: Option<Spanned<i64>>,
     pub texture_filter: Option<Spanned<TextureFilter>>,
     pub max_anisotropy: Option<Spanned<i64>>,
+    /// Extension: widen metallic-roughness lobes by how much the normal
+    /// map turns across a pixel (default true).
+    pub specular_aa: Option<Spanned<bool>>,
     pub address: Option<Spanned<AddressMode>>,
     pub cull: Option<Spanned<CullMode>>,
     pub depth: Option<Spanned<DepthMode>>,

@@ -10,10 +10,14 @@ use glam::{Affine2, Mat3, Vec2, Vec4};
 
 use super::material::{LaneMaterial, Map};
 use super::{Coords, MAX_SIZES};
-use crate::assets::texture::{Taps4, TextureRef};
+use crate::assets::texture::{Footprint, Taps4, TextureRef};
 use crate::scene::material::{NormalMap, NormalSpace};
 use crate::shade::Fetch;
 use crate::simd::{Lane, Mask, V3};
+
+/// `Fetch::normal_spread`: a squared change of the unit normal above this
+/// (a turn of more than 60 degrees) in one pixel's step is a seam.
+const SEAM: f32 = 1.0;
 
 /// Texels of a lane material's maps for the lanes (`Fetch`): through
 /// `Lookups`, each distinct lookup once.
@@ -42,6 +46,53 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
 }
 
 impl<L: Lane> LaneFetch<'_, '_, '_, L> {
+    /// Red, green and blue of map `i` looked up at the lanes'
+    /// coordinates of its set moved by (`du`, `dv`) before its transform,
+    /// each lookup filtered over the lanes' footprints (`probe`: one
+    /// trilinear probe at the level of anisotropic ones).
+    fn offset_rgb(&self, i: usize, (du, dv): (L, L), probe: bool) -> V3<L> {
+        let map = &self.lm.maps[i];
+        let f = self.lookups.coords;
+        let (u, v) = f.sets[(map.source.texcoord as usize).min(1)];
+        let (u, v) = (u + du, v + dv);
+        let (u, v) = if map.source.transform == Affine2::IDENTITY {
+            (u, v)
+        } else {
+            let (m, o) = (
+                map.source.transform.matrix2,
+                map.source.transform.translation,
+            );
+            (
+                L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(o.x),
+                L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(o.y),
+            )
+        };
+        let mut rgb = [[Vec4::ZERO; 3]; 2];
+        for (q, r) in rgb.iter_mut().enumerate().take(L::QUADS) {
+            let mut fps = f.footprints4(map.slot, q);
+            if probe {
+                for fp in &mut fps {
+                    if let Footprint::Probes { lod, .. } = *fp {
+                        *fp = Footprint::Lod(lod);
+                    }
+                }
+            }
+            *r = map.chain.sample4(u.quad(q), v.quad(q), &fps, map.mode);
+        }
+        V3 {
+            x: L::from_quads(|q| rgb[q][0]),
+            y: L::from_quads(|q| rgb[q][1]),
+            z: L::from_quads(|q| rgb[q][2]),
+        }
+    }
+
+    /// The lanes' steps along u and along v (`Footprints::bump`).
+    fn steps(&self) -> (L, L) {
+        let f = self.lookups.coords;
+        let step = |axis: fn(Vec2) -> f32| L::from_fn(|k| axis(f.bump[f.first + k]));
+        (step(|s| s.x), step(|s| s.y))
+    }
+
     /// The interpolated normals bent by the bump map `t` scaled by
     /// `scale` (`ShadeContext::apply_normal_map`): the height's central
     /// differences one step (`Footprints::bump`) along u and along v,
@@ -51,38 +102,15 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
             // No coordinates or no tangents: the normal as it is.
             return self.normal;
         };
-        let map = &self.lm.maps[i];
-        let f = self.lookups.coords;
-        let (u, v) = f.sets[(t.texcoord as usize).min(1)];
-        let step = |axis: fn(Vec2) -> f32| L::from_fn(|k| axis(f.bump[f.first + k]));
-        let (su, sv) = (step(|s| s.x), step(|s| s.y));
+        let (su, sv) = self.steps();
         let zero = L::splat(0.0);
-        let height = |du: L, dv: L| {
-            let (u, v) = (u + du, v + dv);
-            let (u, v) = if map.source.transform == Affine2::IDENTITY {
-                (u, v)
-            } else {
-                let (m, o) = (
-                    map.source.transform.matrix2,
-                    map.source.transform.translation,
-                );
-                (
-                    L::splat(m.x_axis.x) * u + L::splat(m.y_axis.x) * v + L::splat(o.x),
-                    L::splat(m.x_axis.y) * u + L::splat(m.y_axis.y) * v + L::splat(o.y),
-                )
-            };
-            let mut red = [Vec4::ZERO; 2];
-            for (q, r) in red.iter_mut().enumerate().take(L::QUADS) {
-                let fps = f.footprints4(map.slot, q);
-                *r = map.chain.sample4(u.quad(q), v.quad(q), &fps, map.mode)[0];
-            }
-            L::from_quads(|q| red[q])
-        };
+        let height = |d: (L, L)| self.offset_rgb(i, d, false).x;
         let half = L::splat(0.5);
-        let du = (height(su, zero) - height(-su, zero)) * half;
+        let du = (height((su, zero)) - height((-su, zero))) * half;
         // Image rows run down; the bitangent points up the image.
-        let dv = (height(zero, -sv) - height(zero, sv)) * half;
+        let dv = (height((zero, -sv)) - height((zero, sv))) * half;
         let n = self.normal;
+        let f = self.lookups.coords;
         let (tt, b) = tangent_frame(n, (f.tangent, f.sign));
         let scale = L::splat(scale);
         (n - tt.scale(du * scale) - b.scale(dv * scale)).normalize_or(n)
@@ -136,6 +164,36 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
             z: channel(2),
         };
         Some((rgb, channel(3)))
+    }
+
+    fn normal_spread(&mut self, m: &NormalMap, n: V3<L>) -> L {
+        let zero = L::splat(0.0);
+        let NormalMap::Normals {
+            map: t,
+            scale,
+            space: NormalSpace::Tangent,
+        } = m
+        else {
+            return zero;
+        };
+        if !self.lm.spread || !self.lm.tangents {
+            return zero;
+        }
+        let Some(i) = self.lm.index_of(t) else {
+            return zero;
+        };
+        let (su, sv) = self.steps();
+        let f = self.lookups.coords;
+        let frame = (f.tangent, f.sign);
+        // The change one step along each axis; a turn of more than 60
+        // degrees in one step is taken for a step off the map's island (a
+        // seam, the edge of an atlas chart) and does not count.
+        let change = |d: (L, L)| {
+            let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, true), *scale) - n;
+            let m2 = m.dot(m);
+            L::select(m2.cmpgt(L::splat(SEAM)), zero, m2)
+        };
+        change((su, zero)) + change((zero, sv))
     }
 
     #[inline(always)]

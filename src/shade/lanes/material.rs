@@ -76,8 +76,12 @@ pub struct LaneMaterial<'a> {
     /// Some slot's sampler has filters of its own.
     samplers: bool,
     /// A bump map's coordinate set and texture size (times its
-    /// transform's scale along u and v).
+    /// transform's scale along u and v); with `spread`, the tangent-space
+    /// normal map's.
     bump: Option<(usize, Vec2)>,
+    /// Specular anti-aliasing: the normal map is looked up again one
+    /// pixel along u and along v (`Fetch::normal_spread`).
+    pub(super) spread: bool,
 }
 
 /// Where a lane material's maps of one slot are looked up: the same
@@ -197,10 +201,11 @@ impl<'a> LaneMaterial<'a> {
     pub fn footprints(&self, ctx: &ShadeContext, g: [Gradients; 2]) -> Footprints {
         let mut out = Footprints::NONE;
         if let Some((set, size)) = self.bump {
-            // As `ShadeContext::apply_normal_map` steps.
+            // A bump map's central differences step at least a texel; a
+            // normal map's spread is its change across one pixel.
             let g = g[set];
             let texels = (g.dx * size).length().max((g.dy * size).length());
-            out.bump = texels.max(1.0) / size;
+            out.bump = if self.spread { texels } else { texels.max(1.0) } / size;
         }
         if ctx.filter == Filter::Nearest {
             out.slots = [Footprint::Nearest; MAX_SIZES];
@@ -262,6 +267,15 @@ impl<'a> LaneMaterial<'a> {
     }
 }
 
+/// The coordinate set of map `t` and its texture's size times its
+/// transform's scale along u and v: what one texel is in coordinates.
+fn steps_of(t: &TextureRef) -> (usize, Vec2) {
+    let m = t.transform.matrix2;
+    let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
+        * Vec2::new(m.x_axis.length(), m.y_axis.length());
+    ((t.texcoord as usize).min(1), size)
+}
+
 /// Collects a lane material's maps, assigning each a slot by its
 /// coordinates, transform, texture size and chain. A map of a coordinate set the mesh
 /// lacks is left out: it counts as 1.
@@ -273,6 +287,9 @@ struct MapSet<'c, 'a> {
     maps: Vec<Map<'a>>,
     slots: SmallVec<[Slot; MAX_SIZES]>,
     bump: Option<(usize, Vec2)>,
+    /// Metallic-roughness with `render.specular_aa`: a tangent-space
+    /// normal map's steps are kept in `bump`.
+    spread: bool,
 }
 
 impl<'a> MapSet<'_, 'a> {
@@ -327,7 +344,9 @@ impl<'a> MapSet<'_, 'a> {
         }
     }
 
-    fn normal(&mut self, m: &'a Option<NormalMap>) {
+    /// `spread`: the steps of a tangent-space map are kept for its
+    /// spread (`LaneMaterial::spread`).
+    fn normal(&mut self, m: &'a Option<NormalMap>, spread: bool) {
         if self.ctx.mode == ShadingMode::Flat {
             // Flat shading keeps the triangles' normals: not looked up.
             return;
@@ -350,10 +369,11 @@ impl<'a> MapSet<'_, 'a> {
             _ if !self.tangents => {}
             Some(NormalMap::Height { .. }) => {
                 self.map(t);
-                let m = t.transform.matrix2;
-                let size = Vec2::new(t.texture.width as f32, t.texture.height as f32)
-                    * Vec2::new(m.x_axis.length(), m.y_axis.length());
-                self.bump = Some(((t.texcoord as usize).min(1), size));
+                self.bump = Some(steps_of(t));
+            }
+            _ if spread => {
+                self.map(t);
+                self.bump = Some(steps_of(t));
             }
             _ => self.map(t),
         }
@@ -380,7 +400,7 @@ impl<'a> MapSet<'_, 'a> {
         if let Some(k) = &p.clearcoat {
             self.optional(&k.map);
             self.optional(&k.roughness_map);
-            self.normal(&k.normal_map);
+            self.normal(&k.normal_map, false);
         }
         if let Some(t) = &p.transmission {
             self.optional(&t.map);
@@ -401,7 +421,7 @@ impl<'a> MapSet<'_, 'a> {
             self.optional(&k.map);
             self.optional(&k.color_map);
         }
-        self.normal(&m.normal_map)
+        self.normal(&m.normal_map, self.spread)
     }
 
     /// The maps a Blinn-Phong material's shading reads, in the order it
@@ -410,7 +430,7 @@ impl<'a> MapSet<'_, 'a> {
         for t in [&m.map_kd, &m.map_ka, &m.map_ks, &m.map_ke, &m.map_ns] {
             self.optional(t);
         }
-        self.normal(&m.normal_map)
+        self.normal(&m.normal_map, false)
     }
 }
 
@@ -473,6 +493,7 @@ impl<'a> LaneMaterial<'a> {
             maps: Vec::new(),
             slots: SmallVec::new(),
             bump: None,
+            spread: kind == LaneShading::Pbr && ctx.specular_aa,
         };
         match kind {
             LaneShading::BlinnPhong | LaneShading::Gouraud => maps.blinn_phong(m),
@@ -480,7 +501,7 @@ impl<'a> LaneMaterial<'a> {
             LaneShading::Emitted if m.native != Native::Pbr => maps.blinn_phong(m),
             LaneShading::Pbr | LaneShading::Unlit | LaneShading::Emitted => maps.pbr(m),
             LaneShading::Albedo { pbr: true } => maps.pbr(m),
-            LaneShading::Normals => maps.normal(&m.normal_map),
+            LaneShading::Normals => maps.normal(&m.normal_map, false),
             LaneShading::Depth | LaneShading::Wireframe => {}
         }
         // A blended surface's opacity reads these too (`opacity`).
@@ -508,6 +529,7 @@ impl<'a> LaneMaterial<'a> {
                 .iter()
                 .any(|s| s.mag_nearest || s.min_limit.is_some()),
             bump: maps.bump,
+            spread: maps.spread && maps.bump.is_some(),
             slots: maps.slots,
         }
     }

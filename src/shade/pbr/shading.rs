@@ -262,7 +262,15 @@ impl ShadeContext<'_> {
         let mut c = *c;
         let v = self.view_lanes(f.position);
         let n = match &m.normal_map {
-            Some(map) => fetch.normal(map),
+            Some(map) => {
+                let n = fetch.normal(map);
+                // The widened lobe is the lights' and the sampled
+                // environment's: without either, not measured at all.
+                if self.env_sampled.is_some() || !f.light_set(self.lights).is_empty() {
+                    c.widen(fetch.normal_spread(map, n));
+                }
+                n
+            }
             None => f.normal,
         };
         if let Some(a) = &mut c.aniso {

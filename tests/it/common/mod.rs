@@ -103,6 +103,22 @@ pub struct Prim {
     pub indices: Vec<u32>,
 }
 
+/// A 2 x 2 square at z = 0 facing +Z, its texture coordinates 0..1 with
+/// u along +x and v down the image (v = 0 at the top, y = 1).
+pub fn plate() -> Prim {
+    let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+    Prim {
+        positions: corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
+        normals: vec![[0.0, 0.0, 1.0]; 4],
+        uv0: corners
+            .iter()
+            .map(|c| [(c[0] + 1.0) / 2.0, (1.0 - c[1]) / 2.0])
+            .collect(),
+        indices: vec![0, 1, 2, 0, 2, 3],
+        ..Default::default()
+    }
+}
+
 /// The binary buffer of `p` and its "accessors"/"bufferViews" JSON and
 /// the primitive's "attributes"/"indices" JSON.
 fn gltf_parts(p: &Prim) -> (Vec<u8>, String, String) {
