@@ -314,6 +314,18 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
             "render.max_anisotropy has no effect: render.texture_filter is not anisotropic",
         );
     }
+    if s.specular_aa
+        && !matches!(
+            s.texture_filter,
+            TextureFilter::Trilinear | TextureFilter::Anisotropic
+        )
+    {
+        // Without footprints there is no pixel's step to look up.
+        warn(
+            r.specular_aa.as_ref().map(|v| v.span()),
+            "render.specular_aa has no effect: render.texture_filter is not trilinear or anisotropic",
+        );
+    }
     if s.ao.method == AoMethod::Off
         && let Some(ao) = &r.ao
         && (ao.get_ref().radius.is_some() || ao.get_ref().samples.is_some())
