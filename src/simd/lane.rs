@@ -352,6 +352,13 @@ mod f8 {
         }
     }
 
+    impl From<__m256> for F8 {
+        #[inline(always)]
+        fn from(v: __m256) -> F8 {
+            F8(v)
+        }
+    }
+
     impl Lane for F8 {
         type Mask = M8;
         const WIDTH: usize = 8;

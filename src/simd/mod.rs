@@ -161,29 +161,91 @@ pub fn block_steps4(x: [u32; 4], y: [u32; 4], blocks_x: [u32; 4]) -> [[u32; 4]; 
     out
 }
 
-/// Byte `shift / 8` of each of four words, as `byte as f32 * (1.0 /
-/// 255.0)` (an RGBA8 texel's channel as a data value).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub fn unit_bytes4(t: [u32; 4], shift: u32) -> Vec4 {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 only (in every x86-64 target's base features); no
-    // memory is touched.
-    unsafe {
-        let v = _mm_set_epi32(t[3] as i32, t[2] as i32, t[1] as i32, t[0] as i32);
-        let v = _mm_and_si128(
-            _mm_srl_epi32(v, _mm_cvtsi32_si128(shift as i32)),
-            _mm_set1_epi32(0xff),
-        );
-        Vec4::from(_mm_mul_ps(_mm_cvtepi32_ps(v), _mm_set1_ps(1.0 / 255.0)))
+/// Eight words (stored RGBA8 texels), `lo` in lanes 0-3 and `hi` in
+/// lanes 4-7, held in one AVX2 register where the build has it: their
+/// bytes are taken out channel by channel without going through memory
+/// again.
+#[derive(Clone, Copy)]
+pub struct Words8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    v: std::arch::x86_64::__m256i,
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    v: ([u32; 4], [u32; 4]),
+}
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+impl Words8 {
+    #[inline(always)]
+    pub fn new(lo: [u32; 4], hi: [u32; 4]) -> Words8 {
+        use std::arch::x86_64::*;
+        // SAFETY: AVX2 is enabled for the build (the cfg above); no
+        // memory is touched.
+        let v = unsafe {
+            _mm256_set_m128i(
+                _mm_set_epi32(hi[3] as i32, hi[2] as i32, hi[1] as i32, hi[0] as i32),
+                _mm_set_epi32(lo[3] as i32, lo[2] as i32, lo[1] as i32, lo[0] as i32),
+            )
+        };
+        Words8 { v }
+    }
+
+    /// Byte `shift / 8` of each word, 0..=255.
+    #[inline(always)]
+    fn byte(self, shift: u32) -> std::arch::x86_64::__m256i {
+        use std::arch::x86_64::*;
+        // SAFETY: as in `new`.
+        unsafe {
+            _mm256_and_si256(
+                _mm256_srl_epi32(self.v, _mm_cvtsi32_si128(shift as i32)),
+                _mm256_set1_epi32(0xff),
+            )
+        }
+    }
+
+    /// Byte `shift / 8` of each word as `byte as f32`.
+    #[inline(always)]
+    pub fn bytes(self, shift: u32) -> F8 {
+        // SAFETY: as in `new`.
+        F8::from(unsafe { std::arch::x86_64::_mm256_cvtepi32_ps(self.byte(shift)) })
+    }
+
+    /// `table[b]` for byte `shift / 8` of each word: one gather.
+    #[inline(always)]
+    pub fn lookup(self, table: &[f32; 256], shift: u32) -> F8 {
+        // SAFETY: as in `new`; every index is masked to 0..=255, inside
+        // the table's 256 entries.
+        F8::from(unsafe {
+            std::arch::x86_64::_mm256_i32gather_ps::<4>(table.as_ptr(), self.byte(shift))
+        })
     }
 }
 
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-pub fn unit_bytes4(t: [u32; 4], shift: u32) -> Vec4 {
-    let at = |k: usize| ((t[k] >> shift) & 0xff) as f32;
-    Vec4::new(at(0), at(1), at(2), at(3)) * Vec4::splat(1.0 / 255.0)
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+impl Words8 {
+    #[inline(always)]
+    pub fn new(lo: [u32; 4], hi: [u32; 4]) -> Words8 {
+        Words8 { v: (lo, hi) }
+    }
+
+    /// Byte `shift / 8` of each word as `byte as f32`.
+    #[inline(always)]
+    pub fn bytes(self, shift: u32) -> F8 {
+        let at = |t: [u32; 4], k: usize| ((t[k] >> shift) & 0xff) as f32;
+        F8::from_quads(|q| {
+            let t = if q == 0 { self.v.0 } else { self.v.1 };
+            lanes4(at(t, 0), at(t, 1), at(t, 2), at(t, 3))
+        })
+    }
+
+    /// `table[b]` for byte `shift / 8` of each word.
+    #[inline(always)]
+    pub fn lookup(self, table: &[f32; 256], shift: u32) -> F8 {
+        let at = |t: [u32; 4], k: usize| table[((t[k] >> shift) & 0xff) as usize];
+        F8::from_quads(|q| {
+            let t = if q == 0 { self.v.0 } else { self.v.1 };
+            lanes4(at(t, 0), at(t, 1), at(t, 2), at(t, 3))
+        })
+    }
 }
 
 /// Whole numbers below which `ramp4` holds (2^51).
@@ -545,11 +607,16 @@ mod tests {
             [0, 1, 7, 16_777_215]
         );
         let t = [0x0403_0201, 0xff00_80fe, 0, u32::MAX];
+        let squares: [f32; 256] = std::array::from_fn(|i| (i * i) as f32);
         for shift in [0, 8, 16, 24] {
-            let v = unit_bytes4(t, shift);
+            let w = Words8::new(t, [t[3], t[2], t[1], t[0]]);
+            let (bytes, table) = (w.bytes(shift), w.lookup(&squares, shift));
             for k in 0..4 {
                 let b = ((t[k] >> shift) & 0xff) as f32;
-                assert_eq!(v[k].to_bits(), (b * (1.0 / 255.0)).to_bits());
+                for lane in [k, 7 - k] {
+                    assert_eq!(bytes.lane(lane).to_bits(), b.to_bits());
+                    assert_eq!(table.lane(lane), b * b);
+                }
             }
         }
     }

@@ -23,7 +23,7 @@ use super::{ALPHA_TABLE, Footprint, Level, Texture, Wrap};
 use smallvec::SmallVec;
 
 use crate::color::srgb_to_linear_table;
-use crate::simd::{block_steps4, lanes4, unit_bytes4, whole4};
+use crate::simd::{F8, Lane, Words8, block_steps4, lanes4, whole4};
 
 /// Red, green and blue of four lookups, one lane each.
 pub type Rgb4 = [Vec4; 3];
@@ -340,37 +340,34 @@ impl<'t> Chain<'t> {
         }
         let (fx, fy) = (place.fx, place.fy);
         let (gx, gy) = (Vec4::ONE - fx, Vec4::ONE - fy);
+        // The corners go in pairs, eight lanes at once: top-left with
+        // bottom-left, top-right with bottom-right, so that one blend
+        // along x gives the top row's values in lanes 0-3 and the bottom
+        // row's in lanes 4-7.
+        let (gx2, fx2) = (F8::from_quads(|_| gx), F8::from_quads(|_| fx));
         let mut out = [Vec4::ZERO; N];
-        // Channel by channel: its four corners decoded (`Texture::decode`),
-        // then blended.
-        if self.texture.srgb {
-            for (ch, o) in out.iter_mut().enumerate() {
+        // Channel by channel: its four corners decoded
+        // (`Texture::decode`), then blended, a (1 - f) + b f.
+        let (left, right) = (
+            Words8::new(texels[0], texels[2]),
+            Words8::new(texels[1], texels[3]),
+        );
+        for (ch, o) in out.iter_mut().enumerate() {
+            let shift = 8 * ch as u32;
+            let (left, right) = if self.texture.srgb {
                 // Color through the sRGB table, alpha as it is stored.
                 let lut = if ch < 3 {
                     srgb_to_linear_table()
                 } else {
                     &ALPHA_TABLE
                 };
-                let shift = 8 * ch as u32;
-                let a = srgb_channel4(lut, &texels[0], shift, place.live);
-                let b = srgb_channel4(lut, &texels[1], shift, place.live);
-                let c = srgb_channel4(lut, &texels[2], shift, place.live);
-                let d = srgb_channel4(lut, &texels[3], shift, place.live);
-                let top = a * gx + b * fx;
-                let bottom = c * gx + d * fx;
-                *o = top * gy + bottom * fy;
-            }
-        } else {
-            for (ch, o) in out.iter_mut().enumerate() {
-                let shift = 8 * ch as u32;
-                let a = unit_bytes4(texels[0], shift);
-                let b = unit_bytes4(texels[1], shift);
-                let c = unit_bytes4(texels[2], shift);
-                let d = unit_bytes4(texels[3], shift);
-                let top = a * gx + b * fx;
-                let bottom = c * gx + d * fx;
-                *o = top * gy + bottom * fy;
-            }
+                (left.lookup(lut, shift), right.lookup(lut, shift))
+            } else {
+                let unit = F8::splat(1.0 / 255.0);
+                (left.bytes(shift) * unit, right.bytes(shift) * unit)
+            };
+            let rows = left * gx2 + right * fx2;
+            *o = rows.quad(0) * gy + rows.quad(1) * fy;
         }
         let wrapped = place.live & !place.inside;
         if wrapped != 0 {
@@ -561,17 +558,6 @@ fn prefetch_texel(t: &[u32], i: usize) {
 fn blend<const N: usize>(a: [Vec4; N], b: [Vec4; N], f: Vec4) -> [Vec4; N] {
     let g = Vec4::ONE - f;
     std::array::from_fn(|c| a[c] * g + b[c] * f)
-}
-
-/// Channel `shift / 8` of four stored sRGB texels (one per lane),
-/// linear: the decoding table's values.
-#[inline(always)]
-fn srgb_channel4(lut: &[f32; 256], t: &[u32; 4], shift: u32, live: u32) -> Vec4 {
-    let at = |k: usize| lut[((t[k] >> shift) & 0xff) as usize];
-    if live == 0b0001 {
-        return Vec4::splat(at(0));
-    }
-    lanes4(at(0), at(1), at(2), at(3))
 }
 
 #[cfg(test)]
