@@ -107,6 +107,50 @@ fn anisotropy<L: Lane>(
     Aniso::new(dir, clamp01(strength), roughness)
 }
 
+/// The lanes' triangle normals, each on the side of the view direction
+/// `v`.
+fn geometric_towards<L: Lane>(f: &Lanes<L>, v: V3<L>) -> V3<L> {
+    let ng = V3::from_fn(|k| f.geo_normal[k]);
+    let toward = ng.dot(v).cmpge(L::splat(0.0));
+    V3::select(toward, ng, -ng)
+}
+
+/// The shading normal `n` turned towards the geometric normal `ng` (on
+/// the viewer's side) just far enough that the mirror reflection of the
+/// view direction `v` stays above the surface: at least min(0.9 v.ng,
+/// 0.01) above its plane. A normal map can tilt `n` so far that the
+/// reflection points into the surface, where it would fetch light from
+/// below the horizon; Blender Cycles raises the normal of its glossy
+/// lobes this way, and so does softraster for every lobe of a
+/// normal-mapped metallic-roughness material (`docs/cycles.md`: the
+/// bumpy ball's bright rims). Interpolated normals are left as they are:
+/// raising them changed no frame of the Cycles set.
+///
+/// In the plane of `ng` (z) and the part of `n` across it (x), the
+/// raised normal (sqrt(1 - z^2), z) reflects `v` to height t where
+/// 4 a z^4 - 2 b z^2 + c = 0, a = vx^2 + vz^2, b = 2 (a + vz t),
+/// c = (vz + t)^2; of its roots the one with the sign of vx is taken.
+pub(crate) fn valid_reflection<L: Lane>(ng: V3<L>, v: V3<L>, n: V3<L>) -> V3<L> {
+    let zero = L::splat(0.0);
+    let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
+    let vz = v.dot(ng).max(zero);
+    let t = (L::splat(0.9) * vz).min(L::splat(0.01));
+    let low = r.dot(ng).cmplt(t);
+    if !low.any() {
+        return n;
+    }
+    let x = (n - ng.scale(n.dot(ng))).normalize_or(n);
+    let vx = v.dot(x);
+    let a = vx * vx + vz * vz;
+    let b = L::splat(2.0) * (a + vz * t);
+    let c = (t + vz) * (t + vz);
+    let root = (b * b - L::splat(4.0) * a * c).max(zero).sqrt();
+    let z2 = L::select(vx.cmplt(zero), b + root, b - root) * L::splat(0.25) / a;
+    let z2 = clamp01(z2);
+    let raised = x.scale((L::splat(1.0) - z2).sqrt()) + ng.scale(z2.sqrt());
+    V3::select(low, raised, n)
+}
+
 impl ShadeContext<'_> {
     /// The material's metallic-roughness factors times its maps (and the
     /// vertex colour) at the lanes' points.
@@ -263,7 +307,9 @@ impl ShadeContext<'_> {
         let v = self.view_lanes(f.position);
         let n = match &m.normal_map {
             Some(map) => {
-                let n = fetch.normal(map);
+                // Tilted by the map, the normal may reflect the view
+                // into the surface: raised as a path tracer raises it.
+                let n = valid_reflection(geometric_towards(f, v), v, fetch.normal(map));
                 // The widened lobe is the lights' and the sampled
                 // environment's: without either, not measured at all.
                 if self.env_sampled.is_some() || !f.light_set(self.lights).is_empty() {
@@ -400,5 +446,49 @@ impl ShadeContext<'_> {
             }
         }
         under + direct
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec4;
+
+    #[test]
+    fn a_reflection_into_the_surface_is_raised_to_the_threshold() {
+        let ng = Vec3::Z;
+        let v = Vec3::new(0.8, 0.0, 0.6);
+        // Tilted so far from the viewer that v reflects into the surface.
+        let n = Vec3::new(-0.7, 0.0, 0.714_142_8).normalize();
+        let r = 2.0 * n.dot(v) * n - v;
+        assert!(r.z < 0.0);
+        let raised: Vec3 = valid_reflection(V3::from(ng), V3::from(v), V3::from(n)).into();
+        let r = 2.0 * raised.dot(v) * raised - v;
+        assert!((raised.length() - 1.0).abs() < 1e-5);
+        assert!((r.z - 0.01).abs() < 1e-4, "{r}");
+        // Raised in the plane of n and ng, towards ng.
+        assert!(raised.y.abs() < 1e-6 && raised.z > n.z && raised.x < 0.0);
+        // Seen from the other side (vx < 0): the other root.
+        let v2 = Vec3::new(-0.8, 0.0, 0.6);
+        let n2 = Vec3::new(0.7, 0.0, 0.714_142_8).normalize();
+        let raised2: Vec3 = valid_reflection(V3::from(ng), V3::from(v2), V3::from(n2)).into();
+        assert!((raised2 - Vec3::new(-raised.x, 0.0, raised.z)).length() < 1e-5);
+    }
+
+    #[test]
+    fn a_valid_reflection_keeps_its_normal_and_lanes_agree() {
+        let ng = Vec3::Z;
+        let v = Vec3::new(0.0, 0.6, 0.8);
+        let n = Vec3::new(0.1, 0.2, 0.97).normalize();
+        let same: Vec3 = valid_reflection(V3::from(ng), V3::from(v), V3::from(n)).into();
+        assert_eq!(same, n);
+        // A lane that is raised and one that is not, at widths 1 and 4.
+        let bent = Vec3::new(0.0, -0.8, 0.6);
+        let ns = [n, bent, n, bent];
+        let four = valid_reflection::<Vec4>(V3::splat(ng), V3::splat(v), V3::from_lanes(ns));
+        for (k, nk) in ns.iter().enumerate() {
+            let one: Vec3 = valid_reflection(V3::from(ng), V3::from(v), V3::from(*nk)).into();
+            assert_eq!(four.lane(k), one);
+        }
     }
 }
