@@ -30,6 +30,7 @@ mod backdrop;
 mod band;
 pub mod display;
 mod draw_list;
+mod emitters;
 mod env_cache;
 mod exposure;
 mod fragment;
@@ -69,7 +70,8 @@ use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter}
 use crate::scene::{Light, Scene};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
-use crate::shade::env::sampled::EnvSampler;
+use crate::shade::env::emitters::Emitters;
+use crate::shade::env::sampled::{EnvSampler, Sampled};
 use crate::shade::refraction::{self, OpaqueFrame};
 use crate::shade::shadow::Shadows;
 use crate::shade::{ShadeContext, gouraud};
@@ -510,8 +512,19 @@ impl<'s> Renderer<'s> {
         let geo = geometry::setup_and_bin(setup, &verts, vp, filtered);
         let mips = self.frame_mips(setup, &geo);
 
+        let emitters = match sampled {
+            Some(_) => emitters::emitters(setup, &verts),
+            None => Emitters::default(),
+        };
         let mut ctx = shade_context(setup, &mips, &shadows, env);
-        ctx.env_sampled = sampled.zip(tracer.as_ref()).map(|((e, n), t)| (e, t, n));
+        ctx.env_sampled = sampled
+            .zip(tracer.as_ref())
+            .map(|((env, samples), tracer)| Sampled {
+                env,
+                tracer,
+                emitters: &emitters,
+                samples,
+            });
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let mut data = fragment::BandInputs::new(

@@ -186,7 +186,7 @@ impl ShadeContext<'_> {
         };
         let zero = L::splat(0.0);
         let roughness = c.ns.map(roughness_from_ns);
-        if let Some((e, tracer, samples)) = self.env_sampled {
+        if let Some(sampled) = &self.env_sampled {
             return V3::from_fn(|k| {
                 let lobes = Lobes::BlinnPhong {
                     kd: c.kd.lane(k),
@@ -194,7 +194,7 @@ impl ShadeContext<'_> {
                     roughness: roughness.lane(k),
                 };
                 let point = (f.position.lane(k), n.lane(k), f.geo_normal[k]);
-                env_sampled::radiance(e, tracer, point, v.lane(k), &lobes, samples)
+                env_sampled::radiance(sampled, point, v.lane(k), &lobes)
             });
         }
         let diffuse = (c.kd * env.irradiance_lanes(n)).scale(f.ao / L::splat(PI));

@@ -45,13 +45,10 @@ pub struct ShadeContext<'a> {
     pub shadows: &'a shadow::Shadows<'a>,
     /// Image-based lighting, when the scene has an environment.
     pub env: Option<&'a env::EnvLight>,
-    /// `method = "sampled"`: the environment's sampler, the frame's rays and
-    /// the sample count; replaces the prefiltered light of `env`.
-    pub env_sampled: Option<(
-        &'a env::sampled::EnvSampler,
-        &'a crate::raytrace::Tracer<'a>,
-        u32,
-    )>,
+    /// `method = "sampled"`: the environment's sampler, the frame's rays,
+    /// its emissive triangles and the sample count; replaces the
+    /// prefiltered light of `env`.
+    pub env_sampled: Option<env::sampled::Sampled<'a>>,
     /// Rendered pixels per output pixel along an axis (the supersampling
     /// factor): wireframe lines keep their width in output pixels.
     pub pixel_scale: f32,

@@ -5,6 +5,7 @@
 mod common;
 
 mod display;
+mod emitters;
 mod framing;
 mod gltf;
 mod gltf_animation;

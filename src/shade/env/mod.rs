@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use crate::assets::environment::EnvImage;
 
+pub mod emitters;
 mod octahedral;
 pub mod sampled;
 

@@ -15,6 +15,7 @@ use std::f32::consts::PI;
 
 use glam::{Mat3, Vec2, Vec3};
 
+use super::emitters::{EmitterPoint, Emitters};
 use super::{direction_to_uv, uv_to_direction};
 use crate::assets::environment::EnvImage;
 use crate::raytrace::Tracer;
@@ -370,25 +371,32 @@ fn f_cos(lobes: &Lobes, n: Vec3, v: Vec3, a: f32, l: Vec3) -> Vec3 {
     }
 }
 
+/// What `method = "sampled"` lights a frame with: the environment's
+/// sampler, the frame's rays, its emissive triangles and the sample
+/// count.
+#[derive(Clone, Copy)]
+pub struct Sampled<'a> {
+    pub env: &'a EnvSampler,
+    pub tracer: &'a Tracer<'a>,
+    pub emitters: &'a Emitters,
+    pub samples: u32,
+}
+
 /// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
 /// `ng` for the rays' offset) from the environment, `samples` pairs of
-/// directions, with visibility through `tracer`.
-pub fn radiance(
-    env: &EnvSampler,
-    tracer: &Tracer,
-    (p, n, ng): (Vec3, Vec3, Vec3),
-    v: Vec3,
-    lobes: &Lobes,
-    samples: u32,
-) -> Vec3 {
+/// directions, and from the emissive triangles, `samples` points drawn
+/// on them, with visibility through the frame's rays.
+pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lobes) -> Vec3 {
+    let (env, tracer, samples) = (s.env, s.tracer, s.samples);
     let mix = Mixture::new(n, v, lobes);
     let f_cos = |l: Vec3| f_cos(lobes, n, v, mix.a, l);
     // Rays towards the front leave off the front; those of a diffuse
     // transmission, behind the surface, off the back.
-    let visible = |l: Vec3| {
+    let start = |l: Vec3| {
         let off = if n.dot(l) < 0.0 { -ng } else { ng };
-        !tracer.occluded(p + off * tracer.epsilon, l, f32::INFINITY)
+        p + off * tracer.epsilon
     };
+    let visible = |l: Vec3| !tracer.occluded(start(l), l, f32::INFINITY);
     let shift = position_hash(p);
     let mut sum = Vec3::ZERO;
     for i in 0..samples {
@@ -408,6 +416,37 @@ pub fn radiance(
             let pb = mix.pdf(l);
             sum += fc * env.radiance(l) / (env.pdf(l) + pb).max(1e-12);
         }
+        // From the emitters (the rays above that reach one count as
+        // blocked: each emitter is counted here alone).
+        if let Some(q) = s.emitters.sample(point(i, samples, shift * 0.5 + 0.25)) {
+            sum += from_emitter(&q, p, &f_cos, |l, d| {
+                !tracer.occluded(start(l), l, d - 2.0 * tracer.epsilon)
+            });
+        }
     }
     sum / samples as f32
+}
+
+/// The light point `q` sends towards `p` as the lobe `f_cos` takes it:
+/// f cos L cos_q / (d^2 pdf_area), where `visible(l, d)` (the unit
+/// direction and the distance to `q`); zero where it is hidden.
+fn from_emitter(
+    q: &EmitterPoint,
+    p: Vec3,
+    f_cos: &impl Fn(Vec3) -> Vec3,
+    visible: impl Fn(Vec3, f32) -> bool,
+) -> Vec3 {
+    let to = q.at - p;
+    let d2 = to.length_squared();
+    if d2 <= 0.0 || !d2.is_finite() {
+        return Vec3::ZERO;
+    }
+    let d = d2.sqrt();
+    let l = to / d;
+    let cos_q = q.normal.dot(l).abs();
+    let fc = f_cos(l);
+    if cos_q <= 0.0 || fc == Vec3::ZERO || !visible(l, d) {
+        return Vec3::ZERO;
+    }
+    fc * q.radiance * (cos_q / (d2 * q.pdf_area))
 }

@@ -332,11 +332,11 @@ impl ShadeContext<'_> {
         } else {
             self.radiance(f, [n, v], &c)
         };
-        if let Some((e, tracer, samples)) = self.env_sampled {
+        if let Some(sampled) = &self.env_sampled {
             let l = V3::from_fn(|k| {
                 let point = (f.position.lane(k), n.lane(k), f.geo_normal[k]);
                 let lobes = Lobes::Pbr(&c.at(k));
-                env_sampled::radiance(e, tracer, point, v.lane(k), &lobes, samples)
+                env_sampled::radiance(sampled, point, v.lane(k), &lobes)
             });
             return direct + l.scale(c.occlusion);
         }
