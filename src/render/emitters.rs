@@ -6,14 +6,17 @@ use glam::{Vec3, Vec4};
 use super::draw_list::DrawList;
 use super::vertex::ModelVertices;
 use crate::assets::texture::TextureRef;
-use crate::scene::material::{Material, Native};
+use crate::scene::material::Material;
+use crate::scene::settings::ShadingMode;
 use crate::shade::env::emitters::Emitters;
+use crate::shade::shades_pbr;
 
 /// Every triangle whose material emits, at this frame's vertex positions.
 pub(super) fn emitters(setup: &DrawList, verts: &[ModelVertices]) -> Emitters {
+    let mode = setup.scene.settings.shading;
     let mut triangles = Vec::new();
     for (model, mv) in setup.scene.models.iter().zip(verts) {
-        let emitted: Vec<Vec3> = model.materials.iter().map(emitted).collect();
+        let emitted: Vec<Vec3> = model.materials.iter().map(|m| emitted(mode, m)).collect();
         for g in &model.mesh.groups {
             let Some(&radiance) = emitted.get(g.material).filter(|e| **e != Vec3::ZERO) else {
                 continue;
@@ -30,12 +33,18 @@ pub(super) fn emitters(setup: &DrawList, verts: &[ModelVertices]) -> Emitters {
     Emitters::new(triangles)
 }
 
-/// The radiance a material emits, as it is shaded (metallic-roughness:
-/// `emissive`, Blinn-Phong: `Ke`), times its emission map's mean colour.
-fn emitted(m: &Material) -> Vec3 {
-    let (color, map) = match m.native {
-        Native::Pbr => (m.pbr.emissive, &m.pbr.emissive_map),
-        Native::BlinnPhong => (m.ke, &m.map_ke),
+/// The radiance a material emits as shading mode `mode` shades it
+/// (metallic-roughness: `emissive`, Blinn-Phong: `Ke`), times its emission
+/// map's mean colour; nothing for an unlit material, which shows its base
+/// colour alone.
+fn emitted(mode: ShadingMode, m: &Material) -> Vec3 {
+    if m.unlit {
+        return Vec3::ZERO;
+    }
+    let (color, map) = if shades_pbr(mode, m) {
+        (m.pbr.emissive, &m.pbr.emissive_map)
+    } else {
+        (m.ke, &m.map_ke)
     };
     match map {
         Some(t) if color != Vec3::ZERO => color * mean_color(t),

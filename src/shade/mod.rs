@@ -58,6 +58,16 @@ pub struct ShadeContext<'a> {
     pub refraction: std::sync::OnceLock<refraction::OpaqueFrame>,
 }
 
+/// Whether shading mode `mode` shades a point of `m` with
+/// metallic-roughness.
+pub(crate) fn shades_pbr(mode: ShadingMode, m: &Material) -> bool {
+    match mode {
+        ShadingMode::Pbr => true,
+        ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
+        _ => false,
+    }
+}
+
 impl ShadeContext<'_> {
     /// Unit vector from `p` towards the eye.
     #[inline]
@@ -71,11 +81,7 @@ impl ShadeContext<'_> {
 
     /// Whether a point of `m` is shaded with metallic-roughness.
     pub(crate) fn shades_pbr(&self, m: &Material) -> bool {
-        match self.mode {
-            ShadingMode::Pbr => true,
-            ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
-            _ => false,
-        }
+        shades_pbr(self.mode, m)
     }
 
     /// Opacity of material `m` at a point with texture coordinates `uv`

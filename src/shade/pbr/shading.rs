@@ -135,13 +135,15 @@ pub(crate) fn valid_reflection<L: Lane>(ng: V3<L>, v: V3<L>, n: V3<L>) -> V3<L> 
     let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
     let vz = v.dot(ng).max(zero);
     let t = (L::splat(0.9) * vz).min(L::splat(0.01));
-    let low = r.dot(ng).cmplt(t);
-    if !low.any() {
-        return n;
-    }
     let x = (n - ng.scale(n.dot(ng))).normalize_or(n);
     let vx = v.dot(x);
     let a = vx * vx + vz * vz;
+    // (A view along the surface, across the tilt, has a = 0: no raised
+    // normal is defined there, and it is left as it is.)
+    let low = r.dot(ng).cmplt(t) & a.cmpgt(L::splat(1e-12));
+    if !low.any() {
+        return n;
+    }
     let b = L::splat(2.0) * (a + vz * t);
     let c = (t + vz) * (t + vz);
     let root = (b * b - L::splat(4.0) * a * c).max(zero).sqrt();
@@ -307,15 +309,16 @@ impl ShadeContext<'_> {
         let v = self.view_lanes(f.position);
         let n = match &m.normal_map {
             Some(map) => {
-                // Tilted by the map, the normal may reflect the view
-                // into the surface: raised as a path tracer raises it.
-                let n = valid_reflection(geometric_towards(f, v), v, fetch.normal(map));
+                let mapped = fetch.normal(map);
                 // The widened lobe is the lights' and the sampled
                 // environment's: without either, not measured at all.
+                // The spread is the map's own, before any raising.
                 if self.env_sampled.is_some() || !f.light_set(self.lights).is_empty() {
-                    c.widen(fetch.normal_spread(map, n));
+                    c.widen(fetch.normal_spread(map, mapped));
                 }
-                n
+                // Tilted by the map, the normal may reflect the view
+                // into the surface: raised as a path tracer raises it.
+                valid_reflection(geometric_towards(f, v), v, mapped)
             }
             None => f.normal,
         };
@@ -468,6 +471,10 @@ mod tests {
         assert!((r.z - 0.01).abs() < 1e-4, "{r}");
         // Raised in the plane of n and ng, towards ng.
         assert!(raised.y.abs() < 1e-6 && raised.z > n.z && raised.x < 0.0);
+        // A view along the surface, across the tilt: left as it is.
+        let along = Vec3::Y;
+        let kept: Vec3 = valid_reflection(V3::from(ng), V3::from(along), V3::from(n)).into();
+        assert_eq!(kept, n);
         // Seen from the other side (vx < 0): the other root.
         let v2 = Vec3::new(-0.8, 0.0, 0.6);
         let n2 = Vec3::new(0.7, 0.0, 0.714_142_8).normalize();
