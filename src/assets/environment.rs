@@ -20,6 +20,31 @@ pub struct EnvImage {
     pub texels: Vec<Vec3>,
 }
 
+/// A bright region taken out of an image (`EnvImage::extract_sun`,
+/// `extract_lights`) as a directional light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TakenLight {
+    /// The unit vector its light travels along (environment space).
+    pub direction: Vec3,
+    /// Irradiance (RGB) on a surface facing it: what the texels lost.
+    pub irradiance: Vec3,
+    /// Angular radius in radians of a uniform disc with the same spread.
+    pub angle: f32,
+}
+
+/// A light's peak (4x4 box) is at least this many times the image's mean.
+const PEAK_OVER_MEAN: f32 = 20.0;
+/// `extract_lights`: the level, as a fraction of the peak, texels are
+/// lowered to.
+const LIGHT_LEVEL: f32 = 0.02;
+/// `extract_lights`: the half angle in degrees of the cone a light is
+/// taken from.
+const LIGHT_CONE: f32 = 12.0;
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
 impl EnvImage {
     /// Reads an `.hdr` or `.exr` environment. A file that is not 2:1, has
     /// fewer than 8 rows, or holds negative or non-finite radiance is
@@ -139,62 +164,116 @@ impl EnvImage {
     /// Takes the sun out of the image: the texels within 8 degrees of the
     /// brightest one (on a 4x smaller copy) that are brighter than a
     /// quarter of it are lowered to that quarter, and what they lose is
-    /// returned as a directional light: the unit direction it travels
-    /// along (environment space) and its irradiance (RGB). None for an
-    /// image without a clear peak (its peak under 20 times the mean).
-    pub fn extract_sun(&mut self) -> Option<(Vec3, Vec3)> {
+    /// returned as a directional light. None for an image without a clear
+    /// peak (its peak under 20 times the mean).
+    pub fn extract_sun(&mut self) -> Option<TakenLight> {
+        let (peak, at) = self.box_peak();
+        if peak < PEAK_OVER_MEAN * self.mean_luminance() || peak <= 0.0 {
+            return None;
+        }
+        self.take(at, 0.25 * peak, 8f32.to_radians().cos())
+    }
+
+    /// Takes up to `max` lights out of the image (`environment.lights`),
+    /// brightest first: while the peak of a 4x smaller copy is at least 20
+    /// times the image's mean, the texels within 12 degrees of it that
+    /// are brighter than 2% of it are lowered to that level, and what
+    /// they lose becomes a directional light with the spread of what was
+    /// taken. Small bright sources (lamps, softboxes, a sun) then light
+    /// the scene through the light loop, with shadows, and the image keeps
+    /// the rest.
+    pub fn extract_lights(&mut self, max: usize) -> Vec<TakenLight> {
+        let mean = self.mean_luminance();
+        let mut out = Vec::new();
+        while out.len() < max {
+            let (peak, at) = self.box_peak();
+            if peak < PEAK_OVER_MEAN * mean || peak <= 0.0 {
+                break;
+            }
+            match self.take(at, LIGHT_LEVEL * peak, LIGHT_CONE.to_radians().cos()) {
+                Some(l) => out.push(l),
+                None => break,
+            }
+        }
+        out
+    }
+
+    /// Unit direction toward texel (x, y)'s center.
+    fn direction(&self, x: usize, y: usize) -> Vec3 {
         use std::f32::consts::PI;
+        let theta = (y as f32 + 0.5) / self.height as f32 * PI;
+        let phi = ((x as f32 + 0.5) / self.width as f32 - 0.5) * 2.0 * PI;
+        Vec3::new(
+            theta.sin() * phi.sin(),
+            theta.cos(),
+            -theta.sin() * phi.cos(),
+        )
+    }
+
+    /// Solid angle of a texel of row y.
+    fn texel_solid_angle(&self, y: usize) -> f32 {
+        use std::f32::consts::PI;
+        let h = self.height as f32;
+        (2.0 * PI / self.width as f32) * (PI / h) * ((y as f32 + 0.5) / h * PI).sin()
+    }
+
+    /// Mean luminance over the texels.
+    fn mean_luminance(&self) -> f32 {
+        self.texels.iter().map(|c| luminance(*c)).sum::<f32>() / self.texels.len() as f32
+    }
+
+    /// The brightest 4x4 box (one hot texel is not a light): its mean
+    /// luminance and the texel at its center.
+    fn box_peak(&self) -> (f32, (usize, usize)) {
         let (w, h) = (self.width as usize, self.height as usize);
-        let lum = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-        let dir = |x: usize, y: usize| {
-            let theta = (y as f32 + 0.5) / h as f32 * PI;
-            let phi = ((x as f32 + 0.5) / w as f32 - 0.5) * 2.0 * PI;
-            Vec3::new(
-                theta.sin() * phi.sin(),
-                theta.cos(),
-                -theta.sin() * phi.cos(),
-            )
-        };
-        // The peak of a 4x4 box-filtered copy (one hot texel is not a sun).
         let (mut best, mut at) = (0.0f32, (0, 0));
         for by in 0..h / 4 {
             for bx in 0..w / 4 {
                 let mut s = 0.0;
                 for k in 0..16 {
-                    s += lum(self.texels[(by * 4 + k / 4) * w + bx * 4 + k % 4]);
+                    s += luminance(self.texels[(by * 4 + k / 4) * w + bx * 4 + k % 4]);
                 }
                 if s > best {
                     (best, at) = (s, (bx * 4 + 2, by * 4 + 2));
                 }
             }
         }
-        let mean = self.texels.iter().map(|c| lum(*c)).sum::<f32>() / (w * h) as f32;
-        let peak = best / 16.0;
-        if peak < 20.0 * mean || peak <= 0.0 {
-            return None;
-        }
-        let center = dir(at.0, at.1);
-        let (threshold, cos_max) = (0.25 * peak, 8f32.to_radians().cos());
-        let (mut energy, mut weighted) = (Vec3::ZERO, Vec3::ZERO);
+        (best / 16.0, at)
+    }
+
+    /// Lowers the texels within the cone (`cos_max`) around texel `at`
+    /// that are brighter than `threshold` to that luminance; what they
+    /// lose is the light. Its direction is the luminance-weighted mean of
+    /// the directions taken, and its angular radius that of a uniform
+    /// disc with the same mean resultant length R (cos = 2R - 1).
+    fn take(&mut self, at: (usize, usize), threshold: f32, cos_max: f32) -> Option<TakenLight> {
+        let center = self.direction(at.0, at.1);
+        let (w, h) = (self.width as usize, self.height as usize);
+        let (mut energy, mut weighted, mut weight) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
         for y in 0..h {
-            let omega =
-                (2.0 * PI / w as f32) * (PI / h as f32) * ((y as f32 + 0.5) / h as f32 * PI).sin();
+            let omega = self.texel_solid_angle(y);
             for x in 0..w {
-                let d = dir(x, y);
-                let t = &mut self.texels[y * w + x];
-                let l = lum(*t);
+                let d = self.direction(x, y);
+                let t = self.texels[y * w + x];
+                let l = luminance(t);
                 if d.dot(center) < cos_max || l <= threshold {
                     continue;
                 }
-                let kept = *t * (threshold / l);
-                let taken = (*t - kept) * omega;
+                let kept = t * (threshold / l);
+                let taken = (t - kept) * omega;
                 energy += taken;
-                weighted += d * lum(taken);
-                *t = kept;
+                weighted += d * luminance(taken);
+                weight += luminance(taken);
+                self.texels[y * w + x] = kept;
             }
         }
         let toward = weighted.try_normalize()?;
-        Some((-toward, energy))
+        let r = (weighted.length() / weight).min(1.0);
+        Some(TakenLight {
+            direction: -toward,
+            irradiance: energy,
+            angle: (2.0 * r - 1.0).clamp(-1.0, 1.0).acos(),
+        })
     }
 
     /// A uniform environment of radiance `c`.
@@ -313,8 +392,8 @@ mod tests {
         };
         let mut img = EnvImage::new(w, h, texels).unwrap();
         let before = total(&img.texels);
-        let (dir, e) = img.extract_sun().unwrap();
-        let toward = -dir;
+        let sun = img.extract_sun().unwrap();
+        let (toward, e) = (-sun.direction, sun.irradiance);
         let want = Vec3::new(1.0, 1.0, 0.0).normalize();
         assert!(toward.dot(want) > 0.999, "{toward}");
         // Energy is moved, not made: the image keeps the rest.
@@ -325,5 +404,62 @@ mod tests {
         assert!(img.texels.iter().all(|c| c.x <= 5000.0 * 0.25 + 1e-3));
         // No clear peak, no sun.
         assert!(EnvImage::uniform(Vec3::ONE).extract_sun().is_none());
+    }
+
+    #[test]
+    fn lamps_leave_the_image_as_lights_of_their_energy_direction_and_size() {
+        let (w, h) = (512u32, 256u32);
+        let mut img = EnvImage::new(w, h, vec![Vec3::splat(0.2); (w * h) as usize]).unwrap();
+        // Two round lamps: 5 degrees across toward +X, level; 8 degrees
+        // across straight up, half as bright, warm.
+        let lamps = [
+            (Vec3::X, 5f32.to_radians(), Vec3::splat(400.0)),
+            (Vec3::Y, 8f32.to_radians(), Vec3::new(200.0, 150.0, 100.0)),
+        ];
+        let mut painted = [Vec3::ZERO; 2];
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let d = img.direction(x, y);
+                for (k, (dir, r, c)) in lamps.into_iter().enumerate() {
+                    if d.dot(dir) >= r.cos() {
+                        img.texels[y * w as usize + x] += c;
+                        painted[k] += c * img.texel_solid_angle(y);
+                    }
+                }
+            }
+        }
+        let power = |img: &EnvImage| -> Vec3 {
+            (0..(w * h) as usize)
+                .map(|i| img.texels[i] * img.texel_solid_angle(i / w as usize))
+                .sum()
+        };
+        let before = power(&img);
+        let lights = img.extract_lights(4);
+        assert_eq!(lights.len(), 2, "{lights:?}");
+        for ((l, (dir, r, _)), want) in lights.iter().zip(lamps).zip(painted) {
+            assert!((-l.direction).dot(dir) > 0.9995, "{l:?}");
+            // Nearly all of the lamp: what is left is 2% of its peak.
+            let got = l.irradiance;
+            assert!(
+                (got / want - Vec3::ONE).abs().max_element() < 0.03,
+                "{got} against {want}"
+            );
+            assert!((l.angle / r - 1.0).abs() < 0.1, "{} against {r}", l.angle);
+        }
+        // Moved, not made.
+        let after = power(&img) + lights.iter().map(|l| l.irradiance).sum::<Vec3>();
+        assert!((after / before - Vec3::ONE).abs().max_element() < 1e-3);
+        // An even sky has no lights; max bounds the count.
+        assert!(EnvImage::uniform(Vec3::ONE).extract_lights(4).is_empty());
+        let mut again = EnvImage::new(w, h, vec![Vec3::splat(0.2); (w * h) as usize]).unwrap();
+        again.texels[100 * w as usize + 100] = Vec3::splat(1e5);
+        assert_eq!(again.extract_lights(0).len(), 0);
+    }
+
+    #[test]
+    fn the_built_in_studio_keeps_its_soft_panels() {
+        // Its panels peak under 20 times its mean: no lights, no shadows.
+        let mut studio = (*EnvImage::studio()).clone();
+        assert!(studio.extract_lights(4).is_empty());
     }
 }

@@ -12,11 +12,12 @@
 
 use std::sync::{Arc, Mutex};
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::draw_list::DrawList;
 use super::rays::CameraRays;
+use crate::scene::light::LightKind;
 use crate::scene::settings::Background;
 use crate::shade::env::EnvLight;
 
@@ -24,6 +25,10 @@ use crate::shade::env::EnvLight;
 /// it.
 pub(super) struct EnvBackground<'a> {
     env: &'a EnvLight,
+    /// The lights taken out of the image (`environment.lights`): their
+    /// unit direction towards them, irradiance and angular radius, added
+    /// back to the blurred background.
+    discs: Vec<(Vec3, Vec3, f32)>,
     /// Prefiltering roughness; 0: the image itself.
     blur: f32,
     rays: CameraRays,
@@ -59,8 +64,21 @@ impl<'a> EnvBackground<'a> {
         if setup.scene.settings.shading.is_data_view() {
             return None;
         }
+        let discs = setup
+            .lights
+            .iter()
+            .filter_map(|l| match l.kind {
+                LightKind::Directional {
+                    direction,
+                    irradiance,
+                    angle,
+                } if angle > 0.0 => Some((-direction, l.color * irradiance, angle)),
+                _ => None,
+            })
+            .collect();
         Some(EnvBackground {
             env: env?,
+            discs,
             blur,
             rays: CameraRays::new(&setup.camera, width, height),
             width,
@@ -80,7 +98,12 @@ impl<'a> EnvBackground<'a> {
     fn look_up(&self, px: i32, py: i32) -> Vec4 {
         let (_, d) = self.rays.ray(px, py);
         let c = if self.blur > 0.0 {
-            self.env.prefiltered(d, self.blur)
+            let lights: Vec3 = self
+                .discs
+                .iter()
+                .map(|&(l, e, angle)| blurred_disc(d, self.blur, (l, e, angle)))
+                .sum();
+            self.env.prefiltered(d, self.blur) + lights
         } else {
             self.env.radiance(d)
         };
@@ -109,6 +132,19 @@ impl<'a> EnvBackground<'a> {
             });
         out
     }
+}
+
+/// A light taken out of the image, seen along unit `d` through the blur
+/// of perceptual roughness `blur`: its irradiance times the density of the
+/// GGX lobe (alpha = blur^2, widened by the disc) around `d` at the light,
+/// D(d.h) / 4, as the prefiltered levels spread the image.
+fn blurred_disc(d: Vec3, blur: f32, (l, e, angle): (Vec3, Vec3, f32)) -> Vec3 {
+    let w = 0.5 * angle.tan();
+    let a2 = (blur.powi(4) + w * w).min(1.0);
+    let h = (l + d).normalize_or_zero();
+    let c = d.dot(h).max(0.0);
+    let q = c * c * (a2 - 1.0) + 1.0;
+    e * (a2 / (std::f32::consts::PI * q * q) * 0.25)
 }
 
 /// A whole backdrop, rows of the frame's width.
@@ -167,6 +203,7 @@ mod tests {
         };
         EnvBackground {
             env,
+            discs: Vec::new(),
             blur,
             rays: CameraRays::new(&cam, 37, 23),
             width: 37,

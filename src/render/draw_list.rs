@@ -74,6 +74,7 @@ impl<'a> DrawList<'a> {
                 kind: LightKind::Directional {
                     direction: cam.forward(),
                     irradiance: 1.0,
+                    angle: 0.0,
                 },
                 color: Vec3::ONE,
                 shadows: false,

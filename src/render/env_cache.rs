@@ -24,6 +24,8 @@ struct Key {
     rotation: u32,
     size: u32,
     phong: Vec<u32>,
+    /// `content_hash` of the backdrop (0: none).
+    backdrop: u64,
 }
 
 struct Entry {
@@ -38,7 +40,7 @@ static CACHE: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
 /// .with_phong_roughness(phong)`, made once per process for each distinct
 /// set of inputs.
 pub fn env_light(
-    image: &Arc<EnvImage>,
+    (image, backdrop): (&Arc<EnvImage>, Option<&Arc<EnvImage>>),
     (intensity, rotation, size): (f32, f32, u32),
     phong: Vec<f32>,
 ) -> Arc<EnvLight> {
@@ -47,6 +49,7 @@ pub fn env_light(
         k.intensity == intensity.to_bits()
             && k.rotation == rotation.to_bits()
             && k.size == size
+            && k.backdrop == backdrop.map_or(0, |b| content_hash(b))
             && k.phong
                 .iter()
                 .copied()
@@ -64,6 +67,7 @@ pub fn env_light(
         rotation: rotation.to_bits(),
         size,
         phong: phong.iter().map(|r| r.to_bits()).collect(),
+        backdrop: backdrop.map_or(0, |b| content_hash(b)),
     };
     let same = |e: &Entry| {
         e.key == key
@@ -74,8 +78,12 @@ pub fn env_light(
         return e.light.clone();
     }
     // Made without the lock: other renderers go on meanwhile.
-    let light =
-        Arc::new(EnvLight::with_size(image, intensity, rotation, size).with_phong_roughness(phong));
+    let mut light =
+        EnvLight::with_size(image, intensity, rotation, size).with_phong_roughness(phong);
+    if let Some(b) = backdrop {
+        light = light.with_backdrop(b);
+    }
+    let light = Arc::new(light);
     let mut cache = lock();
     if !cache.iter().any(same) {
         if cache.len() == KEEP {
@@ -122,15 +130,17 @@ mod tests {
         let mut other = texels(0.25);
         other[100].y = 0.5;
         let b = Arc::new(EnvImage::new(32, 16, other).unwrap());
-        let first = env_light(&a, (1.0, 0.0, 16), vec![0.5]);
+        let first = env_light((&a, None), (1.0, 0.0, 16), vec![0.5]);
         assert!(Arc::ptr_eq(
             &first,
-            &env_light(&a2, (1.0, 0.0, 16), vec![0.5])
+            &env_light((&a2, None), (1.0, 0.0, 16), vec![0.5])
         ));
         for (image, params, phong) in [
-            (&b, (1.0, 0.0, 16), vec![0.5]),
-            (&a, (2.0, 0.0, 16), vec![0.5]),
-            (&a, (1.0, 0.0, 16), vec![0.25]),
+            ((&b, None), (1.0, 0.0, 16), vec![0.5]),
+            ((&a, None), (2.0, 0.0, 16), vec![0.5]),
+            ((&a, None), (1.0, 0.0, 16), vec![0.25]),
+            // The same lighting with another backdrop.
+            ((&a, Some(&b)), (1.0, 0.0, 16), vec![0.5]),
         ] {
             assert!(!Arc::ptr_eq(&first, &env_light(image, params, phong)));
         }

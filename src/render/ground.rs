@@ -7,8 +7,9 @@
 //!   factor = (sum_i E_i v_i + E_a ao) / (sum_i E_i + E_a)
 //!
 //! with E_i the light's irradiance on the plane and v_i its visibility (a
-//! ray through the scene's BVHs per pixel; 1 for lights that cast no
-//! shadows), E_a the irradiance of the environment from above (or of
+//! ray through the scene's BVHs per pixel, the open share of a cone of
+//! rays for a light with a disc (`shade::soft_shadow`); 1 for lights that
+//! cast no shadows), E_a the irradiance of the environment from above (or of
 //! `[ambient]`), and ao the unoccluded fraction of 16 cosine-weighted rays
 //! within half the models' radius: a soft contact shadow, computed per
 //! frame on a 96x96 grid over the plane within 1.5 radii of the models'
@@ -23,10 +24,12 @@ use super::draw_list::DrawList;
 use super::rays::CameraRays;
 use crate::raytrace::Tracer;
 use crate::scene::Light;
+use crate::scene::light::LightKind;
 use crate::scene::settings::Background;
 use crate::shade::ShadeContext;
 use crate::shade::ao::{for_each_ray, pixel_hash};
 use crate::shade::light::incidence;
+use crate::shade::soft_shadow::open_share;
 
 /// Rays of contact occlusion per grid point.
 const AO_SAMPLES: u32 = 16;
@@ -140,9 +143,13 @@ impl<'a> Ground<'a> {
             } else {
                 inc.l
             };
-            if !light.shadows || !self.tracer.occluded(origin, dir, t_max) {
-                kept += e;
-            }
+            kept += e * match light.kind {
+                _ if !light.shadows => 1.0,
+                LightKind::Directional { angle, .. } if angle > 0.0 => {
+                    open_share(self.tracer, angle, p, Vec3::Y, inc.l)
+                }
+                _ => f32::from(u8::from(!self.tracer.occluded(origin, dir, t_max))),
+            };
         }
         if self.ambient > 0.0 {
             kept += self.ambient * self.contact(p);

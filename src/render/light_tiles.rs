@@ -239,6 +239,7 @@ mod tests {
                 kind: LightKind::Directional {
                     direction: -Vec3::Z,
                     irradiance: 1.0,
+                    angle: 0.0,
                 },
                 color: Vec3::ONE,
                 shadows: false,

@@ -356,7 +356,7 @@ impl<'s> Renderer<'s> {
                 let e = self.scene.environment.as_ref()?;
                 let params = (e.intensity, e.rotation, e.prefilter_size);
                 Some(env_cache::env_light(
-                    &e.image,
+                    (&e.image, e.backdrop.as_ref()),
                     params,
                     self.phong_roughness(),
                 ))

@@ -195,13 +195,17 @@ fn light_shadows(
         let ls = if !light.shadows {
             LightShadow::None
         } else if s.shadows == ShadowMethod::Raytraced {
-            LightShadow::Ray {
-                position: match light.kind {
-                    LightKind::Directional { .. } => None,
-                    LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
-                        Some(position)
-                    }
+            match light.kind {
+                LightKind::Directional { angle, .. } => LightShadow::Ray {
+                    position: None,
+                    cone: angle,
                 },
+                LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                    LightShadow::Ray {
+                        position: Some(position),
+                        cone: 0.0,
+                    }
+                }
             }
         } else {
             match light.kind {
@@ -546,6 +550,7 @@ mod tests {
         LightKind::Directional {
             direction: direction.normalize(),
             irradiance: 1.0,
+            angle: 0.0,
         }
     }
 

@@ -24,8 +24,12 @@ pub enum EnvMethod {
 pub struct Environment {
     /// How its light is integrated.
     pub method: EnvMethod,
-    /// The equirectangular radiance image (linear).
+    /// The equirectangular radiance image (linear), less the lights taken
+    /// out of it (`lights`, `sun`).
     pub image: Arc<EnvImage>,
+    /// The image as read, when lights were taken out of it: what the
+    /// background shows.
+    pub backdrop: Option<Arc<EnvImage>>,
     /// Multiplies the radiance (default 1).
     pub intensity: f32,
     /// Degrees about +Y, counter-clockwise seen from above (default 0).
@@ -37,3 +41,7 @@ pub struct Environment {
 
 /// `environment.prefilter_size` when the scene does not give it.
 pub const DEFAULT_PREFILTER_SIZE: u32 = 128;
+
+/// `environment.lights` when the scene does not give it and the method is
+/// prefiltered (sampled: 0, its rays find the bright regions themselves).
+pub const DEFAULT_ENV_LIGHTS: i64 = 4;

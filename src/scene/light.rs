@@ -21,6 +21,9 @@ pub enum LightKind {
         direction: Vec3,
         /// Irradiance on a surface facing the light.
         irradiance: f32,
+        /// Angular radius of the disc the light comes from, in radians
+        /// (0: a point): widens highlights and softens ray-traced shadows.
+        angle: f32,
     },
     /// A point light limited to a cone around `direction` (unit), with the
     /// KHR_lights_punctual smooth falloff between the cone angles.
@@ -75,9 +78,11 @@ impl Light {
             LightKind::Directional {
                 direction,
                 irradiance,
+                angle,
             } => LightKind::Directional {
                 direction: dir(direction),
                 irradiance,
+                angle,
             },
             LightKind::Point {
                 position,

@@ -20,6 +20,7 @@ use super::env::sampled::{self as env_sampled, Lobes};
 use super::lanes::{Lanes, Lit};
 use super::{Fetch, ShadeContext};
 use crate::scene::Material;
+use crate::scene::light::LightKind;
 use crate::scene::material::roughness_from_ns;
 use crate::simd::{Lane, Mask, V3};
 
@@ -148,6 +149,18 @@ impl ShadeContext<'_> {
         let mut spec = V3::zero();
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, e, lit, .. } = self.lit_lanes(i, light, f, n);
+            if let LightKind::Directional { angle, .. } = light.kind
+                && angle > 0.0
+            {
+                // Taken out of the environment: lit as the environment
+                // lit these surfaces.
+                let (d, s) = image_light([n, v, l], e, ns, angle);
+                diffuse = diffuse + V3::select(lit, d, V3::zero());
+                if specular {
+                    spec = spec + V3::select(lit, s, V3::zero());
+                }
+                return;
+            }
             diffuse = diffuse + V3::select(lit, e, V3::zero());
             if specular {
                 let h = (l + v).normalize_or(V3::zero());
@@ -213,6 +226,35 @@ impl ShadeContext<'_> {
         };
         V3::select(no_ks, diffuse, diffuse + ks * light)
     }
+}
+
+/// A light taken out of the environment image (`environment.lights`; a
+/// disc of angular radius `angle`) as the environment term shaded it:
+/// (E n.l / pi, E n.l D(r.h) / 4), with which Kd and Ks make Kd E(n) / pi
+/// and Ks times the radiance along the reflection r weighted by the GGX
+/// lobe matching Ns (D over the reflected directions, around r, is a
+/// distribution: D(r.h) / 4 is its density at l; alpha^2 = 2 / (Ns + 2),
+/// widened by the disc as `PbrColor::widened` does).
+#[inline(always)]
+fn image_light<L: Lane>(
+    [n, v, l]: [V3<L>; 3],
+    e: V3<L>,
+    ns: Exponent<L>,
+    angle: f32,
+) -> (V3<L>, V3<L>) {
+    let one = L::splat(1.0);
+    let ns = match ns {
+        Exponent::One(ns) => L::splat(ns),
+        Exponent::PerLane(ns) => ns,
+    };
+    let w = 0.5 * angle.tan();
+    let a2 = (L::splat(2.0) / (ns.max(L::splat(0.0)) + L::splat(2.0)) + L::splat(w * w)).min(one);
+    let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
+    let h = (l + r).normalize_or(V3::zero());
+    let c = r.dot(h).max(L::splat(0.0));
+    let q = c * c * (a2 - one) + one;
+    let d = a2 / (L::splat(PI) * q * q);
+    (e.scale(L::splat(1.0 / PI)), e.scale(d * L::splat(0.25)))
 }
 
 #[cfg(test)]

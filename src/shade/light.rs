@@ -26,6 +26,7 @@ pub fn incidence(light: &Light, p: Vec3) -> Option<Incidence> {
         LightKind::Directional {
             direction,
             irradiance,
+            ..
         } => Some(Incidence {
             l: -direction,
             e: light.color * irradiance,
@@ -377,6 +378,7 @@ mod tests {
             kind: LightKind::Directional {
                 direction: -Vec3::Y,
                 irradiance: 1.0,
+                angle: 0.0,
             },
             color: Vec3::ONE,
             shadows: false,

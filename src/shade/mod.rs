@@ -12,6 +12,7 @@ pub mod pbr;
 pub mod refraction;
 pub mod shadow;
 pub mod sheen;
+pub mod soft_shadow;
 pub mod tonemap;
 
 use glam::{Vec2, Vec3, Vec4};

@@ -196,9 +196,11 @@ pub enum LightShadow {
         faces: Box<[ShadowMap; 6]>,
     },
     /// Rays towards the light: to its position (point, spot), or unbounded
-    /// (directional).
+    /// (directional); a directional light with an angular radius `cone`
+    /// (radians, > 0) gets `SOFT_RAYS` rays spread over its disc.
     Ray {
         position: Option<Vec3>,
+        cone: f32,
     },
 }
 
@@ -301,9 +303,13 @@ impl Shadows<'_> {
                     left &= !same;
                 }
             }
-            LightShadow::Ray { position } => {
+            LightShadow::Ray { position, cone } => {
                 for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
-                    out[k] = self.ray(position, p.lane(k), ng[k], l.lane(k));
+                    out[k] = if *cone > 0.0 && position.is_none() {
+                        self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k))
+                    } else {
+                        self.ray(position, p.lane(k), ng[k], l.lane(k))
+                    };
                 }
             }
         }

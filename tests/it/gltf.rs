@@ -346,6 +346,7 @@ fn imported_lights_and_cameras_follow_their_nodes() {
         LightKind::Directional {
             direction,
             irradiance,
+            ..
         } => {
             assert!((direction - Vec3::NEG_Y).length() < 1e-5, "{direction}");
             assert_eq!(irradiance, 2.0);

@@ -573,3 +573,63 @@ fn materials_with_many_slots_are_the_same_at_every_width() {
         every_filter_and_msaa(&dir.join("scene.toml"), &format!("five slots, {alpha}"));
     }
 }
+
+#[test]
+fn lights_from_the_image_are_the_same_at_every_width() {
+    // An image with a lamp (radiance 40, 10 degrees across, 45 degrees up)
+    // gives a light with a disc: soft ray-traced shadows, widened pbr
+    // lobes, Blinn-Phong lit as the image lit it, the blurred background
+    // with the lamp added back.
+    let dir = scratch("widths_env_lights");
+    let lamp = glam::Vec3::new(1.0, 1.0, 0.0).normalize();
+    exr::prelude::write_rgb_file(dir.join("env.exr"), 256, 128, |x, y| {
+        let theta = (y as f32 + 0.5) / 128.0 * std::f32::consts::PI;
+        let phi = ((x as f32 + 0.5) / 256.0 - 0.5) * std::f32::consts::TAU;
+        let d = glam::Vec3::new(
+            theta.sin() * phi.sin(),
+            theta.cos(),
+            -theta.sin() * phi.cos(),
+        );
+        let c = if d.dot(lamp) >= 5f32.to_radians().cos() {
+            40.2
+        } else {
+            0.2
+        };
+        (c, c, c)
+    })
+    .unwrap();
+    let env = format!(
+        "environment.path={:?}",
+        dir.join("env.exr").display().to_string()
+    );
+    let scenes = common::root().join("scenes");
+    let walker = load_with(
+        &scenes.join("walker.toml"),
+        &["output.width=96", "output.height=72", &env],
+    );
+    assert_eq!(walker.lights.len(), 1, "the lamp is a light");
+    same_at_every_width(&walker, &[10], "walker, lights from the image");
+    let obj = softraster::procedural::sphere(1.0, 48, 24).to_obj("ball", "m.mtl", "m");
+    let floor = "mtllib m.mtl\nusemtl m\nv -4 -1 -4\nv 4 -1 -4\nv 4 -1 4\nv -4 -1 4\nf 4 3 2 1\n";
+    for background in ["\"environment\"", "\"blurred\""] {
+        let text = format!(
+            "[output]\nwidth = 64\nheight = 48\nbackground = {background}\n\
+             [environment]\npath = \"env.exr\"\n\
+             [[model]]\npath = \"ball.obj\"\n[[model]]\npath = \"floor.obj\"\n\
+             [[camera]]\neye = [-1.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 60.0\n"
+        );
+        let scene = scene_in(
+            &dir,
+            &text,
+            &[
+                ("ball.obj", obj.text.as_str()),
+                ("floor.obj", floor),
+                (
+                    "m.mtl",
+                    "newmtl m\nKd 0.6 0.5 0.4\nKs 0.5 0.5 0.5\nNs 200\nillum 2\n",
+                ),
+            ],
+        );
+        same_at_every_width(&scene, &[0], &format!("Blinn-Phong, {background}"));
+    }
+}

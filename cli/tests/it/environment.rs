@@ -247,8 +247,17 @@ fn bad_environments_are_refused_by_name() {
         err.contains("environment.intensity = -1") && err.contains("s.toml:"),
         "{err}"
     );
+    // More lights than 16, or fewer than none.
+    for bad in ["lights = 17", "lights = -1"] {
+        let (code, _, err) = run(bad);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("environment.lights") && err.contains("s.toml:"),
+            "{err}"
+        );
+    }
     // And a good one renders.
-    let (code, _, err) = run("intensity = 2.0");
+    let (code, _, err) = run("intensity = 2.0\nlights = 16");
     assert_eq!(code, 0, "{err}");
 }
 
@@ -468,7 +477,7 @@ fn the_sun_of_real_skies_becomes_a_shadow_casting_light() {
     let dir = scratch("env_sun");
     for hdri in ["sunset", "city"] {
         let path = assets.join(format!("hdri/{hdri}.exr"));
-        let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "sun = true", "").replace(
+        let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "sun = true\nlights = 0", "").replace(
             "path = \"env.exr\"",
             &format!("path = {:?}", path.display().to_string()),
         );
@@ -478,6 +487,7 @@ fn the_sun_of_real_skies_becomes_a_shadow_casting_light() {
         let softraster::scene::light::LightKind::Directional {
             direction,
             irradiance,
+            ..
         } = l.kind
         else {
             panic!("{hdri}: {:?}", l.kind)
@@ -715,5 +725,102 @@ fn a_light_adds_to_the_studio_look() {
     assert_eq!(
         v1.settings.background,
         softraster::scene::settings::Background::Color(Vec3::ZERO)
+    );
+}
+
+/// A lamp of radiance 40, 10 degrees across, 45 degrees up toward +X, in a
+/// sky of 0.2 (a 512 x 256 image), and what a floor facing up receives
+/// from the lamp (its painted texels' radiance times solid angle times
+/// cosine).
+fn lamp_in_sky(path: &Path) -> f32 {
+    use std::f32::consts::PI;
+    let (w, h) = (512usize, 256usize);
+    let dir = |x: usize, y: usize| {
+        let theta = (y as f32 + 0.5) / h as f32 * PI;
+        let phi = ((x as f32 + 0.5) / w as f32 - 0.5) * 2.0 * PI;
+        Vec3::new(
+            theta.sin() * phi.sin(),
+            theta.cos(),
+            -theta.sin() * phi.cos(),
+        )
+    };
+    let lamp = Vec3::new(1.0, 1.0, 0.0).normalize();
+    let inside = |x: usize, y: usize| dir(x, y).dot(lamp) >= 5f32.to_radians().cos();
+    write_env(path, w, |x, y| {
+        let c = if inside(x, y) { 40.2 } else { 0.2 };
+        [c, c, c]
+    });
+    let mut e = 0.0;
+    for y in 0..h {
+        let omega =
+            (2.0 * PI / w as f32) * (PI / h as f32) * ((y as f32 + 0.5) / h as f32 * PI).sin();
+        for x in (0..w).filter(|&x| inside(x, y)) {
+            e += 40.0 * omega * dir(x, y).y;
+        }
+    }
+    e
+}
+
+#[test]
+fn a_lamp_in_the_image_casts_a_soft_shadow_and_keeps_its_energy() {
+    use std::f32::consts::PI;
+    let dir = scratch("env_lamp");
+    let e_lamp = lamp_in_sky(&dir.join("env.exr"));
+    let floor = "mtllib m.mtl\nusemtl m\nv -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nf 4 3 2 1\n";
+    // A ball of radius 0.5 at height 1.5 over a grey floor; the lamp's
+    // shadow falls around (-1.5, 0, 0), an umbra: from there the ball is
+    // 27 degrees across, the lamp 10. Seen from straight above, 64 x 64
+    // over 4 units.
+    let text = |lights: &str| {
+        format!(
+            "[output]\nwidth = 64\nheight = 64\n[render]\nshading = \"blinn-phong\"\n\
+             [environment]\npath = \"env.exr\"\n{lights}\n\
+             [[model]]\npath = \"sphere.obj\"\nscale = 0.5\ntranslate = [0.0, 1.5, 0.0]\n\
+             [[model]]\npath = \"floor.obj\"\n\
+             [[camera]]\neye = [0.0, 10.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+             projection = \"orthographic\"\nheight = 4.0\n"
+        )
+    };
+    let mut f = files();
+    f.push(("floor.obj", floor.to_string()));
+    let refs: Vec<(&str, &str)> = f.iter().map(|(n, t)| (*n, t.as_str())).collect();
+    let at = |frame: &softraster::render::Frame, x: f32, z: f32| {
+        let (px, py) = ((32.0 + x * 16.0) as usize, (32.0 + z * 16.0) as usize);
+        frame.color[py * 64 + px].x
+    };
+    let s = scene_in(&dir, &text(""), &refs);
+    assert_eq!(s.lights.len(), 1, "the lamp is the image's one light");
+    let lit = render_frame(&s, 0, 0);
+    let s = scene_in(&dir, &text("lights = 0"), &refs);
+    assert!(s.lights.is_empty());
+    let unlit = render_frame(&s, 0, 0);
+    // In the open, taking the lamp out of the image changes nothing.
+    let (open, open0) = (at(&lit, 1.5, 1.5), at(&unlit, 1.5, 1.5));
+    assert!((open / open0 - 1.0).abs() < 0.01, "{open} against {open0}");
+    // In the umbra the floor loses what the lamp gave it (but the 2% of
+    // the lamp's level the image keeps).
+    let lamp = 0.6 / PI * e_lamp;
+    let umbra = at(&lit, -1.5, 0.0);
+    let want = open0 - 0.98 * lamp;
+    assert!((umbra - want).abs() < 0.03 * lamp, "{umbra} against {want}");
+    // Without the light, nothing casts a shadow there.
+    assert!((at(&unlit, -1.5, 0.0) / open0 - 1.0).abs() < 0.01);
+    // Across the shadow's edge (sideways along z, at z = 0.5: the ball
+    // lies 2.1 from the floor along the light, so the penumbra spans
+    // 2.1 tan 5 degrees = 0.19 either side) the floor brightens gradually
+    // (to within the rays' noise).
+    let edge: Vec<f32> = (0..12)
+        .map(|k| at(&lit, -1.5, 0.2 + 0.0625 * k as f32))
+        .collect();
+    assert!(
+        edge.windows(2).all(|w| w[1] >= w[0] - 0.1 * lamp),
+        "{edge:?}"
+    );
+    assert!(
+        edge.iter()
+            .filter(|&&v| v > umbra + 0.1 * lamp && v < open - 0.1 * lamp)
+            .count()
+            >= 3,
+        "{edge:?}"
     );
 }

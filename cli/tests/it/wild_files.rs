@@ -504,6 +504,7 @@ fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
             LightKind::Directional {
                 direction,
                 irradiance,
+                ..
             } => {
                 sun |= close(direction, glam::Vec3::NEG_Y) && irradiance > 0.0;
             }

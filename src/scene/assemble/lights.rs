@@ -25,6 +25,7 @@ pub(super) fn from_desc(l: &desc::LightDesc) -> Light {
         Some(desc::LightKind::Directional) => LightKind::Directional {
             direction,
             irradiance: get(&l.irradiance, 1.0),
+            angle: 0.0,
         },
         Some(desc::LightKind::Spot) => LightKind::Spot {
             position,
@@ -51,6 +52,7 @@ pub(super) fn from_gltf(g: &GltfLight, world_from_file: Mat4) -> Light {
         GltfLightKind::Directional => LightKind::Directional {
             direction,
             irradiance: intensity,
+            angle: 0.0,
         },
         GltfLightKind::Point => LightKind::Point {
             position,
@@ -101,7 +103,8 @@ mod tests {
             l[1].kind,
             LightKind::Directional {
                 direction: -Vec3::Y,
-                irradiance: 1.0
+                irradiance: 1.0,
+                angle: 0.0,
             }
         );
         let LightKind::Spot {

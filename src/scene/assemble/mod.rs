@@ -18,9 +18,9 @@ use glam::Vec3;
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, SceneDesc, Spanned};
-use super::environment::{DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
+use super::environment::{DEFAULT_ENV_LIGHTS, DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
 use super::overrides::{self, SetOverride};
-use crate::assets::environment::EnvImage;
+use crate::assets::environment::{EnvImage, TakenLight};
 use crate::assets::input::Input;
 use crate::error::Error;
 use crate::scene::settings::RenderSettings;
@@ -249,7 +249,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
     let ground = get(&d.ground.shadow, default_look).then(|| ground_plane(&models.models, bounds));
     let environment = match &d.environment {
         Some(e) => {
-            let (env, sun) = environment(e.get_ref(), ctx, &scene_dir, &input)?;
+            let (env, sun, env_lights) = environment(e.get_ref(), ctx, &scene_dir, &input)?;
             if let Some(v) = &e.get_ref().sun
                 && *v.get_ref()
                 && sun.is_none()
@@ -260,11 +260,13 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
                 ));
             }
             lights.extend(sun);
+            lights.extend(env_lights);
             Some(env)
         }
         None if default_look => Some(Environment {
             method: EnvMethod::Prefiltered,
             image: EnvImage::studio(),
+            backdrop: None,
             intensity: 1.0,
             rotation: 0.0,
             prefilter_size: DEFAULT_PREFILTER_SIZE,
@@ -440,7 +442,7 @@ fn environment(
     ctx: &Ctx,
     scene_dir: &Path,
     input: &Input,
-) -> Result<(Environment, Option<super::Light>), Error> {
+) -> Result<(Environment, Option<super::Light>, Vec<super::Light>), Error> {
     let mut image = match (&e.path, e.preset.as_ref().map(|p| *p.get_ref())) {
         (Some(p), _) => {
             let path = scene_dir.join(p.get_ref().replace('\\', "/"));
@@ -469,36 +471,53 @@ fn environment(
     };
     let (intensity, rotation) = (get(&e.intensity, 1.0), get(&e.rotation, 0.0));
     // `sun = true`: the brightest region becomes a shadow-casting light
-    // (turned and scaled like the image), and leaves the image.
+    // (turned and scaled like the image), and leaves the image; then
+    // `lights`: the compact bright regions, each with its spread.
+    let to_light = |t: TakenLight, angle: f32| {
+        let world = glam::Mat3::from_rotation_y(rotation.to_radians()) * t.direction;
+        let e = t.irradiance * intensity;
+        let peak = e.max_element().max(1e-12);
+        super::Light {
+            kind: super::light::LightKind::Directional {
+                direction: world.normalize(),
+                irradiance: peak,
+                angle,
+            },
+            color: e / peak,
+            shadows: true,
+            range: None,
+        }
+    };
+    let read = image.clone();
     let sun = if get(&e.sun, false) {
         Arc::make_mut(&mut image)
             .extract_sun()
-            .map(|(direction, irradiance)| {
-                let world = glam::Mat3::from_rotation_y(rotation.to_radians()) * direction;
-                let e = irradiance * intensity;
-                let peak = e.max_element().max(1e-12);
-                super::Light {
-                    kind: super::light::LightKind::Directional {
-                        direction: world.normalize(),
-                        irradiance: peak,
-                    },
-                    color: e / peak,
-                    shadows: true,
-                    range: None,
-                }
-            })
+            .map(|t| to_light(t, 0.0))
     } else {
         None
+    };
+    let sampled = matches!(method, EnvMethod::Sampled { .. });
+    let wanted = get(&e.lights, if sampled { 0 } else { DEFAULT_ENV_LIGHTS }) as usize;
+    let lights = if wanted > 0 {
+        Arc::make_mut(&mut image)
+            .extract_lights(wanted)
+            .into_iter()
+            .map(|t| to_light(t, t.angle))
+            .collect()
+    } else {
+        Vec::new()
     };
     Ok((
         Environment {
             method,
+            backdrop: (sun.is_some() || !lights.is_empty()).then_some(read),
             image,
             intensity,
             rotation,
             prefilter_size: get(&e.prefilter_size, DEFAULT_PREFILTER_SIZE as i64) as u32,
         },
         sun,
+        lights,
     ))
 }
 

@@ -32,6 +32,9 @@ pub struct EnvironmentDesc {
     pub prefilter_size: Option<Spanned<i64>>,
     /// A shadow-casting directional light from the brightest region.
     pub sun: Option<Spanned<bool>>,
+    /// How many compact bright regions become shadow-casting lights
+    /// (default 4 prefiltered, 0 sampled).
+    pub lights: Option<Spanned<i64>>,
 }
 
 /// The built-in environments.

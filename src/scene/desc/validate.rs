@@ -62,6 +62,7 @@ pub(super) fn validate_environment(c: &Ctx, e: &Spanned<EnvironmentDesc>) -> Res
     c.finite(&e.rotation, "environment.rotation")?;
     c.int_range(&e.samples, "environment.samples", 1, 65536)?;
     c.int_range(&e.prefilter_size, "environment.prefilter_size", 8, 2048)?;
+    c.int_range(&e.lights, "environment.lights", 0, 16)?;
     Ok(())
 }
 

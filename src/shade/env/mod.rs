@@ -252,6 +252,9 @@ pub struct EnvLight {
     /// map, so a lookup reads one level instead of two and needs no arc
     /// tangents.
     phong: Vec<(u32, Octahedral)>,
+    /// The image before lights were taken out of it (`with_backdrop`),
+    /// for `radiance`: what the background and refraction show.
+    backdrop: Option<Equirect>,
 }
 
 /// At most this many blended levels (distinct Blinn-Phong exponents) per
@@ -312,7 +315,24 @@ impl EnvLight {
                 .then(|| Mat3::from_rotation_y(-rotation_deg.to_radians())),
             intensity,
             phong: Vec::new(),
+            backdrop: None,
         }
+    }
+
+    /// `radiance` reads `image` (the environment before lights were taken
+    /// out of it), halved to at most 2048 texels wide like the mirror
+    /// level.
+    pub fn with_backdrop(mut self, image: &EnvImage) -> EnvLight {
+        let mut level = Equirect {
+            width: image.width as usize,
+            height: image.height as usize,
+            texels: image.texels.iter().map(|&t| Vec3A::from(t)).collect(),
+        };
+        while level.width > MIRROR_MAX_WIDTH && level.height > 4 {
+            level = level.half();
+        }
+        self.backdrop = Some(level);
+        self
     }
 
     /// Adds blended levels for these perceptual roughnesses (those of the
@@ -396,10 +416,12 @@ impl EnvLight {
         V3::from_fn(|k| Vec3::from(self.irradiance.at(u.lane(k), v.lane(k)) * self.intensity))
     }
 
-    /// Radiance arriving from direction `d` (world space), unfiltered.
+    /// Radiance arriving from direction `d` (world space), unfiltered,
+    /// with any lights taken out of the image.
     pub fn radiance(&self, d: Vec3) -> Vec3 {
         let (u, v) = direction_to_uv_lanes(self.to_env(V3::<f32>::from(d)));
-        Vec3::from(self.levels[0].sample_uv(u, v)) * self.intensity
+        let level = self.backdrop.as_ref().unwrap_or(&self.levels[0]);
+        Vec3::from(level.sample_uv(u, v)) * self.intensity
     }
 
     /// Radiance along reflection direction `r` (world space), prefiltered

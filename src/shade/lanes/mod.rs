@@ -469,6 +469,7 @@ fn incidence<L: Lane>(light: &Light, p: V3<L>) -> (V3<L>, V3<L>, L::Mask) {
         LightKind::Directional {
             direction,
             irradiance,
+            ..
         } => {
             return (
                 V3::splat(-direction),

@@ -126,6 +126,23 @@ pub struct PbrColor<L: Lane = f32> {
 }
 
 impl<L: Lane> PbrColor<L> {
+    /// The specular lobes (base and clearcoat) as a light seen as a disc
+    /// of angular radius `angle` (radians) makes them look: alpha widened
+    /// by half the disc's tangent (the half vector turns half as far as
+    /// the light), in quadrature. The widened GGX lobe keeps its energy.
+    #[inline(always)]
+    pub fn widened(&self, angle: f32) -> PbrColor<L> {
+        let w = 0.5 * angle.tan();
+        let w2 = L::splat(w * w);
+        let mut c = *self;
+        c.a2 = (c.a2 + w2).min(L::splat(1.0));
+        if let Some(coat) = &mut c.coat {
+            let a = coat.roughness * coat.roughness;
+            coat.roughness = (a * a + w2).sqrt().sqrt().min(L::splat(1.0));
+        }
+        c
+    }
+
     /// A material of these base colour, metallic and roughness (each
     /// clamped by the caller), unoccluded, without emission or layers.
     #[inline(always)]

@@ -9,6 +9,7 @@ use super::{
     Aniso, COAT_F0, Coat, Films, PbrColor, Sheens, brdf, btdf, env_brdf, environment, f_cos, splat3,
 };
 use crate::scene::Material;
+use crate::scene::light::{Light, LightKind};
 use crate::shade::env::sampled::{self as env_sampled, Lobes};
 use crate::shade::lanes::{Lanes, Lit};
 use crate::shade::{Fetch, ShadeContext};
@@ -358,6 +359,8 @@ impl ShadeContext<'_> {
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
+                let mut widened = None;
+                let c = seen_by(c, light, &mut widened);
                 let added = out + e * brdf(n, v, l, ndl, c);
                 out = V3::select(lit, added, out);
             }
@@ -416,6 +419,8 @@ impl ShadeContext<'_> {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
                 // e carries n.l, and so does f_cos.
+                let mut widened = None;
+                let c = seen_by(c, light, &mut widened);
                 let added = direct + e * (f_cos(n, v, l, ndl, c) / ndl);
                 direct = V3::select(lit, added, direct);
             }
@@ -449,6 +454,20 @@ impl ShadeContext<'_> {
             }
         }
         under + direct
+    }
+}
+
+/// `c` as `light` sees it: widened by the light's disc (kept in `slot`),
+/// if it has one.
+#[inline(always)]
+fn seen_by<'c, L: Lane>(
+    c: &'c PbrColor<L>,
+    light: &Light,
+    slot: &'c mut Option<PbrColor<L>>,
+) -> &'c PbrColor<L> {
+    match light.kind {
+        LightKind::Directional { angle, .. } if angle > 0.0 => slot.insert(c.widened(angle)),
+        _ => c,
     }
 }
 

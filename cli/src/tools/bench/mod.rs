@@ -344,6 +344,7 @@ fn anchor_lights(scene: &Scene, shadows: bool) -> Vec<Light> {
             kind: LightKind::Directional {
                 direction: -dir_l,
                 irradiance: 1.0,
+                angle: 0.0,
             },
             color: Vec3::new(0.9, 0.88, 0.85),
             shadows,
@@ -463,6 +464,7 @@ fn lights_toml(lights: &[Light]) -> String {
             LightKind::Directional {
                 direction,
                 irradiance,
+                ..
             } => s.push_str(&format!(
                 "kind = \"directional\"\ndirection = {}\nirradiance = {irradiance}\n",
                 v(direction)
