@@ -21,8 +21,12 @@ pub enum LightKind {
         direction: Vec3,
         /// Irradiance on a surface facing the light.
         irradiance: f32,
-        /// Angular radius of the disc the light comes from, in radians
-        /// (0: a point): widens highlights and softens ray-traced shadows.
+        /// Angular radius of the disc the light comes from, in radians:
+        /// 0 (a point) for the scene's and the glTF files' lights, > 0
+        /// only for lights taken out of the environment image
+        /// (`environment.lights`). Such a light widens highlights, softens
+        /// ray-traced shadows, and lights Blinn-Phong surfaces as the
+        /// image did (`blinn_phong::image_light`).
         angle: f32,
     },
     /// A point light limited to a cone around `direction` (unit), with the

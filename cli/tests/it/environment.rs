@@ -394,7 +394,13 @@ fn presets_light_without_a_file() {
     // upper left more than its lower right; nothing is black.
     let text = sphere_scene(&dir, [0.0, 0.0, 5.0], "", "")
         .replace("path = \"env.exr\"", "preset = \"studio\"");
-    let f = render_frame(&load(&dir, &text), 0, 0);
+    let s = load(&dir, &text);
+    // No lights taken out of it: the one shared image, unchanged.
+    let env = s.environment.as_ref().unwrap();
+    assert!(s.lights.is_empty() && env.backdrop.is_none());
+    let studio = softraster::assets::environment::EnvImage::studio();
+    assert!(std::sync::Arc::ptr_eq(&env.image, &studio));
+    let f = render_frame(&s, 0, 0);
     let (ul, lr) = (f.color[20 * 64 + 20].x, f.color[44 * 64 + 44].x);
     assert!(ul > 2.0 * lr && lr > 0.05, "{ul} {lr}");
     // Both: refused at the table.

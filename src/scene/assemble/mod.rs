@@ -498,15 +498,21 @@ fn environment(
     };
     let sampled = matches!(method, EnvMethod::Sampled { .. });
     let wanted = get(&e.lights, if sampled { 0 } else { DEFAULT_ENV_LIGHTS }) as usize;
-    let lights = if wanted > 0 {
-        Arc::make_mut(&mut image)
+    // On a copy, kept only when it gave lights: an image without any (the
+    // built-in presets) stays the shared one, which the lighting cache
+    // finds without hashing it.
+    let mut lights = Vec::new();
+    if wanted > 0 {
+        let mut copy = (*image).clone();
+        lights = copy
             .extract_lights(wanted)
             .into_iter()
             .map(|t| to_light(t, t.angle))
-            .collect()
-    } else {
-        Vec::new()
-    };
+            .collect();
+        if !lights.is_empty() {
+            image = Arc::new(copy);
+        }
+    }
     Ok((
         Environment {
             method,
