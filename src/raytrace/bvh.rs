@@ -241,7 +241,6 @@ impl Bvh {
     }
 
     /// The nearest hit with t in (t_min, t_max).
-    #[cfg(test)]
     pub fn nearest(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
         self.traverse(o, d, t_min, t_max, false)
     }

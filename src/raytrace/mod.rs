@@ -20,6 +20,8 @@ pub struct Placed<'a> {
 }
 
 struct Instance<'a> {
+    /// Its place in the `placed` list the tracer was made from.
+    index: usize,
     bvh: &'a Bvh,
     object_from_world: Mat4,
     /// World-space bounds (a quick reject before the transform).
@@ -41,8 +43,9 @@ impl<'a> Tracer<'a> {
     pub fn new(placed: impl IntoIterator<Item = Placed<'a>>, scene_radius: f32) -> Tracer<'a> {
         let instances = placed
             .into_iter()
-            .filter(|p| !p.bvh.is_empty())
-            .map(|p| {
+            .enumerate()
+            .filter(|(_, p)| !p.bvh.is_empty())
+            .map(|(index, p)| {
                 let (lo, hi) = p.bounds;
                 let w = p.world_from_object;
                 let mut wlo = Vec3A::splat(f32::INFINITY);
@@ -58,6 +61,7 @@ impl<'a> Tracer<'a> {
                     whi = whi.max(q);
                 }
                 Instance {
+                    index,
                     bvh: p.bvh,
                     object_from_world: w.inverse(),
                     lo: wlo,
@@ -93,6 +97,41 @@ impl<'a> Tracer<'a> {
                     .occluded(m.transform_point3(o), m.transform_vector3(d), 0.0, t_max)
             }
         })
+    }
+}
+
+/// The nearest surface a ray meets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceHit {
+    /// The mesh: its index in the `placed` list of `Tracer::new`.
+    pub mesh: usize,
+    /// The triangle within the mesh.
+    pub prim: u32,
+    /// Where along the ray: the point is `o + t d`.
+    pub t: f32,
+}
+
+impl Tracer<'_> {
+    /// The nearest surface on `o + t d` for t in (0, t_max).
+    pub fn nearest(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<TraceHit> {
+        let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
+        let mut best: Option<TraceHit> = None;
+        for i in &self.instances {
+            let reach = best.map_or(t_max, |b| b.t);
+            if !box_hit(i.lo, i.hi, oa, inv, reach) {
+                continue;
+            }
+            let m = &i.object_from_world;
+            let (oo, od) = (m.transform_point3(o), m.transform_vector3(d));
+            if let Some(h) = i.bvh.nearest(oo, od, 0.0, reach) {
+                best = Some(TraceHit {
+                    mesh: i.index,
+                    prim: h.prim,
+                    t: h.t,
+                });
+            }
+        }
+        best
     }
 }
 

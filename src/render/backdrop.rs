@@ -12,14 +12,14 @@
 
 use std::sync::{Arc, Mutex};
 
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 use rayon::prelude::*;
 
 use super::draw_list::DrawList;
 use super::rays::CameraRays;
 use crate::scene::light::LightKind;
 use crate::scene::settings::Background;
-use crate::shade::env::EnvLight;
+use crate::shade::env::{Disc, EnvLight};
 
 /// The environment seen through the camera, where the background shows
 /// it.
@@ -28,7 +28,7 @@ pub(super) struct EnvBackground<'a> {
     /// The lights taken out of the image (`environment.lights`): their
     /// unit direction towards them, irradiance and angular radius, added
     /// back to the blurred background.
-    discs: Vec<(Vec3, Vec3, f32)>,
+    discs: Vec<Disc>,
     /// Prefiltering roughness; 0: the image itself.
     blur: f32,
     rays: CameraRays,
@@ -64,21 +64,9 @@ impl<'a> EnvBackground<'a> {
         if setup.scene.settings.shading.is_data_view() {
             return None;
         }
-        let discs = setup
-            .lights
-            .iter()
-            .filter_map(|l| match l.kind {
-                LightKind::Directional {
-                    direction,
-                    irradiance,
-                    angle,
-                } if angle > 0.0 => Some((-direction, l.color * irradiance, angle)),
-                _ => None,
-            })
-            .collect();
         Some(EnvBackground {
             env: env?,
-            discs,
+            discs: image_discs(setup),
             blur,
             rays: CameraRays::new(&setup.camera, width, height),
             width,
@@ -97,17 +85,7 @@ impl<'a> EnvBackground<'a> {
 
     fn look_up(&self, px: i32, py: i32) -> Vec4 {
         let (_, d) = self.rays.ray(px, py);
-        let c = if self.blur > 0.0 {
-            let lights: Vec3 = self
-                .discs
-                .iter()
-                .map(|&(l, e, angle)| blurred_disc(d, self.blur, (l, e, angle)))
-                .sum();
-            self.env.prefiltered(d, self.blur) + lights
-        } else {
-            self.env.radiance(d)
-        };
-        c.extend(1.0)
+        self.env.seen(d, self.blur, &self.discs).extend(1.0)
     }
 
     fn key(&self) -> Key {
@@ -134,17 +112,21 @@ impl<'a> EnvBackground<'a> {
     }
 }
 
-/// A light taken out of the image, seen along unit `d` through the blur
-/// of perceptual roughness `blur`: its irradiance times the density of the
-/// GGX lobe (alpha = blur^2, widened by the disc) around `d` at the light,
-/// D(d.h) / 4, as the prefiltered levels spread the image.
-fn blurred_disc(d: Vec3, blur: f32, (l, e, angle): (Vec3, Vec3, f32)) -> Vec3 {
-    let w = 0.5 * angle.tan();
-    let a2 = (blur.powi(4) + w * w).min(1.0);
-    let h = (l + d).normalize_or_zero();
-    let c = d.dot(h).max(0.0);
-    let q = c * c * (a2 - 1.0) + 1.0;
-    e * (a2 / (std::f32::consts::PI * q * q) * 0.25)
+/// The lights the frame took out of its environment image (directional
+/// lights with a disc), as `EnvLight::seen` puts them back.
+pub(super) fn image_discs(setup: &DrawList) -> Vec<Disc> {
+    setup
+        .lights
+        .iter()
+        .filter_map(|l| match l.kind {
+            LightKind::Directional {
+                direction,
+                irradiance,
+                angle,
+            } if angle > 0.0 => Some((-direction, l.color * irradiance, angle)),
+            _ => None,
+        })
+        .collect()
 }
 
 /// A whole backdrop, rows of the frame's width.

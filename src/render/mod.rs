@@ -28,6 +28,7 @@ mod ao_pass;
 mod aovs;
 mod backdrop;
 mod band;
+mod bounce;
 pub mod display;
 mod draw_list;
 mod emitters;
@@ -66,10 +67,11 @@ use crate::raytrace::{Placed, Tracer};
 use crate::scene::camera::Projection;
 use crate::scene::environment::EnvMethod;
 use crate::scene::material::{Native, roughness_from_ns};
-use crate::scene::settings::{AoMethod, ShadingMode, ShadowMethod, TextureFilter};
+use crate::scene::settings::{AoMethod, Background, ShadingMode, ShadowMethod, TextureFilter};
 use crate::scene::{Light, Scene};
 use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
+use crate::shade::env::bounce::Surfaces;
 use crate::shade::env::emitters::Emitters;
 use crate::shade::env::sampled::{EnvSampler, Sampled};
 use crate::shade::refraction::{self, OpaqueFrame};
@@ -395,18 +397,18 @@ impl<'s> Renderer<'s> {
             .collect()
     }
 
-    /// `method = "sampled"`: the sampling tables (built once) and the
-    /// sample count.
-    fn env_sampler(&self) -> Option<(&EnvSampler, u32)> {
+    /// `method = "sampled"`: the sampling tables (built once), the
+    /// sample count and whether light bounces.
+    fn env_sampler(&self) -> Option<(&EnvSampler, u32, bool)> {
         let e = self.scene.environment.as_ref()?;
-        let EnvMethod::Sampled { samples } = e.method else {
+        let EnvMethod::Sampled { samples, bounces } = e.method else {
             return None;
         };
         let sampler = self
             .env_sampler
             .get_or_init(|| Some(EnvSampler::new(&e.image, e.intensity, e.rotation)))
             .as_ref()?;
-        Some((sampler, samples))
+        Some((sampler, samples, bounces > 0))
     }
 
     /// Whether frames lit by `lights` trace rays through the BVHs:
@@ -516,15 +518,22 @@ impl<'s> Renderer<'s> {
             Some(_) => emitters::emitters(setup, &verts),
             None => Emitters::default(),
         };
+        let surfaces = bounce::FrameSurfaces {
+            setup,
+            verts: &verts,
+        };
         let mut ctx = shade_context(setup, &mips, &shadows, env);
-        ctx.env_sampled = sampled
-            .zip(tracer.as_ref())
-            .map(|((env, samples), tracer)| Sampled {
-                env,
-                tracer,
-                emitters: &emitters,
-                samples,
-            });
+        ctx.env_sampled =
+            sampled
+                .zip(tracer.as_ref())
+                .map(|((sampler, samples, bounces), tracer)| Sampled {
+                    env: sampler,
+                    tracer,
+                    emitters: &emitters,
+                    samples,
+                    surfaces: bounces.then_some(&surfaces as &dyn Surfaces),
+                    light: env,
+                });
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let mut data = fragment::BandInputs::new(
@@ -679,7 +688,10 @@ impl<'s> Renderer<'s> {
                 eye: data.ctx.eye,
                 forward: data.ctx.forward,
             };
-            let opaque = OpaqueFrame::new((&out.color, &out.depth), out.width, out.height, camera);
+            let sky = data.setup.scene.settings.background == Background::Environment;
+            let opaque = OpaqueFrame::new((&out.color, &out.depth), out.width, out.height, camera)
+                .sky_behind(sky)
+                .image_lights(backdrop::image_discs(data.setup));
             // One `bands` call per frame's inputs: set here only.
             let _ = data.ctx.refraction.set(opaque);
             out.color

@@ -16,6 +16,10 @@ pub enum EnvMethod {
     Sampled {
         /// Directions of each kind per point (default 64).
         samples: u32,
+        /// Bounces between surfaces: 1 (default) counts what a ray that
+        /// meets a surface brings from it (`shade::env::bounce`), 0 counts
+        /// it as dark.
+        bounces: u32,
     },
 }
 

@@ -14,19 +14,25 @@
 //! - reads the opaque frame where that point projects, at the level of
 //!   detail log2(frame size) x roughness x clamp(2 ior - 2, 0, 1) (the
 //!   sample viewer's blur by roughness);
-//! - where the point leaves the screen or lies behind the camera, reads
-//!   the environment along the bent ray at the surface's roughness (the
-//!   frame's border colour without an environment).
+//! - where the point leaves the screen, lies behind the camera or lands
+//!   on a background that shows the environment, reads the environment
+//!   along the bent ray, blurred by the transmitted lobe's spread
+//!   (`spread_through`), with the lights taken out of the image put back
+//!   (the frame's border colour without an environment).
 //!
 //! The shading then multiplies this by the surface's transmittance (base
 //! colour, 1 - reflection, Beer's law along the thickness). What lies
 //! behind is the opaque frame only: other blended or transmissive
 //! surfaces do not show through a transmissive one, as in the viewers.
+//!
+//! `method = "sampled"` traces the refracted ray instead (`traced`).
 
-use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
+use glam::{Mat4, Vec2, Vec3, Vec4, Vec4Swizzles};
 use rayon::prelude::*;
 
-use super::env::EnvLight;
+use super::env::bounce::Scene;
+use super::env::sampled::{alpha, frame, ggx_sample_aniso, point, position_hash};
+use super::env::{Disc, EnvLight};
 
 /// The shaded opaque frame and its mip chain (linear RGB), its depth, and
 /// the camera that maps world points to its pixels.
@@ -37,6 +43,13 @@ pub struct OpaqueFrame {
     /// Level 0's distance along the view axis (+inf: background).
     depth: Vec<f32>,
     camera: Camera,
+    /// The background shows the environment sharp: a ray that lands on
+    /// it reads the environment at the surface's roughness, as where it
+    /// leaves the screen.
+    sky: bool,
+    /// The lights taken out of the environment image, put back where the
+    /// environment is read.
+    discs: Vec<Disc>,
 }
 
 /// What `OpaqueFrame` needs of the frame's camera.
@@ -117,6 +130,30 @@ pub struct RefractedRay {
     pub roughness: f32,
 }
 
+impl RefractedRay {
+    /// What `seen(ior)` gives at the volume's index (1.5 where it is not a
+    /// number of at least 1). With dispersion, in a volume, red bends
+    /// least and blue most: each channel is read through its own index,
+    /// (ior - 1) / 40 x dispersion either side of green's (the extension's
+    /// sample viewer).
+    fn per_channel(&self, seen: impl Fn(f32) -> Vec3) -> Vec3 {
+        let ior = if self.ior.is_finite() && self.ior >= 1.0 {
+            self.ior
+        } else {
+            1.5
+        };
+        let solid = self.thickness > 0.0 && self.thickness.is_finite();
+        if self.dispersion > 0.0 && self.dispersion.is_finite() && solid {
+            let half = (ior - 1.0) * 0.025 * self.dispersion;
+            let red = seen((ior - half).max(1.0));
+            let green = seen(ior);
+            let blue = seen(ior + half);
+            return Vec3::new(red.x, green.y, blue.z);
+        }
+        seen(ior)
+    }
+}
+
 /// Where a point or direction lands in the frame.
 enum Landing {
     /// On screen, at these level-0 pixel coordinates.
@@ -157,7 +194,26 @@ impl OpaqueFrame {
                 vec![f32::INFINITY]
             },
             camera,
+            sky: false,
+            discs: Vec::new(),
         }
+    }
+
+    /// The frame's background is the environment itself (`output.background
+    /// = "environment"`): rays landing on it read the environment, blurred
+    /// by roughness as a path tracer's rough glass blurs it, rather than
+    /// the frame's pixels, whose blur by the mip chain differs from it and
+    /// would show the screen's edge as a seam.
+    pub fn sky_behind(mut self, sky: bool) -> OpaqueFrame {
+        self.sky = sky;
+        self
+    }
+
+    /// The lights taken out of the environment image: rays that read the
+    /// environment see them too (a lamp through clear glass).
+    pub fn image_lights(mut self, discs: Vec<Disc>) -> OpaqueFrame {
+        self.discs = discs;
+        self
     }
 
     /// Trilinear read at (x, y) in level-0 pixels, level of detail `lod`.
@@ -201,36 +257,23 @@ impl OpaqueFrame {
     /// (+inf: background or off screen).
     fn depth_behind(&self, p: Vec3) -> f32 {
         match self.land(p.extend(1.0)) {
-            Landing::On(x, y) => {
-                let w = self.levels[0].width;
-                let (x, y) = (x as usize, y as usize);
-                self.depth[y.min(self.levels[0].height - 1) * w + x.min(w - 1)]
-            }
+            Landing::On(x, y) => self.depth_at(x, y),
             Landing::Off(..) => f32::INFINITY,
         }
+    }
+
+    /// The view-axis distance at level-0 pixel (x, y).
+    fn depth_at(&self, x: f32, y: f32) -> f32 {
+        let w = self.levels[0].width;
+        let (x, y) = (x as usize, y as usize);
+        self.depth[y.min(self.levels[0].height - 1) * w + x.min(w - 1)]
     }
 
     /// What the fragment sees through itself: the opaque frame where the
     /// refracted ray meets the surface behind, blurred by roughness, or
     /// the environment where it leaves the screen.
     pub fn through(&self, r: &RefractedRay, env: Option<&EnvLight>) -> Vec3 {
-        let ior = if r.ior.is_finite() && r.ior >= 1.0 {
-            r.ior
-        } else {
-            1.5
-        };
-        let solid = r.thickness > 0.0 && r.thickness.is_finite();
-        if r.dispersion > 0.0 && r.dispersion.is_finite() && solid {
-            // Red bends least, blue most: each channel through its own
-            // index, (ior - 1) / 40 x dispersion either side of green's (the
-            // extension's sample viewer).
-            let half = (ior - 1.0) * 0.025 * r.dispersion;
-            let red = self.through_at(r, (ior - half).max(1.0), env);
-            let green = self.through_at(r, ior, env);
-            let blue = self.through_at(r, ior + half, env);
-            return Vec3::new(red.x, green.y, blue.z);
-        }
-        self.through_at(r, ior, env)
+        r.per_channel(|ior| self.through_at(r, ior, env))
     }
 
     /// `through` at index of refraction `ior`.
@@ -239,6 +282,7 @@ impl OpaqueFrame {
         let l0 = &self.levels[0];
         let blur = r.roughness.clamp(0.0, 1.0) * (2.0 * ior - 2.0).clamp(0.0, 1.0);
         let lod = (l0.width.max(l0.height) as f32).log2() * blur;
+        let rough = spread_through(r, ior);
         // The opaque surface behind the fragment, taken as a plane facing
         // the camera at its depth; the background lies at infinity.
         let (eye, forward) = (self.camera.eye, self.camera.forward);
@@ -251,11 +295,95 @@ impl OpaqueFrame {
             out.extend(0.0)
         };
         match (self.land(target), env) {
+            (Landing::On(x, y), Some(env)) if self.sky && self.depth_at(x, y).is_infinite() => {
+                env.seen(out, rough, &self.discs)
+            }
             (Landing::On(x, y), _) => self.read(x, y, lod),
-            (Landing::Off(..), Some(env)) => env.prefiltered(out, r.roughness.clamp(0.0, 1.0)),
+            (Landing::Off(..), Some(env)) => env.seen(out, rough, &self.discs),
             (Landing::Off(x, y), None) => self.read(x, y, lod),
         }
     }
+}
+
+/// `method = "sampled"` (with `bounces = 1`): what a transmissive
+/// fragment sees through itself, traced. The view ray refracts into the
+/// surface; in a volume (thickness > 0) it is followed to the surface
+/// where it leaves (one that transmits), refracted out (totally
+/// reflected inside, up to 8 times, where Snell's law allows no exit),
+/// and what it then meets is counted as the bounce counts it: the
+/// environment, or the light a surface reflects. An opaque surface
+/// inside the volume (a bulb's filament) is seen where the ray meets it.
+/// A thin wall lets the ray straight through. A rough surface turns each
+/// of `samples` paths by a microfacet normal drawn from its GGX lobe (at
+/// entry and exit). With dispersion, each
+/// channel takes its own index, as `through` does.
+pub fn traced(scene: &Scene, r: &RefractedRay, samples: u32) -> Vec3 {
+    r.per_channel(|ior| traced_at(scene, r, ior, samples))
+}
+
+/// `traced` at index of refraction `ior`: the mean over its paths.
+fn traced_at(scene: &Scene, r: &RefractedRay, ior: f32, samples: u32) -> Vec3 {
+    let rough = r.roughness.clamp(0.0, 1.0);
+    // Smooth glass sends every path the same way, but what a path
+    // meets is itself a Monte Carlo estimate (`Scene::seen`): all of
+    // them average it.
+    let paths = samples.clamp(1, 256);
+    let shift = position_hash(r.position);
+    let a = alpha(rough);
+    let sum: Vec3 = (0..paths)
+        .map(|i| traced_path(scene, r, (ior, a, rough > 0.0), point(i, paths, shift)))
+        .sum();
+    sum / paths as f32
+}
+
+/// One path of `traced_at`: (ior, GGX alpha, rough) and the path's two
+/// numbers in [0, 1).
+fn traced_path(
+    scene: &Scene,
+    r: &RefractedRay,
+    (ior, a, rough): (f32, f32, bool),
+    xi: Vec2,
+) -> Vec3 {
+    let eps = scene.tracer.epsilon;
+    let facet = |n: Vec3, u: Vec2| {
+        if rough {
+            ggx_sample_aniso(frame(n), a, a, u)
+        } else {
+            n
+        }
+    };
+    let (n, v) = (r.normal, r.view);
+    if r.thickness <= 0.0 || !r.thickness.is_finite() {
+        return scene.seen(r.position - n * eps, -v, xi);
+    }
+    let mut d = refract(-v, facet(n, xi), 1.0 / ior);
+    if d.dot(n) >= 0.0 {
+        // The drawn facet sent the ray back out: straight on instead.
+        d = -v;
+    }
+    let mut o = r.position - n * eps;
+    let turn = Vec2::new(xi.y, xi.x);
+    for _ in 0..8 {
+        let Some(hit) = scene.tracer.nearest(o, d, f32::INFINITY) else {
+            return scene.sampler.radiance(d);
+        };
+        let Some(b) = scene.surfaces.at(hit, o, d) else {
+            return Vec3::ZERO;
+        };
+        if b.transmission < 0.5 {
+            return b.emitted + scene.reflected(&b, -d, xi);
+        }
+        // The normal met faces the inside, where the ray comes from.
+        let out = refract(d, facet(b.normal, turn), ior);
+        if out.dot(b.normal) > 0.0 {
+            // Totally reflected: on inside.
+            o = b.position + b.geometric * eps;
+            d = out;
+            continue;
+        }
+        return scene.seen(b.position - b.geometric * eps, out, xi);
+    }
+    Vec3::ZERO
 }
 
 /// The ray through the volume: into it at the surface by Snell's law,
@@ -275,6 +403,31 @@ fn bend(r: &RefractedRay, ior: f32) -> (Vec3, Vec3) {
     let exit = r.position + d * (r.thickness * cos);
     let n_exit = n + d * (2.0 * cos);
     (exit, refract(d, -n_exit, ior))
+}
+
+/// The roughness at which the environment is read through a rough
+/// volume: the width of the transmitted lobe in the units of a reflected
+/// one. A facet tilted by d turns a reflected ray by 2d, a refracted one
+/// by e d, where e = 1 - cos(in) / (eta cos(out)) at each face. Through a
+/// ball (the shape `bend` assumes), the exit face turns the ray by
+/// e_exit d and the entry face's turn reaches the exit at about half its
+/// size, so the spread is sqrt((e_entry / 2)^2 + e_exit^2) d (0.53 d
+/// head-on at ior 1.5, 1.5 d at 60 degrees), and GGX alpha scales by
+/// that over 2 (perceptual roughness by its square root; at most 1). A
+/// thin wall reads at the surface's roughness.
+fn spread_through(r: &RefractedRay, ior: f32) -> f32 {
+    let rough = r.roughness.clamp(0.0, 1.0);
+    if r.thickness <= 0.0 || !r.thickness.is_finite() || rough == 0.0 {
+        return rough;
+    }
+    let cos_i = r.normal.dot(r.view).clamp(1e-3, 1.0);
+    let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (ior * ior)).max(0.0).sqrt();
+    let entry = 1.0 - cos_i / (ior * cos_t).max(1e-3);
+    // The exit face meets the ray at the entry's refracted angle and
+    // sends it out at the entry's incident one.
+    let exit = 1.0 - ior * cos_t / cos_i;
+    let spread = ((0.5 * entry).powi(2) + exit * exit).sqrt();
+    (rough * (spread / 2.0).min(1.0).sqrt()).min(1.0)
 }
 
 /// Snell's law: `i` (unit, towards the surface) through the unit normal
@@ -431,6 +584,24 @@ mod tests {
             roughness: 0.0,
         };
         assert_eq!(f.through(&r, None).x, 7.0);
+    }
+
+    #[test]
+    fn each_channel_takes_the_index_the_extension_gives_it() {
+        // ior 1.5, dispersion 4 (Abbe number 5): h = 0.5 / 40 x 4 = 0.05.
+        let mut r = on_ball(Vec3::Z, 0.5, 0.0, 1.5);
+        r.dispersion = 4.0;
+        let got = r.per_channel(Vec3::splat);
+        assert!(
+            (got - Vec3::new(1.45, 1.5, 1.55)).abs().max_element() < 1e-6,
+            "{got}"
+        );
+        // A thin wall, or no dispersion: one index; a bad one reads 1.5.
+        r.thickness = 0.0;
+        assert_eq!(r.per_channel(Vec3::splat), Vec3::splat(1.5));
+        let mut r = on_ball(Vec3::Z, 0.5, 0.0, f32::NAN);
+        r.dispersion = 0.0;
+        assert_eq!(r.per_channel(Vec3::splat), Vec3::splat(1.5));
     }
 
     #[test]

@@ -425,9 +425,10 @@ fn out_of_range_volume_values_warn_naming_the_file_and_the_material() {
 /// The linear colours across the middle row of a 64x64 frame: a glass
 /// ball (radius 0.5, ior 1.5, `volume`: its KHR_materials_volume JSON)
 /// 2 in front of a backdrop that glows red left of x = 0 and blue right
-/// of it, seen from 4 in front of the ball. No light and no environment:
-/// what the ball shows is what it lets through.
-fn ball_over_backdrop(name: &str, volume: &str) -> Vec<Vec3> {
+/// of it, seen from 4 in front of the ball. No light and no environment
+/// (`extra`: more of the scene's TOML): what the ball shows is what it
+/// lets through.
+fn ball_over_backdrop(name: &str, volume: &str, extra: &str) -> Vec<Vec3> {
     let dir = common::scratch(name);
     let b = softraster::procedural::sphere(0.5, 96, 48);
     let ball = common::Prim {
@@ -457,21 +458,35 @@ fn ball_over_backdrop(name: &str, volume: &str) -> Vec<Vec3> {
     let scene = "[output]\nwidth = 64\nheight = 64\n[render]\nmsaa = 1\n[ambient]\ncolor = [0.0, 0.0, 0.0]\n\
          [[model]]\npath = \"b.obj\"\n[[model]]\npath = \"ball.gltf\"\n\
          [[camera]]\neye = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 30.0\n";
-    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    std::fs::write(dir.join("s.toml"), format!("{scene}{extra}")).unwrap();
     let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
     let f = render_frame(&s, 0, 0);
     (0..64).map(|x| f.color[32 * 64 + x].truncate()).collect()
 }
 
+/// `method = "sampled"` in the dark: the ball's refraction is traced
+/// through it (`shade::refraction::traced`), what it shows is the
+/// backdrop's glow.
+const SAMPLED_DARK: &str =
+    "[environment]\npreset = \"neutral\"\nintensity = 0.0\nmethod = \"sampled\"\nsamples = 4\n";
+
 #[test]
 fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
+    // In screen space (the default) and traced (`sampled`).
+    for (mode, extra) in [("", ""), ("_sampled", SAMPLED_DARK)] {
+        upside_down_through_the_ball(mode, extra);
+    }
+}
+
+fn upside_down_through_the_ball(mode: &str, extra: &str) {
     // The ball covers x = 32 +- 15 pixels. Left of its centre, a solid
     // ball (thickness = its diameter) is a lens that shows the backdrop's
     // right half, and right of its centre the left half; the backdrop
     // beside it keeps its own colour.
     let solid = ball_over_backdrop(
-        "gltf_refraction_ball",
+        &format!("gltf_refraction_ball{mode}"),
         r#", "KHR_materials_volume": {"thicknessFactor": 1.0}"#,
+        extra,
     );
     let red = |c: Vec3| c.x > 0.5 && c.z < 0.1;
     let blue = |c: Vec3| c.z > 0.5 && c.x < 0.1;
@@ -482,18 +497,18 @@ fn a_glass_ball_refracts_the_backdrop_upside_down_and_a_thin_wall_does_not() {
         solid[58]
     );
     for x in [24, 27] {
-        assert!(blue(solid[x]), "solid ball at x = {x}: {}", solid[x]);
+        assert!(blue(solid[x]), "{mode} solid ball at x = {x}: {}", solid[x]);
     }
     for x in [36, 39] {
-        assert!(red(solid[x]), "solid ball at x = {x}: {}", solid[x]);
+        assert!(red(solid[x]), "{mode} solid ball at x = {x}: {}", solid[x]);
     }
     // A thin wall (no volume) lets the backdrop straight through.
-    let thin = ball_over_backdrop("gltf_refraction_thin", "");
+    let thin = ball_over_backdrop(&format!("gltf_refraction_thin{mode}"), "", extra);
     for x in [24, 27] {
-        assert!(red(thin[x]), "thin wall at x = {x}: {}", thin[x]);
+        assert!(red(thin[x]), "{mode} thin wall at x = {x}: {}", thin[x]);
     }
     for x in [36, 39] {
-        assert!(blue(thin[x]), "thin wall at x = {x}: {}", thin[x]);
+        assert!(blue(thin[x]), "{mode} thin wall at x = {x}: {}", thin[x]);
     }
 }
 
@@ -681,19 +696,40 @@ fn khr_materials_dispersion_bends_red_and_blue_by_their_own_indices() {
     // index) and blue (a higher one) move each their own way; green keeps
     // the material's index and lands where it did without dispersion.
     let solid = r#", "KHR_materials_volume": {"thicknessFactor": 1.0}"#;
-    let plain = ball_over_backdrop("gltf_dispersion_none", solid);
+    // (Traced, under `sampled`, the edge on the axis stays on the axis at
+    // every index: `shade::refraction` tests the indices both methods
+    // take.)
+    let plain = ball_over_backdrop("gltf_dispersion_none", solid, "");
     let spread = ball_over_backdrop(
         "gltf_dispersion",
         &format!(r#"{solid}, "KHR_materials_dispersion": {{"dispersion": 6.0}}"#),
+        "",
     );
+    moved_apart(&plain, &spread, "screen space");
+}
+
+/// Red and blue moved between `plain` and `spread`, green did not.
+fn moved_apart(plain: &[Vec3], spread: &[Vec3], mode: &str) {
     let most = |channel: fn(&Vec3) -> f32| {
         plain
             .iter()
-            .zip(&spread)
+            .zip(spread)
             .map(|(a, b)| (channel(a) - channel(b)).abs())
             .fold(0.0f32, f32::max)
     };
-    assert!(most(|c| c.y) < 1e-6, "green moved by {}", most(|c| c.y));
-    assert!(most(|c| c.x) > 0.05, "red moved by {}", most(|c| c.x));
-    assert!(most(|c| c.z) > 0.05, "blue moved by {}", most(|c| c.z));
+    assert!(
+        most(|c| c.y) < 1e-6,
+        "{mode}: green moved by {}",
+        most(|c| c.y)
+    );
+    assert!(
+        most(|c| c.x) > 0.05,
+        "{mode}: red moved by {}",
+        most(|c| c.x)
+    );
+    assert!(
+        most(|c| c.z) > 0.05,
+        "{mode}: blue moved by {}",
+        most(|c| c.z)
+    );
 }

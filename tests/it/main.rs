@@ -4,6 +4,7 @@
 
 mod common;
 
+mod bounce;
 mod display;
 mod emitters;
 mod framing;

@@ -412,7 +412,10 @@ fn the_sampled_environment_is_the_same_at_every_width() {
     for (file, frame) in [("showcase.toml", 4), ("walker.toml", 10)] {
         let scene = load_with(&scenes.join(file), &sampled);
         let env = scene.environment.as_ref().map(|e| e.method);
-        let reference = softraster::scene::environment::EnvMethod::Sampled { samples: 4 };
+        let reference = softraster::scene::environment::EnvMethod::Sampled {
+            samples: 4,
+            bounces: 1,
+        };
         assert_eq!(env, Some(reference));
         same_at_every_width(&scene, &[frame], &format!("{file} sampled"));
         let mut one = sampled.to_vec();

@@ -256,6 +256,18 @@ fn bad_environments_are_refused_by_name() {
             "{err}"
         );
     }
+    // Bounces other than 0 or 1.
+    for bad in [
+        "method = \"sampled\"\nbounces = 2",
+        "method = \"sampled\"\nbounces = -1",
+    ] {
+        let (code, _, err) = run(bad);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("environment.bounces") && err.contains("s.toml:"),
+            "{err}"
+        );
+    }
     // And a good one renders.
     let (code, _, err) = run("intensity = 2.0\nlights = 16");
     assert_eq!(code, 0, "{err}");

@@ -466,6 +466,7 @@ fn environment(
     let method = match e.method.as_ref().map(|m| *m.get_ref()) {
         Some(desc::EnvMethodName::Sampled) => EnvMethod::Sampled {
             samples: get(&e.samples, 64) as u32,
+            bounces: get(&e.bounces, 1) as u32,
         },
         _ => EnvMethod::Prefiltered,
     };

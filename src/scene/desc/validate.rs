@@ -61,6 +61,7 @@ pub(super) fn validate_environment(c: &Ctx, e: &Spanned<EnvironmentDesc>) -> Res
     c.float_range(&e.intensity, "environment.intensity", 0.0, 1e9)?;
     c.finite(&e.rotation, "environment.rotation")?;
     c.int_range(&e.samples, "environment.samples", 1, 65536)?;
+    c.int_range(&e.bounces, "environment.bounces", 0, 1)?;
     c.int_range(&e.prefilter_size, "environment.prefilter_size", 8, 2048)?;
     c.int_range(&e.lights, "environment.lights", 0, 16)?;
     Ok(())

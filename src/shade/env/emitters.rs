@@ -96,6 +96,30 @@ impl Emitters {
     }
 }
 
+/// The light point `q` sends towards `p` as the lobe `f_cos` takes it:
+/// f cos L cos_q / (d^2 pdf_area), where `visible(l, d)` (the unit
+/// direction and the distance to `q`); zero where it is hidden.
+pub fn from_emitter(
+    q: &EmitterPoint,
+    p: Vec3,
+    f_cos: &impl Fn(Vec3) -> Vec3,
+    visible: impl Fn(Vec3, f32) -> bool,
+) -> Vec3 {
+    let to = q.at - p;
+    let d2 = to.length_squared();
+    if d2 <= 0.0 || !d2.is_finite() {
+        return Vec3::ZERO;
+    }
+    let d = d2.sqrt();
+    let l = to / d;
+    let cos_q = q.normal.dot(l).abs();
+    let fc = f_cos(l);
+    if cos_q <= 0.0 || fc == Vec3::ZERO || !visible(l, d) {
+        return Vec3::ZERO;
+    }
+    fc * q.radiance * (cos_q / (d2 * q.pdf_area))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

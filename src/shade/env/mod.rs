@@ -24,8 +24,14 @@ use rayon::prelude::*;
 
 use crate::assets::environment::EnvImage;
 
+pub use discs::{Disc, disc_lobe};
+
+pub mod bounce;
+mod discs;
 pub mod emitters;
+mod image_sampler;
 mod octahedral;
+mod pattern;
 pub mod sampled;
 
 use octahedral::Octahedral;
@@ -422,6 +428,18 @@ impl EnvLight {
         let (u, v) = direction_to_uv_lanes(self.to_env(V3::<f32>::from(d)));
         let level = self.backdrop.as_ref().unwrap_or(&self.levels[0]);
         Vec3::from(level.sample_uv(u, v)) * self.intensity
+    }
+
+    /// What the image shows along `d` blurred to perceptual `roughness`,
+    /// with the lights taken out of it (`discs`) put back: the image as
+    /// read at 0, else the prefiltered level plus each light's GGX lobe.
+    /// The blurred background and what rough glass shows both read it.
+    pub fn seen(&self, d: Vec3, roughness: f32, discs: &[Disc]) -> Vec3 {
+        if roughness <= 0.0 {
+            return self.radiance(d);
+        }
+        let lights: Vec3 = discs.iter().map(|&l| disc_lobe(d, roughness, l)).sum();
+        self.prefiltered(d, roughness) + lights
     }
 
     /// Radiance along reflection direction `r` (world space), prefiltered

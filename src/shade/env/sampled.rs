@@ -15,116 +15,14 @@ use std::f32::consts::PI;
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::emitters::{EmitterPoint, Emitters};
-use super::{direction_to_uv, uv_to_direction};
-use crate::assets::environment::EnvImage;
+use super::EnvLight;
+use super::bounce::{self, Surfaces};
+use super::emitters::{Emitters, from_emitter};
+pub use super::image_sampler::EnvSampler;
+use super::image_sampler::luminance;
+pub(crate) use super::pattern::{frame, point, position_hash};
 use crate::raytrace::Tracer;
 use crate::shade::pbr::{self, PbrColor};
-
-/// Luminance-proportional sampling of an environment image.
-#[derive(Debug, Clone)]
-pub struct EnvSampler {
-    width: usize,
-    height: usize,
-    texels: Vec<Vec3>,
-    /// Per row: the cumulative weight of the rows above and including it.
-    rows: Vec<f32>,
-    /// Per texel: the cumulative weight within its row.
-    cols: Vec<f32>,
-    /// Per texel: its sampling weight (luminance plus a floor, times sin).
-    weight: Vec<f32>,
-    total: f32,
-    env_from_world: Mat3,
-    world_from_env: Mat3,
-    intensity: f32,
-}
-
-fn luminance(c: Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-impl EnvSampler {
-    pub fn new(image: &EnvImage, intensity: f32, rotation_deg: f32) -> EnvSampler {
-        let (w, h) = (image.width as usize, image.height as usize);
-        let mean = image.texels.iter().map(|c| luminance(*c)).sum::<f32>() / (w * h) as f32;
-        // A floor of a tenth of the mean: no direction has zero density.
-        let floor = 0.1 * mean.max(1e-6);
-        let mut weight = vec![0.0f32; w * h];
-        let mut cols = vec![0.0f32; w * h];
-        let mut rows = vec![0.0f32; h];
-        let mut total = 0.0f32;
-        for (y, row_end) in rows.iter_mut().enumerate() {
-            let sin = ((y as f32 + 0.5) / h as f32 * PI).sin();
-            let mut acc = 0.0f32;
-            for x in 0..w {
-                let i = y * w + x;
-                weight[i] = (luminance(image.texels[i]) + floor) * sin;
-                acc += weight[i];
-                cols[i] = acc;
-            }
-            total += acc;
-            *row_end = total;
-        }
-        let world_from_env = Mat3::from_rotation_y(rotation_deg.to_radians());
-        EnvSampler {
-            width: w,
-            height: h,
-            texels: image.texels.clone(),
-            rows,
-            cols,
-            weight,
-            total,
-            env_from_world: world_from_env.transpose(),
-            world_from_env,
-            intensity,
-        }
-    }
-
-    /// The texel a direction (environment space) falls in.
-    fn texel(&self, d: Vec3) -> usize {
-        let uv = direction_to_uv(d);
-        let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);
-        let y = ((uv.y * self.height as f32) as usize).min(self.height - 1);
-        y * self.width + x
-    }
-
-    /// Radiance from world direction `d`.
-    pub fn radiance(&self, d: Vec3) -> Vec3 {
-        self.texels[self.texel(self.env_from_world * d)] * self.intensity
-    }
-
-    /// Density (per steradian) of drawing world direction `d`.
-    pub fn pdf(&self, d: Vec3) -> f32 {
-        let i = self.texel(self.env_from_world * d);
-        let y = i / self.width;
-        let sin = ((y as f32 + 0.5) / self.height as f32 * PI).sin();
-        let texel_omega = (2.0 * PI / self.width as f32) * (PI / self.height as f32) * sin;
-        if texel_omega <= 0.0 {
-            return 0.0;
-        }
-        self.weight[i] / self.total / texel_omega
-    }
-
-    /// A world direction drawn from `xi` (uniform in [0, 1)^2).
-    pub fn sample(&self, xi: Vec2) -> Vec3 {
-        let t = xi.y * self.total;
-        let y = self.rows.partition_point(|&r| r <= t).min(self.height - 1);
-        let row = &self.cols[y * self.width..(y + 1) * self.width];
-        let before = if y == 0 { 0.0 } else { self.rows[y - 1] };
-        let row_total = row[self.width - 1].max(1e-30);
-        let tx = (xi.x * row_total).min(row_total * 0.999_999);
-        let x = row.partition_point(|&c| c <= tx).min(self.width - 1);
-        // Where within the texel: the leftover of each choice.
-        let start = if x == 0 { 0.0 } else { row[x - 1] };
-        let fx = ((tx - start) / self.weight[y * self.width + x].max(1e-30)).clamp(0.0, 1.0);
-        let fy = ((t - before) / (row_total)).clamp(0.0, 1.0);
-        let uv = Vec2::new(
-            (x as f32 + fx) / self.width as f32,
-            (y as f32 + fy) / self.height as f32,
-        );
-        self.world_from_env * uv_to_direction(uv)
-    }
-}
 
 /// What a sampled estimate integrates at a point.
 pub enum Lobes<'a> {
@@ -137,38 +35,8 @@ pub enum Lobes<'a> {
     },
 }
 
-/// Point `i` of `n` of the Hammersley set, rotated by `shift` (mod 1).
-fn point(i: u32, n: u32, shift: Vec2) -> Vec2 {
-    let p = Vec2::new(
-        i as f32 / n as f32,
-        i.reverse_bits() as f32 * 2.328_306_4e-10,
-    ) + shift;
-    p - p.floor()
-}
-
-/// Two numbers in [0, 1) from a position (the pattern's rotation).
-fn position_hash(p: Vec3) -> Vec2 {
-    let mut h = p.x.to_bits().wrapping_mul(0x9E37_79B1)
-        ^ p.y.to_bits().wrapping_mul(0x85EB_CA77).rotate_left(13)
-        ^ p.z.to_bits().wrapping_mul(0xC2B2_AE3D).rotate_left(7);
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7FEB_352D);
-    h ^= h >> 15;
-    let g = h.wrapping_mul(0x846C_A68B) ^ (h >> 16);
-    Vec2::new(
-        (h >> 8) as f32 / (1u32 << 24) as f32,
-        (g >> 8) as f32 / (1u32 << 24) as f32,
-    )
-}
-
-/// An orthonormal frame whose third axis is `n`.
-fn frame(n: Vec3) -> Mat3 {
-    let t = n.any_orthonormal_vector();
-    Mat3::from_cols(t, n.cross(t), n)
-}
-
 /// GGX alpha of a perceptual roughness.
-fn alpha(roughness: f32) -> f32 {
+pub(crate) fn alpha(roughness: f32) -> f32 {
     (roughness * roughness).max(2e-3)
 }
 
@@ -185,7 +53,7 @@ fn ggx_d_aniso(m: Mat3, ax: f32, ay: f32, h: Vec3) -> f32 {
 
 /// A half vector drawn from D(h) (n.h) of `ggx_d_aniso`: the slopes of
 /// the alpha-1 lobe stretched by the alphas.
-fn ggx_sample_aniso(m: Mat3, ax: f32, ay: f32, u: Vec2) -> Vec3 {
+pub(crate) fn ggx_sample_aniso(m: Mat3, ax: f32, ay: f32, u: Vec2) -> Vec3 {
     let phi = 2.0 * PI * u.x;
     let r = (u.y / (1.0 - u.y).max(1e-7)).sqrt();
     let slope = Vec2::new(ax * r * phi.cos(), ay * r * phi.sin());
@@ -380,6 +248,24 @@ pub struct Sampled<'a> {
     pub tracer: &'a Tracer<'a>,
     pub emitters: &'a Emitters,
     pub samples: u32,
+    /// The frame's surfaces, for one bounce (`bounce`); None: a ray that
+    /// meets a surface brings nothing.
+    pub surfaces: Option<&'a dyn Surfaces>,
+    /// The prefiltered environment, for the bounce's specular lobes.
+    pub light: Option<&'a EnvLight>,
+}
+
+impl<'a> Sampled<'a> {
+    /// The frame's scene as rays meet it, where light bounces.
+    pub fn bounce(&self) -> Option<bounce::Scene<'a>> {
+        self.surfaces.map(|surfaces| bounce::Scene {
+            sampler: self.env,
+            light: self.light,
+            tracer: self.tracer,
+            surfaces,
+            emitters: self.emitters,
+        })
+    }
 }
 
 /// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
@@ -396,7 +282,14 @@ pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lo
         let off = if n.dot(l) < 0.0 { -ng } else { ng };
         p + off * tracer.epsilon
     };
-    let visible = |l: Vec3| !tracer.occluded(start(l), l, f32::INFINITY);
+    // What arrives along a ray: the environment where nothing is in the
+    // way; with the frame's surfaces, what the one met reflects.
+    let bounce = s.bounce();
+    let incoming = |l: Vec3, xi: Vec2| match &bounce {
+        Some(b) => b.incoming(start(l), l, xi),
+        None if tracer.occluded(start(l), l, f32::INFINITY) => Vec3::ZERO,
+        None => env.radiance(l),
+    };
     let shift = position_hash(p);
     let mut sum = Vec3::ZERO;
     for i in 0..samples {
@@ -404,17 +297,17 @@ pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lo
         let xi = point(i, samples, shift);
         let l = env.sample(xi);
         let fc = f_cos(l);
-        if fc != Vec3::ZERO && visible(l) {
+        if fc != Vec3::ZERO {
             let pe = env.pdf(l);
-            sum += fc * env.radiance(l) / (pe + mix.pdf(l)).max(1e-12);
+            sum += fc * incoming(l, xi) / (pe + mix.pdf(l)).max(1e-12);
         }
         // From the BRDF.
         let xi = point(i, samples, Vec2::new(shift.y, shift.x));
         let l = mix.sample(xi);
         let fc = f_cos(l);
-        if fc != Vec3::ZERO && visible(l) {
+        if fc != Vec3::ZERO {
             let pb = mix.pdf(l);
-            sum += fc * env.radiance(l) / (env.pdf(l) + pb).max(1e-12);
+            sum += fc * incoming(l, xi) / (env.pdf(l) + pb).max(1e-12);
         }
         // From the emitters (the rays above that reach one count as
         // blocked: each emitter is counted here alone).
@@ -425,28 +318,4 @@ pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lo
         }
     }
     sum / samples as f32
-}
-
-/// The light point `q` sends towards `p` as the lobe `f_cos` takes it:
-/// f cos L cos_q / (d^2 pdf_area), where `visible(l, d)` (the unit
-/// direction and the distance to `q`); zero where it is hidden.
-fn from_emitter(
-    q: &EmitterPoint,
-    p: Vec3,
-    f_cos: &impl Fn(Vec3) -> Vec3,
-    visible: impl Fn(Vec3, f32) -> bool,
-) -> Vec3 {
-    let to = q.at - p;
-    let d2 = to.length_squared();
-    if d2 <= 0.0 || !d2.is_finite() {
-        return Vec3::ZERO;
-    }
-    let d = d2.sqrt();
-    let l = to / d;
-    let cos_q = q.normal.dot(l).abs();
-    let fc = f_cos(l);
-    if cos_q <= 0.0 || fc == Vec3::ZERO || !visible(l, d) {
-        return Vec3::ZERO;
-    }
-    fc * q.radiance * (cos_q / (d2 * q.pdf_area))
 }

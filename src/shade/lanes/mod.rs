@@ -22,7 +22,7 @@
 use glam::{Mat3, Vec2, Vec3, Vec4};
 
 use super::light::{LightMask, LightSet};
-use super::refraction::RefractedRay;
+use super::refraction::{self, RefractedRay};
 use super::{Fetch, ShadeContext};
 use crate::assets::texture::Footprint;
 use crate::scene::light::{Light, LightKind};
@@ -294,7 +294,16 @@ impl<'a> ShadeContext<'a> {
                             thickness: p.volume.0,
                             roughness: p.roughness,
                         };
-                        let seen = frame.through(&ray, self.env);
+                        // `sampled` traces the refracted ray; the
+                        // default reads the opaque frame.
+                        let seen = match self
+                            .env_sampled
+                            .as_ref()
+                            .and_then(|s| s.bounce().map(|scene| (scene, s.samples)))
+                        {
+                            Some((scene, samples)) => refraction::traced(&scene, &ray, samples),
+                            None => frame.through(&ray, self.env),
+                        };
                         (c.lane(k) + t * seen, Vec3::ZERO, opacity)
                     }
                     None => (c.lane(k), t, opacity),

@@ -407,7 +407,14 @@ fn sweep_env(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Res
         }
     };
     let reference = if opts.quick { 64 } else { 256 };
-    set(scene, EnvMethod::Sampled { samples: reference }, original.1);
+    set(
+        scene,
+        EnvMethod::Sampled {
+            samples: reference,
+            bounces: 1,
+        },
+        original.1,
+    );
     let (_, reference_img, t) = timed(scene, opts.frame, 1)?;
     let against = format!("sampled {reference}");
     let (t, e) = reference_row(scene, opts, t, |_, img| flip(&reference_img, img, None))?;
@@ -437,7 +444,14 @@ fn sweep_env(scene: &mut Scene, opts: &ChartOptions, rows: &mut Vec<Row>) -> Res
     }
     let counts: &[u32] = if opts.quick { &[4, 16] } else { &[4, 16, 64] };
     for &samples in counts {
-        set(scene, EnvMethod::Sampled { samples }, original.1);
+        set(
+            scene,
+            EnvMethod::Sampled {
+                samples,
+                bounces: 1,
+            },
+            original.1,
+        );
         let (_, img, t) = timed(scene, opts.frame, opts.runs)?;
         let e = flip(&reference_img, &img, None)?;
         rows.push(row(

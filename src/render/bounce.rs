@@ -1,0 +1,215 @@
+//! The frame's surfaces as `method = "sampled"`'s bounce meets them
+//! (`shade::env::bounce`): the triangle a ray hit, placed as this frame
+//! places it, with its material's reflectance where the ray met it.
+//!
+//! The material is read plainly: base colour (or Kd) times its map,
+//! bilinear at the point's texture coordinates, times vertex colours;
+//! metallic and roughness with their map; transmission takes its share
+//! from the diffuse colour; emission (or Ke) times its map. Normal maps
+//! and the KHR layers are left out: the bounce carries a fraction of the
+//! light, averaged over many rays.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use super::draw_list::DrawList;
+use super::vertex::ModelVertices;
+use crate::assets::texture::{TextureRef, Wrap};
+use crate::raytrace::TraceHit;
+use crate::scene::material::{Material, roughness_from_ns};
+use crate::scene::settings::ShadingMode;
+use crate::shade::env::bounce::{Bounce, Surfaces};
+use crate::shade::shades_pbr;
+
+/// Every model of one frame, at its vertices' positions.
+pub(super) struct FrameSurfaces<'a> {
+    pub setup: &'a DrawList<'a>,
+    pub verts: &'a [ModelVertices],
+}
+
+/// What a material does with light at one point.
+struct Reflectance {
+    diffuse: Vec3,
+    /// At normal incidence.
+    specular: Vec3,
+    /// Perceptual.
+    roughness: f32,
+    /// The share it lets through.
+    transmission: f32,
+    emitted: Vec3,
+}
+
+impl Surfaces for FrameSurfaces<'_> {
+    fn at(&self, hit: TraceHit, o: Vec3, d: Vec3) -> Option<Bounce> {
+        let model = self.setup.scene.models.get(hit.mesh)?;
+        let mv = self.verts.get(hit.mesh)?;
+        let mesh = &model.mesh;
+        let tri = *mesh.triangles.get(hit.prim as usize)?;
+        let corner = |i: u32| mv.world.get(i as usize).copied();
+        let (a, b, c) = (corner(tri[0])?, corner(tri[1])?, corner(tri[2])?);
+        let position = o + d * hit.t;
+        let w = barycentric(position, (a, b, c))?;
+        let toward = -d;
+        let face = (b - a).cross(c - a).normalize_or_zero();
+        if face == Vec3::ZERO {
+            return None;
+        }
+        let geometric = if face.dot(toward) < 0.0 { -face } else { face };
+        let lerp3 = |v: &[Vec3]| -> Option<Vec3> {
+            let at = |i: u32| v.get(i as usize).copied();
+            Some(at(tri[0])? * w.x + at(tri[1])? * w.y + at(tri[2])? * w.z)
+        };
+        let normal = lerp3(&mv.normal).map_or(geometric, |n| n.normalize_or(geometric));
+        let normal = if normal.dot(toward) < 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        let uv = |set: &[Vec2]| {
+            let at = |i: u32| set.get(i as usize).copied();
+            Some(at(tri[0])? * w.x + at(tri[1])? * w.y + at(tri[2])? * w.z)
+        };
+        let tint = {
+            let at = |i: u32| mesh.colors.get(i as usize).copied();
+            match (at(tri[0]), at(tri[1]), at(tri[2])) {
+                (Some(p), Some(q), Some(r)) => p * w.x + q * w.y + r * w.z,
+                _ => Vec4::ONE,
+            }
+        };
+        let group = mesh
+            .groups
+            .iter()
+            .find(|g| g.triangles.contains(&hit.prim))?;
+        let material = model.materials.get(group.material)?;
+        let read = Reading {
+            uv: (uv(&mesh.uvs), uv(&mesh.uvs1)),
+            wrap: self.setup.scene.settings.address.into(),
+        };
+        let r = reflectance(self.setup.scene.settings.shading, material, &read, tint);
+        Some(Bounce {
+            position,
+            normal,
+            geometric,
+            diffuse: r.diffuse,
+            specular: r.specular,
+            roughness: r.roughness,
+            transmission: r.transmission,
+            emitted: r.emitted,
+        })
+    }
+}
+
+/// How a map is read at the point met.
+struct Reading {
+    /// The point's texture coordinates, sets 0 and 1 (None: the mesh has
+    /// none).
+    uv: (Option<Vec2>, Option<Vec2>),
+    wrap: Wrap,
+}
+
+impl Reading {
+    /// The map's linear RGBA at the point; white where the mesh has no
+    /// coordinates for it.
+    fn map(&self, t: &Option<TextureRef>) -> Vec4 {
+        let Some(t) = t else {
+            return Vec4::ONE;
+        };
+        let uv = if t.texcoord == 1 {
+            self.uv.1
+        } else {
+            self.uv.0
+        };
+        match uv {
+            Some(uv) => t.texture.sample_bilinear(
+                t.transform.transform_point2(uv),
+                t.address.unwrap_or(self.wrap),
+            ),
+            None => Vec4::ONE,
+        }
+    }
+}
+
+/// The material at the point as shading mode `mode` reads it. An unlit
+/// material reflects nothing and shows its colour as if it emitted it.
+fn reflectance(mode: ShadingMode, m: &Material, read: &Reading, tint: Vec4) -> Reflectance {
+    let pbr = shades_pbr(mode, m);
+    if m.unlit {
+        let color = if pbr {
+            m.pbr.base_color * read.map(&m.pbr.base_color_map)
+        } else {
+            m.kd.extend(1.0) * read.map(&m.map_kd)
+        };
+        return Reflectance {
+            diffuse: Vec3::ZERO,
+            specular: Vec3::ZERO,
+            roughness: 1.0,
+            transmission: 0.0,
+            emitted: (color * tint).truncate(),
+        };
+    }
+    if pbr {
+        let p = &m.pbr;
+        let base = (p.base_color * read.map(&p.base_color_map) * tint).truncate();
+        let mr = read.map(&p.metallic_roughness_map);
+        let metal = (p.metallic * mr.z * read.map(&p.metallic_map).x).clamp(0.0, 1.0);
+        let rough = (p.roughness * mr.y * read.map(&p.roughness_map).x).clamp(0.0, 1.0);
+        let through = p
+            .transmission
+            .as_ref()
+            .map_or(0.0, |t| (t.factor * read.map(&t.map).x).clamp(0.0, 1.0));
+        Reflectance {
+            diffuse: base * ((1.0 - metal) * (1.0 - through)),
+            specular: Vec3::splat(0.04).lerp(base, metal),
+            roughness: rough,
+            transmission: through,
+            emitted: p.emissive * read.map(&p.emissive_map).truncate(),
+        }
+    } else {
+        let kd = m.kd * (read.map(&m.map_kd) * tint).truncate();
+        let ks = if m.illum >= 2 {
+            m.ks * read.map(&m.map_ks).truncate()
+        } else {
+            Vec3::ZERO
+        };
+        Reflectance {
+            diffuse: kd,
+            specular: ks,
+            roughness: roughness_from_ns(m.ns),
+            transmission: 0.0,
+            emitted: m.ke * read.map(&m.map_ke).truncate(),
+        }
+    }
+}
+
+/// The barycentric weights of `p` in triangle (a, b, c); None for a
+/// degenerate triangle.
+fn barycentric(p: Vec3, (a, b, c): (Vec3, Vec3, Vec3)) -> Option<Vec3> {
+    let (e0, e1, e2) = (b - a, c - a, p - a);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (e2.dot(e0), e2.dot(e1));
+    let den = d00 * d11 - d01 * d01;
+    if den.abs() <= f32::MIN_POSITIVE || !den.is_finite() {
+        return None;
+    }
+    let v = (d11 * d20 - d01 * d21) / den;
+    let w = (d00 * d21 - d01 * d20) / den;
+    Some(Vec3::new(1.0 - v - w, v, w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn barycentric_weights_rebuild_the_point() {
+        let (a, b, c) = (
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 3.0, 1.0),
+        );
+        let w = Vec3::new(0.2, 0.5, 0.3);
+        let p = a * w.x + b * w.y + c * w.z;
+        let got = barycentric(p, (a, b, c)).unwrap();
+        assert!((got - w).abs().max_element() < 1e-5, "{got}");
+        assert!(barycentric(p, (a, a, a)).is_none());
+    }
+}
