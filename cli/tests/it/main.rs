@@ -15,6 +15,7 @@ mod aov;
 mod camera_paths;
 mod chart;
 mod cli;
+mod cycles;
 mod environment;
 mod golden;
 mod light_culling;

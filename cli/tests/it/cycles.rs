@@ -1,0 +1,66 @@
+//! softraster against Blender Cycles on the scenes of the reference set
+//! cheap enough for a test (`tests/cycles`: 160x120, the glTF scenes of
+//! `benches/cycles/scenes.py` whose files are small, under two HDRIs of
+//! `../shared/assets/hdri`). Each golden is Cycles' frame (128 samples,
+//! denoised, the "Standard" view); the test renders the scene with the
+//! default method and holds mean FLIP within 0.01 of what was measured
+//! when the golden was made (`docs/cycles.md` has the whole set at
+//! 320x240). SKIPPED without the shared HDRIs; a failure under CI.
+
+use crate::binary::run;
+use crate::common::{root, scratch, shared_assets};
+
+/// Renders `tests/cycles/{name}.toml` and measures its mean FLIP against
+/// `{name}-cycles.png`.
+fn flip_against_cycles(name: &str) -> f64 {
+    let dir = root().join("tests/cycles");
+    let out = scratch(&format!("cycles_{name}"));
+    let scene = dir.join(format!("{name}.toml"));
+    let (code, _, err) = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "output.name=frame",
+    ]);
+    assert_eq!(code, 0, "{name}: {err}");
+    let golden = dir.join(format!("{name}-cycles.png"));
+    let frame = out.join("frame.png");
+    let (code, json, err) = run(&[
+        "compare",
+        golden.to_str().unwrap(),
+        frame.to_str().unwrap(),
+        "--metric",
+        "flip",
+        "--json",
+        "--threshold",
+        "1000",
+    ]);
+    assert_eq!(code, 0, "{name}: {err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    v["files"][0]["value"].as_f64().unwrap()
+}
+
+#[test]
+fn the_default_method_stays_as_close_to_cycles_as_measured() {
+    if shared_assets().is_none() {
+        return;
+    }
+    // Measured when the goldens were made (e234314): texture transform
+    // 0.045 and 0.035; anisotropy discs 0.151 and 0.165 (Blender's importer
+    // gives the discs other alphas: `docs/cycles.md`).
+    for (name, measured) in [
+        ("texture-transform-courtyard", 0.0454),
+        ("texture-transform-studio", 0.0353),
+        ("anisotropy-discs-courtyard", 0.1512),
+        ("anisotropy-discs-studio", 0.1645),
+    ] {
+        let flip = flip_against_cycles(name);
+        assert!(
+            flip <= measured + 0.01,
+            "{name}: FLIP {flip:.4} against Cycles, measured {measured}"
+        );
+    }
+}
