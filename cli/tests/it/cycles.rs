@@ -16,28 +16,17 @@ fn flip_against_cycles(name: &str) -> f64 {
     let dir = root().join("tests/cycles");
     let out = scratch(&format!("cycles_{name}"));
     let scene = dir.join(format!("{name}.toml"));
-    let (code, _, err) = run(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--set",
-        "output.name=frame",
-    ]);
+    let (scene, out_dir) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let mut render = vec!["render", scene, "--out", out_dir];
+    render.extend(["--quiet", "--set", "output.name=frame"]);
+    let (code, _, err) = run(&render);
     assert_eq!(code, 0, "{name}: {err}");
     let golden = dir.join(format!("{name}-cycles.png"));
     let frame = out.join("frame.png");
-    let (code, json, err) = run(&[
-        "compare",
-        golden.to_str().unwrap(),
-        frame.to_str().unwrap(),
-        "--metric",
-        "flip",
-        "--json",
-        "--threshold",
-        "1000",
-    ]);
+    let (golden, frame) = (golden.to_str().unwrap(), frame.to_str().unwrap());
+    let mut compare = vec!["compare", golden, frame];
+    compare.extend(["--metric", "flip", "--json", "--threshold", "1000"]);
+    let (code, json, err) = run(&compare);
     assert_eq!(code, 0, "{name}: {err}");
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     v["files"][0]["value"].as_f64().unwrap()
