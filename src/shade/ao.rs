@@ -195,10 +195,18 @@ pub fn for_each_ray(normal: Vec3, n: u32, (su, sv): (f32, f32), mut f: impl FnMu
     for i in 0..n {
         let u = ((i as f32 + 0.5) / n as f32 + su).fract();
         let v = (radical_inverse(i) + sv).fract();
-        let r = u.sqrt();
-        let phi = TAU * v;
-        f(tx * (r * phi.cos()) + ty * (r * phi.sin()) + normal * (1.0 - u).max(0.0).sqrt());
+        f(cosine_direction(normal, (tx, ty), (u, v)));
     }
+}
+
+/// The cosine-weighted direction about unit `normal` (with unit tangents
+/// `tx`, `ty` across it) for (u, v) in [0, 1)^2: radius sqrt(u) at angle
+/// 2 pi v on the disc, lifted to the hemisphere.
+#[inline]
+pub fn cosine_direction(normal: Vec3, (tx, ty): (Vec3, Vec3), (u, v): (f32, f32)) -> Vec3 {
+    let r = u.sqrt();
+    let phi = TAU * v;
+    tx * (r * phi.cos()) + ty * (r * phi.sin()) + normal * (1.0 - u).max(0.0).sqrt()
 }
 
 /// 4x4 ordered pattern (0..16), for the per-pixel slice rotation and step
@@ -401,6 +409,25 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cosine_directions_lie_above_the_plane_with_mean_height_two_thirds() {
+        let n = Vec3::new(0.6, 0.0, 0.8);
+        let basis = n.any_orthonormal_pair();
+        let count = 4096;
+        let mut sum = 0.0;
+        for i in 0..count {
+            let uv = (
+                (i as f32 + 0.5) / count as f32,
+                (i * 37 % count) as f32 / count as f32,
+            );
+            let d = cosine_direction(n, basis, uv);
+            assert!(d.dot(n) >= 0.0 && (d.length() - 1.0).abs() < 1e-4);
+            sum += d.dot(n);
+        }
+        // E[cos] under p = cos / pi is 2/3.
+        assert!((sum / count as f32 - 2.0 / 3.0).abs() < 0.01);
+    }
 
     #[test]
     fn fast_acos_is_within_its_bound() {

@@ -44,8 +44,8 @@ pub struct OpaqueFrame {
     depth: Vec<f32>,
     camera: Camera,
     /// The background shows the environment sharp: a ray that lands on
-    /// it reads the environment at the surface's roughness, as where it
-    /// leaves the screen.
+    /// it reads the environment (`spread_through`), as where it leaves the
+    /// screen.
     sky: bool,
     /// The lights taken out of the environment image, put back where the
     /// environment is read.
