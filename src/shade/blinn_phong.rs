@@ -206,7 +206,7 @@ impl ShadeContext<'_> {
                     ks: c.ks.lane(k),
                     roughness: roughness.lane(k),
                 };
-                let point = (f.position.lane(k), n.lane(k), f.geo_normal[k]);
+                let point = (f.position.lane(k), &[n.lane(k)][..], f.geo_normal[k]);
                 env_sampled::radiance(sampled, point, v.lane(k), &lobes)
             });
         }

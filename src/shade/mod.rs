@@ -148,6 +148,15 @@ pub(crate) trait Fetch<L: Lane> {
         L::splat(0.0)
     }
 
+    /// The normals `map` gives at four points spread over each lane's
+    /// pixel (a rotated grid, a quarter of a pixel's step from the middle
+    /// along u and v): what the pixel averages, for `sampled` to
+    /// integrate. None where `normal_spread` measures nothing.
+    fn normal_samples(&mut self, map: &NormalMap) -> Option<[V3<L>; 4]> {
+        let _ = map;
+        None
+    }
+
     /// The lanes' interpolated tangents and their bitangent signs, where
     /// the mesh has them.
     fn tangents(&self) -> Option<(V3<L>, L)> {

@@ -342,6 +342,16 @@ fn samplers_and_the_nearest_filter_are_the_same_at_every_width() {
     let base = s.models[0].materials[0].pbr.base_color_map.as_ref();
     assert!(base.is_some_and(|t| t.mag_nearest && t.min_limit.is_none()));
     every_filter_and_msaa(&dir.join("scene.toml"), "samplers");
+    // The sampled environment reads the normal map at four points of
+    // each pixel (`Fetch::normal_samples`).
+    let sampled = [
+        "environment.preset=\"studio\"",
+        "environment.method=\"sampled\"",
+        "environment.samples=4",
+        "render.msaa=4",
+    ];
+    let scene = load_with(&dir.join("scene.toml"), &sampled);
+    same_at_every_width(&scene, &[0], "samplers, sampled");
 }
 
 #[test]

@@ -238,7 +238,7 @@ mod tests {
             (0..points)
                 .map(|k| {
                     let p = Vec3::new(0.37 * k as f32, 0.0, -0.21 * k as f32);
-                    radiance(&s, (p, Vec3::Y, Vec3::Y), Vec3::Y, &lobes)
+                    radiance(&s, (p, &[Vec3::Y], Vec3::Y), Vec3::Y, &lobes)
                 })
                 .sum::<Vec3>()
                 / points as f32

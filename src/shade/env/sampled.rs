@@ -11,6 +11,7 @@
 //! the average radiance over the GGX lobe whose roughness matches Ns
 //! (specular, a normalized lobe).
 
+use smallvec::SmallVec;
 use std::f32::consts::PI;
 
 use glam::{Mat3, Vec2, Vec3};
@@ -268,31 +269,37 @@ impl<'a> Sampled<'a> {
     }
 }
 
-/// Outgoing radiance towards `v` at `p` (unit normal `n`, geometric normal
-/// `ng` for the rays' offset) from the environment, `samples` pairs of
-/// directions, and from the emissive triangles, `samples` points drawn
-/// on them, with visibility through the frame's rays.
-pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lobes) -> Vec3 {
+/// Outgoing radiance towards `v` at `p` (unit normals `ns`, geometric
+/// normal `ng` for the rays' offset) from the environment, `samples`
+/// pairs of directions, and from the emissive triangles, `samples` points
+/// drawn on them, with visibility through the frame's rays. With several
+/// normals (a normal map's, spread over the pixel) sample `i` is taken
+/// about `ns[i % ns.len()]`: the pixel's average, as a path tracer's
+/// samples spread over the pixel find it.
+pub fn radiance(s: &Sampled, (p, ns, ng): (Vec3, &[Vec3], Vec3), v: Vec3, lobes: &Lobes) -> Vec3 {
     let (env, tracer, samples) = (s.env, s.tracer, s.samples);
-    let mix = Mixture::new(n, v, lobes);
-    let f_cos = |l: Vec3| f_cos(lobes, n, v, mix.a, l);
-    // Rays towards the front leave off the front; those of a diffuse
-    // transmission, behind the surface, off the back.
-    let start = |l: Vec3| {
-        let off = if n.dot(l) < 0.0 { -ng } else { ng };
-        p + off * tracer.epsilon
-    };
-    // What arrives along a ray: the environment where nothing is in the
-    // way; with the frame's surfaces, what the one met reflects.
+    let mixes: SmallVec<[(Vec3, Mixture); 4]> =
+        ns.iter().map(|&n| (n, Mixture::new(n, v, lobes))).collect();
     let bounce = s.bounce();
-    let incoming = |l: Vec3, xi: Vec2| match &bounce {
-        Some(b) => b.incoming(start(l), l, xi),
-        None if tracer.occluded(start(l), l, f32::INFINITY) => Vec3::ZERO,
-        None => env.radiance(l),
-    };
     let shift = position_hash(p);
     let mut sum = Vec3::ZERO;
     for i in 0..samples {
+        let (n, mix) = &mixes[i as usize % mixes.len()];
+        let (n, mix) = (*n, mix);
+        let f_cos = |l: Vec3| f_cos(lobes, n, v, mix.a, l);
+        // Rays towards the front leave off the front; those of a diffuse
+        // transmission, behind the surface, off the back.
+        let start = |l: Vec3| {
+            let off = if n.dot(l) < 0.0 { -ng } else { ng };
+            p + off * tracer.epsilon
+        };
+        // What arrives along a ray: the environment where nothing is in
+        // the way; with the frame's surfaces, what the one met reflects.
+        let incoming = |l: Vec3, xi: Vec2| match &bounce {
+            Some(b) => b.incoming(start(l), l, xi),
+            None if tracer.occluded(start(l), l, f32::INFINITY) => Vec3::ZERO,
+            None => env.radiance(l),
+        };
         // From the environment.
         let xi = point(i, samples, shift);
         let l = env.sample(xi);
@@ -318,4 +325,60 @@ pub fn radiance(s: &Sampled, (p, n, ng): (Vec3, Vec3, Vec3), v: Vec3, lobes: &Lo
         }
     }
     sum / samples as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assets::environment::EnvImage;
+
+    /// A white Lambertian surface under a sky white above the horizon and
+    /// black below: radiance 1 facing up, 1/2 facing sideways. Given both
+    /// normals (a pixel whose normal map turns half its area sideways),
+    /// `radiance` gives their average, 3/4.
+    #[test]
+    fn several_normals_give_their_average() {
+        let (w, h) = (256u32, 128u32);
+        let texels = (0..w * h)
+            .map(|i| if i / w < h / 2 { Vec3::ONE } else { Vec3::ZERO })
+            .collect();
+        let sky = EnvSampler::new(&EnvImage::new(w, h, texels).unwrap(), 1.0, 0.0);
+        let tracer = Tracer::new([], 1.0);
+        let emitters = Emitters::default();
+        let s = Sampled {
+            env: &sky,
+            tracer: &tracer,
+            emitters: &emitters,
+            samples: 256,
+            surfaces: None,
+            light: None,
+        };
+        let lobes = Lobes::BlinnPhong {
+            kd: Vec3::ONE,
+            ks: Vec3::ZERO,
+            roughness: 1.0,
+        };
+        let (up, side) = (Vec3::Y, Vec3::X);
+        let points = 16;
+        let at = |normals: &[Vec3]| {
+            (0..points)
+                .map(|k| {
+                    let p = Vec3::new(0.37 * k as f32, 0.0, -0.21 * k as f32);
+                    radiance(&s, (p, normals, Vec3::Y), Vec3::new(0.0, 0.6, 0.8), &lobes).x
+                })
+                .sum::<f32>()
+                / points as f32
+        };
+        for (normals, expected) in [
+            (&[up][..], 1.0),
+            (&[side][..], 0.5),
+            (&[up, side, up, side][..], 0.75),
+        ] {
+            let got = at(normals);
+            assert!(
+                (got - expected).abs() < 0.02,
+                "{normals:?}: {got}, expected {expected}"
+            );
+        }
+    }
 }

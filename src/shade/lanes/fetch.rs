@@ -49,8 +49,9 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
     /// Red, green and blue of map `i` looked up at the lanes'
     /// coordinates of its set moved by (`du`, `dv`) before its transform,
     /// each lookup filtered over the lanes' footprints (`probe`: one
-    /// trilinear probe at the level of anisotropic ones).
-    fn offset_rgb(&self, i: usize, (du, dv): (L, L), probe: bool) -> V3<L> {
+    /// trilinear probe at the level of anisotropic ones, that many levels
+    /// finer).
+    fn offset_rgb(&self, i: usize, (du, dv): (L, L), probe: Option<f32>) -> V3<L> {
         let map = &self.lm.maps[i];
         let f = self.lookups.coords;
         let (u, v) = f.sets[(map.source.texcoord as usize).min(1)];
@@ -70,10 +71,16 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
         let mut rgb = [[Vec4::ZERO; 3]; 2];
         for (q, r) in rgb.iter_mut().enumerate().take(L::QUADS) {
             let mut fps = f.footprints4(map.slot, q);
-            if probe {
+            if let Some(finer) = probe {
                 for fp in &mut fps {
-                    if let Footprint::Probes { lod, .. } = *fp {
-                        *fp = Footprint::Lod(lod);
+                    match *fp {
+                        Footprint::Probes { lod, .. } => {
+                            *fp = Footprint::Lod((lod - finer).max(0.0))
+                        }
+                        Footprint::Lod(lod) if finer > 0.0 => {
+                            *fp = Footprint::Lod((lod - finer).max(0.0))
+                        }
+                        _ => {}
                     }
                 }
             }
@@ -104,7 +111,7 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
         };
         let (su, sv) = self.steps();
         let zero = L::splat(0.0);
-        let height = |d: (L, L)| self.offset_rgb(i, d, false).x;
+        let height = |d: (L, L)| self.offset_rgb(i, d, None).x;
         let half = L::splat(0.5);
         let du = (height((su, zero)) - height((-su, zero))) * half;
         // Image rows run down; the bitangent points up the image.
@@ -166,6 +173,36 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         Some((rgb, channel(3)))
     }
 
+    fn normal_samples(&mut self, m: &NormalMap) -> Option<[V3<L>; 4]> {
+        let NormalMap::Normals {
+            map: t,
+            scale,
+            space: NormalSpace::Tangent,
+        } = m
+        else {
+            return None;
+        };
+        if !self.lm.spread || !self.lm.tangents {
+            return None;
+        }
+        let i = self.lm.index_of(t)?;
+        let (su, sv) = self.steps();
+        let frame = (self.lookups.coords.tangent, self.lookups.coords.sign);
+        // A rotated grid: each point a quarter step from its neighbours'
+        // rows and columns.
+        const GRID: [(f32, f32); 4] = [
+            (-0.375, -0.125),
+            (0.125, -0.375),
+            (0.375, 0.125),
+            (-0.125, 0.375),
+        ];
+        Some(GRID.map(|(a, b)| {
+            let d = (su * L::splat(a), sv * L::splat(b));
+            // Each point covers a quarter of the pixel: a level finer.
+            tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(1.0)), *scale)
+        }))
+    }
+
     fn normal_spread(&mut self, m: &NormalMap, n: V3<L>) -> L {
         let zero = L::splat(0.0);
         let NormalMap::Normals {
@@ -189,7 +226,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         // degrees in one step is taken for a step off the map's island (a
         // seam, the edge of an atlas chart) and does not count.
         let change = |d: (L, L)| {
-            let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, true), *scale) - n;
+            let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(0.0)), *scale) - n;
             let m2 = m.dot(m);
             L::select(m2.cmpgt(L::splat(SEAM)), zero, m2)
         };

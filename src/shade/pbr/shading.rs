@@ -308,9 +308,20 @@ impl ShadeContext<'_> {
     ) -> V3<L> {
         let mut c = *c;
         let v = self.view_lanes(f.position);
+        // `sampled` integrates a normal map's normals over the pixel
+        // (`Fetch::normal_samples`) where the lobe is isotropic, with the
+        // material as it is; the lights see it widened.
+        let mut spread_normals = None;
+        let plain = c;
         let n = match &m.normal_map {
             Some(map) => {
                 let mapped = fetch.normal(map);
+                let towards = geometric_towards(f, v);
+                if self.env_sampled.is_some() && c.aniso.is_none() {
+                    spread_normals = fetch
+                        .normal_samples(map)
+                        .map(|ns| ns.map(|m| valid_reflection(towards, v, m)));
+                }
                 // The widened lobe is the lights' and the sampled
                 // environment's: without either, not measured at all.
                 // The spread is the map's own, before any raising.
@@ -319,7 +330,7 @@ impl ShadeContext<'_> {
                 }
                 // Tilted by the map, the normal may reflect the view
                 // into the surface: raised as a path tracer raises it.
-                valid_reflection(geometric_towards(f, v), v, mapped)
+                valid_reflection(towards, v, mapped)
             }
             None => f.normal,
         };
@@ -337,10 +348,16 @@ impl ShadeContext<'_> {
             self.radiance(f, [n, v], &c)
         };
         if let Some(sampled) = &self.env_sampled {
-            let l = V3::from_fn(|k| {
-                let point = (f.position.lane(k), n.lane(k), f.geo_normal[k]);
-                let lobes = Lobes::Pbr(&c.at(k));
-                env_sampled::radiance(sampled, point, v.lane(k), &lobes)
+            let l = V3::from_fn(|k| match &spread_normals {
+                Some(ns) => {
+                    let ns = ns.map(|n| n.lane(k));
+                    let point = (f.position.lane(k), &ns[..], f.geo_normal[k]);
+                    env_sampled::radiance(sampled, point, v.lane(k), &Lobes::Pbr(&plain.at(k)))
+                }
+                None => {
+                    let point = (f.position.lane(k), &[n.lane(k)][..], f.geo_normal[k]);
+                    env_sampled::radiance(sampled, point, v.lane(k), &Lobes::Pbr(&c.at(k)))
+                }
             });
             return direct + l.scale(c.occlusion);
         }
