@@ -93,6 +93,25 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
         }
     }
 
+    /// A tangent-space normal map's index and scale where its change
+    /// across the pixel is measured (`normal_spread`, `normal_samples`):
+    /// metallic-roughness with `render.specular_aa`, tangents, and the
+    /// map's coordinates.
+    fn measured(&self, m: &NormalMap) -> Option<(usize, f32)> {
+        let NormalMap::Normals {
+            map,
+            scale,
+            space: NormalSpace::Tangent,
+        } = m
+        else {
+            return None;
+        };
+        if !self.lm.spread || !self.lm.tangents {
+            return None;
+        }
+        Some((self.lm.index_of(map)?, *scale))
+    }
+
     /// The lanes' steps along u and along v (`Footprints::bump`).
     fn steps(&self) -> (L, L) {
         let f = self.lookups.coords;
@@ -174,18 +193,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
     }
 
     fn normal_samples(&mut self, m: &NormalMap) -> Option<[V3<L>; 4]> {
-        let NormalMap::Normals {
-            map: t,
-            scale,
-            space: NormalSpace::Tangent,
-        } = m
-        else {
-            return None;
-        };
-        if !self.lm.spread || !self.lm.tangents {
-            return None;
-        }
-        let i = self.lm.index_of(t)?;
+        let (i, scale) = self.measured(m)?;
         let (su, sv) = self.steps();
         let frame = (self.lookups.coords.tangent, self.lookups.coords.sign);
         // A rotated grid: each point a quarter step from its neighbours'
@@ -199,24 +207,13 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         Some(GRID.map(|(a, b)| {
             let d = (su * L::splat(a), sv * L::splat(b));
             // Each point covers a quarter of the pixel: a level finer.
-            tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(1.0)), *scale)
+            tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(1.0)), scale)
         }))
     }
 
     fn normal_spread(&mut self, m: &NormalMap, n: V3<L>) -> L {
         let zero = L::splat(0.0);
-        let NormalMap::Normals {
-            map: t,
-            scale,
-            space: NormalSpace::Tangent,
-        } = m
-        else {
-            return zero;
-        };
-        if !self.lm.spread || !self.lm.tangents {
-            return zero;
-        }
-        let Some(i) = self.lm.index_of(t) else {
+        let Some((i, scale)) = self.measured(m) else {
             return zero;
         };
         let (su, sv) = self.steps();
@@ -226,7 +223,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         // degrees in one step is taken for a step off the map's island (a
         // seam, the edge of an atlas chart) and does not count.
         let change = |d: (L, L)| {
-            let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(0.0)), *scale) - n;
+            let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(0.0)), scale) - n;
             let m2 = m.dot(m);
             L::select(m2.cmpgt(L::splat(SEAM)), zero, m2)
         };
