@@ -74,11 +74,9 @@ impl<L: Lane> LaneFetch<'_, '_, '_, L> {
             if let Some(finer) = probe {
                 for fp in &mut fps {
                     match *fp {
-                        Footprint::Probes { lod, .. } => {
-                            *fp = Footprint::Lod((lod - finer).max(0.0))
-                        }
-                        Footprint::Lod(lod) if finer > 0.0 => {
-                            *fp = Footprint::Lod((lod - finer).max(0.0))
+                        Footprint::Probes { lod, .. } if finer == 0.0 => *fp = Footprint::Lod(lod),
+                        Footprint::Probes { lod, .. } | Footprint::Lod(lod) if finer > 0.0 => {
+                            *fp = Footprint::Lod((lod - finer).max(0.0));
                         }
                         _ => {}
                     }
