@@ -54,34 +54,24 @@ impl Surfaces for FrameSurfaces<'_> {
             return None;
         }
         let geometric = if face.dot(toward) < 0.0 { -face } else { face };
-        let lerp3 = |v: &[Vec3]| -> Option<Vec3> {
-            let at = |i: u32| v.get(i as usize).copied();
-            Some(at(tri[0])? * w.x + at(tri[1])? * w.y + at(tri[2])? * w.z)
-        };
-        let normal = lerp3(&mv.normal).map_or(geometric, |n| n.normalize_or(geometric));
+        let normal =
+            interpolate(&mv.normal, tri, w).map_or(geometric, |n| n.normalize_or(geometric));
         let normal = if normal.dot(toward) < 0.0 {
             -normal
         } else {
             normal
         };
-        let uv = |set: &[Vec2]| {
-            let at = |i: u32| set.get(i as usize).copied();
-            Some(at(tri[0])? * w.x + at(tri[1])? * w.y + at(tri[2])? * w.z)
-        };
-        let tint = {
-            let at = |i: u32| mesh.colors.get(i as usize).copied();
-            match (at(tri[0]), at(tri[1]), at(tri[2])) {
-                (Some(p), Some(q), Some(r)) => p * w.x + q * w.y + r * w.z,
-                _ => Vec4::ONE,
-            }
-        };
+        let tint = interpolate(&mesh.colors, tri, w).unwrap_or(Vec4::ONE);
         let group = mesh
             .groups
             .iter()
             .find(|g| g.triangles.contains(&hit.prim))?;
         let material = model.materials.get(group.material)?;
         let read = Reading {
-            uv: (uv(&mesh.uvs), uv(&mesh.uvs1)),
+            uv: (
+                interpolate(&mesh.uvs, tri, w),
+                interpolate(&mesh.uvs1, tri, w),
+            ),
             wrap: self.setup.scene.settings.address.into(),
         };
         let r = reflectance(self.setup.scene.settings.shading, material, &read, tint);
@@ -178,6 +168,16 @@ fn reflectance(mode: ShadingMode, m: &Material, read: &Reading, tint: Vec4) -> R
             emitted: m.ke * read.map(&m.map_ke).truncate(),
         }
     }
+}
+
+/// A vertex attribute at the point of triangle `tri` with barycentric
+/// weights `w`; None where the mesh lacks it (or it is short).
+fn interpolate<T>(values: &[T], tri: [u32; 3], w: Vec3) -> Option<T>
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+{
+    let at = |i: u32| values.get(i as usize).copied();
+    Some(at(tri[0])? * w.x + at(tri[1])? * w.y + at(tri[2])? * w.z)
 }
 
 /// The barycentric weights of `p` in triangle (a, b, c); None for a

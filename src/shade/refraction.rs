@@ -371,7 +371,7 @@ fn traced_path(
             return Vec3::ZERO;
         };
         if b.transmission < 0.5 {
-            return b.emitted + scene.reflected(&b, -d, xi);
+            return scene.leaving(&b, -d, xi, true);
         }
         // The normal met faces the inside, where the ray comes from.
         let out = refract(d, facet(b.normal, turn), ior);

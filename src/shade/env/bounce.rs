@@ -101,18 +101,24 @@ impl Scene<'_> {
                 o = b.position - b.geometric * self.tracer.epsilon;
                 continue;
             }
-            // The bounce's own numbers: turned by a hash of the point
-            // met, so they do not follow the ray's.
-            let u = xi + position_hash(b.position);
-            let own = if emission { b.emitted } else { Vec3::ZERO };
-            return own + self.reflected(&b, -d, u - u.floor());
+            return self.leaving(&b, -d, xi, emission);
         }
         Vec3::ZERO
     }
 
+    /// What surface `b` sends towards unit `wo` (`reflected`), with its
+    /// emission where `emission`. The bounce draws its own numbers: `xi`
+    /// (the ray's) turned by a hash of the point met, so that its
+    /// directions do not follow those that chose the ray.
+    pub fn leaving(&self, b: &Bounce, wo: Vec3, xi: Vec2, emission: bool) -> Vec3 {
+        let u = xi + position_hash(b.position);
+        let own = if emission { b.emitted } else { Vec3::ZERO };
+        own + self.reflected(b, wo, u - u.floor())
+    }
+
     /// What surface `b` reflects towards unit `wo`, clamped
     /// (`INDIRECT_CLAMP`).
-    pub fn reflected(&self, b: &Bounce, wo: Vec3, xi: Vec2) -> Vec3 {
+    fn reflected(&self, b: &Bounce, wo: Vec3, xi: Vec2) -> Vec3 {
         clamped(self.reflected_unclamped(b, wo, xi))
     }
 
