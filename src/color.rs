@@ -170,6 +170,56 @@ pub fn encode_srgb_xyz(c: glam::Vec4) -> [u8; 3] {
     [byte(0), byte(1), byte(2)]
 }
 
+/// `encode_srgb` of eight values each in \[0, 1\] (or -0), as
+/// `Segments::encode` finds them, eight at once: the segments by one
+/// gather (AVX2 builds), the bytes packed.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline]
+pub fn encode_srgb8(v: crate::simd::F8) -> [u8; 8] {
+    use std::arch::x86_64::*;
+    let t = segments();
+    let mut out = [0u32; 8];
+    // SAFETY: AVX2 is enabled for the build (the cfg above); the gather's
+    // indices are clamped to the table's SEGMENTS entries, and the store
+    // writes the 32 bytes of `out`.
+    unsafe {
+        let v: __m256 = v.into();
+        // `Segments::encode`'s key: (|bits| >> 16) - KEY_BASE, 0 below,
+        // at most the last segment.
+        let bits = _mm256_and_si256(_mm256_castps_si256(v), _mm256_set1_epi32(0x7fff_ffff));
+        let d = _mm256_sub_epi32(
+            _mm256_srli_epi32(bits, 16),
+            _mm256_set1_epi32(KEY_BASE as i32),
+        );
+        let k = _mm256_and_si256(d, _mm256_cmpgt_epi32(d, _mm256_setzero_si256()));
+        let k = _mm256_min_epi32(k, _mm256_set1_epi32(SEGMENTS as i32 - 1));
+        let e = _mm256_i32gather_epi32::<4>(t.0.as_ptr() as *const i32, k);
+        // `lut_index`: v * 65535 + 0.5, truncated (in 0.5..=65535.5).
+        let i = _mm256_cvttps_epi32(_mm256_add_ps(
+            _mm256_mul_ps(v, _mm256_set1_ps((LUT_SIZE - 1) as f32)),
+            _mm256_set1_ps(0.5),
+        ));
+        // The byte, one more where i >= the next byte's first entry: a
+        // compare of "the step lies beyond i" is -1, else 0.
+        let step = _mm256_srli_epi32(e, 8);
+        let byte = _mm256_add_epi32(
+            _mm256_and_si256(e, _mm256_set1_epi32(0xff)),
+            _mm256_add_epi32(_mm256_set1_epi32(1), _mm256_cmpgt_epi32(step, i)),
+        );
+        _mm256_storeu_si256(out.as_mut_ptr() as *mut __m256i, byte);
+    }
+    out.map(|b| b as u8)
+}
+
+/// `encode_srgb` of eight values each in \[0, 1\] (or -0).
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+#[inline]
+pub fn encode_srgb8(v: crate::simd::F8) -> [u8; 8] {
+    use crate::simd::Lane;
+    let t = segments();
+    std::array::from_fn(|k| t.encode(v.lane(k)))
+}
+
 /// \[0, 1\] -> byte without transfer curve (data: normals, depth, alpha).
 #[inline]
 pub fn encode_linear(v: f32) -> u8 {
@@ -179,6 +229,33 @@ pub fn encode_linear(v: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Eight at once (`encode_srgb8`) gives `encode_srgb`'s bytes: every
+    /// 97th float of [0, 1] and the values where the bytes step, each
+    /// with its neighbouring floats, in every lane.
+    #[test]
+    fn eight_at_once_are_the_bytes_of_one_at_a_time() {
+        use crate::simd::{F8, Lane};
+        let mut values: Vec<f32> = (0..=1.0f32.to_bits())
+            .step_by(97)
+            .map(f32::from_bits)
+            .collect();
+        for b in 0..256 {
+            let v = srgb_to_linear(b as f32 / 255.0);
+            for d in [-1i32, 0, 1] {
+                values.push(f32::from_bits((v.to_bits() as i32 + d).max(0) as u32).min(1.0));
+            }
+        }
+        values.extend([-0.0, 0.0, 1.0]);
+        for chunk in values.chunks(8) {
+            let lanes = F8::from_fn(|k| chunk[k % chunk.len()]);
+            let got = encode_srgb8(lanes);
+            for k in 0..8 {
+                let v = chunk[k % chunk.len()];
+                assert_eq!(got[k], encode_srgb(v), "{v} in lane {k}");
+            }
+        }
+    }
 
     /// The segment table gives the 64K-entry table's byte for every
     /// float in [0, 1] (each one of the 1.07 billion, and -0).

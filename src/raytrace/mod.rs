@@ -32,6 +32,10 @@ struct Instance<'a> {
 /// The scene's triangles as placed in one frame.
 pub struct Tracer<'a> {
     instances: Vec<Instance<'a>>,
+    /// The instances' world-space bounds together, where all are finite:
+    /// a ray that misses them meets nothing (one test before the
+    /// instances' own).
+    bounds: Option<(Vec3A, Vec3A)>,
     /// Offset along the geometric normal that keeps a ray from hitting the
     /// surface it starts on (a ten-thousandth of the scene's radius).
     pub epsilon: f32,
@@ -41,7 +45,7 @@ impl<'a> Tracer<'a> {
     /// `placed`: every mesh of the frame (empty BVHs are skipped);
     /// `scene_radius`: the scene's bounding radius, which sets `epsilon`.
     pub fn new(placed: impl IntoIterator<Item = Placed<'a>>, scene_radius: f32) -> Tracer<'a> {
-        let instances = placed
+        let instances: Vec<Instance> = placed
             .into_iter()
             .enumerate()
             .filter(|(_, p)| !p.bvh.is_empty())
@@ -69,8 +73,18 @@ impl<'a> Tracer<'a> {
                 }
             })
             .collect();
+        let finite = instances
+            .iter()
+            .all(|i| i.lo.is_finite() && i.hi.is_finite());
+        let bounds = finite.then(|| {
+            instances.iter().fold(
+                (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+                |(lo, hi), i| (lo.min(i.lo), hi.max(i.hi)),
+            )
+        });
         Tracer {
             instances,
+            bounds,
             epsilon: scene_radius.max(1e-6) * 1e-4,
         }
     }
@@ -90,6 +104,9 @@ impl<'a> Tracer<'a> {
     /// Whether anything lies on `o + t d` for t in (0, t_max).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
         let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
+        if !self.may_meet(oa, inv, t_max) {
+            return false;
+        }
         self.instances.iter().any(|i| {
             box_hit(i.lo, i.hi, oa, inv, t_max) && {
                 let m = &i.object_from_world;
@@ -97,6 +114,17 @@ impl<'a> Tracer<'a> {
                     .occluded(m.transform_point3(o), m.transform_vector3(d), 0.0, t_max)
             }
         })
+    }
+}
+
+impl Tracer<'_> {
+    /// Whether the ray from `o` (1 / its direction: `inv`) within `t_max`
+    /// meets the instances' bounds together: where it does not, it meets
+    /// no instance's (each lies inside them).
+    #[inline(always)]
+    fn may_meet(&self, o: Vec3A, inv: Vec3A, t_max: f32) -> bool {
+        self.bounds
+            .is_none_or(|(lo, hi)| box_hit(lo, hi, o, inv, t_max))
     }
 }
 
@@ -115,6 +143,9 @@ impl Tracer<'_> {
     /// The nearest surface on `o + t d` for t in (0, t_max).
     pub fn nearest(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<TraceHit> {
         let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
+        if !self.may_meet(oa, inv, t_max) {
+            return None;
+        }
         let mut best: Option<TraceHit> = None;
         for i in &self.instances {
             let reach = best.map_or(t_max, |b| b.t);

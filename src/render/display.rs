@@ -11,10 +11,11 @@ use glam::Vec4;
 use rayon::prelude::*;
 
 use super::Frame;
-use crate::color::{encode_linear, encode_srgb_xyz, encode_srgb3};
+use crate::color::{encode_linear, encode_srgb_xyz, encode_srgb3, encode_srgb8};
 use crate::scene::RenderSettings;
 use crate::scene::settings::{Background, Tonemap};
-use crate::shade::tonemap::tonemap;
+use crate::shade::tonemap::{tonemap, tonemap_lanes};
+use crate::simd::{F8, Lane, V3};
 
 /// 8-bit display image: RGB, or RGBA for a transparent background.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -142,25 +143,49 @@ impl Encoder {
         plain: Option<PlainBackground>,
         out: &mut [u8],
     ) {
-        let scale = self.scale;
         if self.data_view {
             rows::<C>(colors, width, plain, out, |c| {
                 pixel::<C>(c, |c| {
                     [encode_linear(c.x), encode_linear(c.y), encode_linear(c.z)]
                 })
             });
-        } else if self.tonemap == Tonemap::Clamp {
-            // `tonemap`'s clamp is the encoding's own: the same bytes,
-            // without a trip through memory.
-            rows::<C>(colors, width, plain, out, |c| {
-                pixel::<C>(c, |c| encode_srgb_xyz(c * scale))
+        } else if C == 3 {
+            // Opaque: eight pixels at a time (`encode8`), the same bytes.
+            let one = |c: &Vec4| pixel::<C>(c, |c| self.encode1(c));
+            rows_with::<C>(colors, width, plain, out, one, |o, r| {
+                resolve_row8(o, r, one, |p| self.encode8(p))
             });
         } else {
-            let op = self.tonemap;
             rows::<C>(colors, width, plain, out, |c| {
-                pixel::<C>(c, |c| encode_srgb3(tonemap(c.truncate(), op, scale)))
+                pixel::<C>(c, |c| self.encode1(c))
             });
         }
+    }
+
+    /// One opaque colour's bytes.
+    #[inline(always)]
+    fn encode1(&self, c: Vec4) -> [u8; 3] {
+        if self.tonemap == Tonemap::Clamp {
+            // `tonemap`'s clamp is the encoding's own: the same bytes,
+            // without a trip through memory.
+            encode_srgb_xyz(c * self.scale)
+        } else {
+            encode_srgb3(tonemap(c.truncate(), self.tonemap, self.scale))
+        }
+    }
+
+    /// `encode1` of eight opaque colours at once.
+    #[inline(always)]
+    fn encode8(&self, p: &[Vec4]) -> [[u8; 3]; 8] {
+        let c = V3 {
+            x: F8::from_fn(|k| p[k].x),
+            y: F8::from_fn(|k| p[k].y),
+            z: F8::from_fn(|k| p[k].z),
+        };
+        // (The clamp of `encode_srgb` is the tone map's last step.)
+        let t = tonemap_lanes(c, self.tonemap, self.scale);
+        let (r, g, b) = (encode_srgb8(t.x), encode_srgb8(t.y), encode_srgb8(t.z));
+        std::array::from_fn(|k| [r[k], g[k], b[k]])
     }
 }
 
@@ -189,6 +214,21 @@ fn rows<const C: usize>(
     out: &mut [u8],
     pixel: impl Fn(&Vec4) -> [u8; 4],
 ) {
+    rows_with::<C>(colors, width, plain, out, &pixel, |o, r| {
+        resolve_row::<C>(o, r, &pixel)
+    });
+}
+
+/// `rows`, each row's span resolved by `row` (bytes, colours).
+#[inline(always)]
+fn rows_with<const C: usize>(
+    colors: &[Vec4],
+    width: usize,
+    plain: Option<PlainBackground>,
+    out: &mut [u8],
+    pixel: impl Fn(&Vec4) -> [u8; 4],
+    row: impl Fn(&mut [u8], &[Vec4]),
+) {
     let (lo, hi) = plain.map_or((0, width), |p| {
         let hi = p.columns.1.min(width);
         (p.columns.0.min(hi), hi)
@@ -208,13 +248,44 @@ fn rows<const C: usize>(
             part.copy_from_slice(&run[..part.len()]);
         }
     };
-    for (row, bytes) in colors.chunks(width).zip(out.chunks_mut(width * C)) {
+    for (colors, bytes) in colors.chunks(width).zip(out.chunks_mut(width * C)) {
         if let Some(run) = &bg {
             fill(&mut bytes[..lo * C], run);
             fill(&mut bytes[hi * C..], run);
         }
-        resolve_row::<C>(&mut bytes[lo * C..hi * C], &row[lo..hi], &pixel);
+        row(&mut bytes[lo * C..hi * C], &colors[lo..hi]);
     }
+}
+
+/// One row of opaque pixels into 3 bytes each, eight at a time
+/// (`eight`), a group of eight that repeats the pixel before it copied;
+/// the last few one by one (`pixel`).
+#[inline]
+fn resolve_row8(
+    out: &mut [u8],
+    row: &[Vec4],
+    pixel: impl Fn(&Vec4) -> [u8; 4],
+    eight: impl Fn(&[Vec4]) -> [[u8; 3]; 8],
+) {
+    let n = row.len();
+    let mut x = 0;
+    while x + 8 <= n {
+        let p = &row[x..x + 8];
+        if x > 0 && p.iter().all(|c| *c == row[x - 1]) {
+            let (done, rest) = out.split_at_mut(x * 3);
+            let last = &done[x * 3 - 3..];
+            for o in rest[..24].chunks_exact_mut(3) {
+                o.copy_from_slice(last);
+            }
+        } else {
+            let bytes = eight(p);
+            for (o, b) in out[x * 3..x * 3 + 24].chunks_exact_mut(3).zip(bytes) {
+                o.copy_from_slice(&b);
+            }
+        }
+        x += 8;
+    }
+    resolve_row::<3>(&mut out[x * 3..], &row[x..], pixel);
 }
 
 /// One row into C bytes per pixel; runs of one colour (the background,

@@ -18,7 +18,7 @@
 
 use std::sync::OnceLock;
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
 use super::draw_list::DrawList;
 use super::rays::CameraRays;
@@ -28,7 +28,7 @@ use crate::scene::light::LightKind;
 use crate::scene::settings::Background;
 use crate::shade::ShadeContext;
 use crate::shade::ao::{for_each_ray, pixel_hash};
-use crate::shade::light::incidence;
+use crate::shade::light::{Incidence, incidence};
 use crate::shade::soft_shadow::open_share;
 
 /// Rays of contact occlusion per grid point.
@@ -49,6 +49,11 @@ pub(super) struct Ground<'a> {
     ambient: f32,
     /// Contact occlusion on the grid, rows along +Z.
     ao: Vec<f32>,
+    /// Without lights, the pixels (first and last column, first and last
+    /// row) outside which the catcher keeps all the light: the contact
+    /// grid's shadowed part seen through the camera (`open_outside`).
+    /// None: no such bounds.
+    open_outside: Option<[i32; 4]>,
     transparent: bool,
 }
 
@@ -79,7 +84,7 @@ impl<'a> Ground<'a> {
         } else {
             Vec::new()
         };
-        Some(Ground {
+        let mut ground = Ground {
             rays: CameraRays::new(&setup.camera, width, height),
             height: plane.height,
             center: plane.center,
@@ -88,14 +93,78 @@ impl<'a> Ground<'a> {
             tracer,
             ambient,
             ao,
+            open_outside: None,
             transparent: setup.scene.settings.background == Background::Transparent,
-        })
+        };
+        ground.open_outside = ground.open_outside();
+        Some(ground)
+    }
+
+    /// `open_outside`'s bounds: where there are no lights, those of the
+    /// contact grid's shadowed part (its points below 1, two cells wider:
+    /// beyond them every lookup blends four 1s, and the factor is 1) seen
+    /// through the camera, its corners all in front of it (the rectangle,
+    /// convex, then lies within their bounds).
+    fn open_outside(&self) -> Option<[i32; 4]> {
+        const NOWHERE: Option<[i32; 4]> = Some([1, 1, 0, 0]);
+        if !self.lights.is_empty() {
+            return None;
+        }
+        // Grid points other than 1 (NaN included), by column and row.
+        let mut cells = (0..self.ao.len()).filter(|&k| self.ao[k] != 1.0);
+        let Some(first) = cells.next() else {
+            // No contact shadow (or no light from above): nothing to show.
+            return NOWHERE;
+        };
+        let at = |k: usize| ((k % AO_GRID) as f32, (k / AO_GRID) as f32);
+        let (mut glo, mut ghi) = (Vec2::from(at(first)), Vec2::from(at(first)));
+        for k in cells {
+            glo = glo.min(Vec2::from(at(k)));
+            ghi = ghi.max(Vec2::from(at(k)));
+        }
+        let half = AO_EXTENT * self.radius;
+        let step = 2.0 * half / AO_GRID as f32;
+        // Grid point (i, j) lies at center - half + (i + 1/2) step.
+        let world = |g: Vec2| {
+            Vec2::new(self.center.x, self.center.z) - Vec2::splat(half)
+                + (g + Vec2::splat(0.5)) * step
+        };
+        let (wlo, whi) = (world(glo - Vec2::splat(2.0)), world(ghi + Vec2::splat(2.0)));
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for (x, z) in [
+            (wlo.x, wlo.y),
+            (whi.x, wlo.y),
+            (wlo.x, whi.y),
+            (whi.x, whi.y),
+        ] {
+            let (x, y) = self.rays.pixel_of(Vec3::new(x, self.height, z))?;
+            lo = lo.min(Vec2::new(x, y));
+            hi = hi.max(Vec2::new(x, y));
+        }
+        // Pixel k's center is at k + 1/2; two pixels cover rounding.
+        let (lo, hi) = (lo - Vec2::splat(2.5), hi + Vec2::splat(1.5));
+        (lo.is_finite() && hi.is_finite() && hi.max_element() < 1e9 && lo.min_element() > -1e9)
+            .then(|| {
+                [
+                    lo.x.floor() as i32,
+                    lo.y.floor() as i32,
+                    hi.x.ceil() as i32,
+                    hi.y.ceil() as i32,
+                ]
+            })
     }
 
     /// `bg` with the catcher at pixel (px, py) composited over it: darkened
     /// by the catcher's factor, or, over a transparent background, black
     /// with the shadow's opacity as alpha.
     pub fn over(&self, bg: Vec4, px: i32, py: i32) -> Vec4 {
+        if let Some([x0, y0, x1, y1]) = self.open_outside
+            && (px < x0 || px > x1 || py < y0 || py > y1)
+        {
+            // Factor 1 or none: `bg` either way (over a transparent
+            // background, black with alpha 0, which is `bg` there).
+            return bg;
+        }
         let Some(f) = self.factor(px, py) else {
             return bg;
         };
@@ -108,6 +177,27 @@ impl<'a> Ground<'a> {
 
     /// The share of light the plane keeps at the pixel (1: none taken).
     fn factor(&self, px: i32, py: i32) -> Option<f32> {
+        let (p, fade) = self.plane_point(px, py)?;
+        let (mut total, mut kept) = (self.ambient, 0.0);
+        for light in self.lights {
+            let Some((e, inc)) = self.reaching(light, p) else {
+                continue;
+            };
+            total += e;
+            kept += e * self.visibility(light, p, inc);
+        }
+        if self.ambient > 0.0 {
+            kept += self.ambient * self.contact(p);
+        }
+        if total <= 0.0 {
+            return None;
+        }
+        Some(1.0 - fade * (1.0 - kept / total))
+    }
+
+    /// The plane point pixel (px, py) sees, and the catcher's fade there;
+    /// None where it sees none the catcher shows.
+    fn plane_point(&self, px: i32, py: i32) -> Option<(Vec3, f32)> {
         let (o, d) = self.rays.ray(px, py);
         if d.y.abs() < 1e-6 {
             return None;
@@ -119,45 +209,39 @@ impl<'a> Ground<'a> {
         let p = o + d * t;
         let r = Vec3::new(p.x - self.center.x, 0.0, p.z - self.center.z).length() / self.radius;
         let fade = 1.0 - smoothstep(2.0, 3.0, r);
-        if fade <= 0.0 {
-            return None;
-        }
+        (fade > 0.0).then_some((p, fade))
+    }
+
+    /// The luminance of `light`'s irradiance on the plane at `p`, and its
+    /// incidence; None where it brings none.
+    fn reaching(&self, light: &Light, p: Vec3) -> Option<(f32, Incidence)> {
+        let inc = incidence(light, p)?;
+        let e = luminance(inc.e) * inc.l.y.max(0.0);
+        (e > 0.0).then_some((e, inc))
+    }
+
+    /// How much of `light` (arriving as `inc`) plane point `p` sees: a
+    /// ray, or the open share of a disc's cone; 1 for a light that casts
+    /// no shadows.
+    fn visibility(&self, light: &Light, p: Vec3, inc: Incidence) -> f32 {
         let origin = p + Vec3::Y * self.tracer.epsilon;
-        let (mut total, mut kept) = (self.ambient, 0.0);
-        for light in self.lights {
-            let Some(inc) = incidence(light, p) else {
-                continue;
-            };
-            let e = luminance(inc.e) * inc.l.y.max(0.0);
-            if e <= 0.0 {
-                continue;
+        let t_max = if light.kind_is_directional() {
+            f32::INFINITY
+        } else {
+            1.0
+        };
+        let dir = if t_max.is_finite() {
+            light.position_or(p) - origin
+        } else {
+            inc.l
+        };
+        match light.kind {
+            _ if !light.shadows => 1.0,
+            LightKind::Directional { angle, .. } if angle > 0.0 => {
+                open_share(self.tracer, angle, p, Vec3::Y, inc.l)
             }
-            total += e;
-            let t_max = if light.kind_is_directional() {
-                f32::INFINITY
-            } else {
-                1.0
-            };
-            let dir = if t_max.is_finite() {
-                light.position_or(p) - origin
-            } else {
-                inc.l
-            };
-            kept += e * match light.kind {
-                _ if !light.shadows => 1.0,
-                LightKind::Directional { angle, .. } if angle > 0.0 => {
-                    open_share(self.tracer, angle, p, Vec3::Y, inc.l)
-                }
-                _ => f32::from(u8::from(!self.tracer.occluded(origin, dir, t_max))),
-            };
+            _ => f32::from(u8::from(!self.tracer.occluded(origin, dir, t_max))),
         }
-        if self.ambient > 0.0 {
-            kept += self.ambient * self.contact(p);
-        }
-        if total <= 0.0 {
-            return None;
-        }
-        Some(1.0 - fade * (1.0 - kept / total))
     }
 }
 
@@ -250,13 +334,8 @@ mod tests {
     use crate::shade::ao::occlusion_at;
     use glam::Mat4;
 
-    /// The grid (its kept ray table and the skip of points far from every
-    /// model) equals `occlusion_at` at every point, bit for bit: a box
-    /// standing on the plane off the center, so that some points are near
-    /// it, some under its overhang and most far from it.
-    #[test]
-    fn the_contact_grid_is_occlusion_at_every_point() {
-        let (lo, hi) = (Vec3::new(0.2, 0.0, -0.4), Vec3::new(0.9, 0.6, 0.1));
+    /// The box from `lo` to `hi` as twelve triangles.
+    fn box_bvh(lo: Vec3, hi: Vec3) -> Bvh {
         let corner = |k: u32| {
             Vec3::new(
                 if k & 1 == 0 { lo.x } else { hi.x },
@@ -277,7 +356,119 @@ mod tests {
             .iter()
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect();
-        let bvh = Bvh::build(&positions, &triangles);
+        Bvh::build(&positions, &triangles)
+    }
+
+    /// Without lights, the bounds of the contact shadow (`open_outside`)
+    /// change no pixel: every pixel the catcher darkens lies within them,
+    /// and they are tight (the darkened pixels reach within 12 of each
+    /// side inside the frame).
+    #[test]
+    fn pixels_outside_the_contact_shadow_keep_the_background() {
+        let (lo, hi) = (Vec3::new(-0.3, 0.0, -0.2), Vec3::new(0.2, 0.7, 0.3));
+        let bvh = box_bvh(lo, hi);
+        let tracer = box_tracer(&bvh, lo, hi);
+        for transparent in [false, true] {
+            let mut ground = box_ground(&tracer, &[]);
+            ground.transparent = transparent;
+            let bg = if transparent {
+                Vec4::ZERO
+            } else {
+                Vec4::new(0.3, 0.5, 0.7, 1.0)
+            };
+            let bits = |c: Vec4| c.to_array().map(f32::to_bits);
+            let everywhere = ground.pixels(|g, x, y| bits(g.over(bg, x, y)));
+            ground.open_outside = ground.open_outside();
+            let Some([x0, y0, x1, y1]) = ground.open_outside else {
+                panic!("no bounds");
+            };
+            let bounded = ground.pixels(|g, x, y| bits(g.over(bg, x, y)));
+            assert_eq!(bounded, everywhere);
+            let mut reach = [i32::MAX, i32::MAX, i32::MIN, i32::MIN];
+            for (k, c) in everywhere.iter().enumerate() {
+                let (x, y) = ((k % W as usize) as i32, (k / W as usize) as i32);
+                if *c != bits(bg) {
+                    assert!(x >= x0 && x <= x1 && y >= y0 && y <= y1, "({x}, {y})");
+                    reach = [
+                        reach[0].min(x),
+                        reach[1].min(y),
+                        reach[2].max(x),
+                        reach[3].max(y),
+                    ];
+                }
+            }
+            assert!(reach[0] <= reach[2], "no contact shadow");
+            let inside = [
+                x0.max(0),
+                y0.max(0),
+                x1.min(W as i32 - 1),
+                y1.min(H as i32 - 1),
+            ];
+            for k in 0..4 {
+                assert!((reach[k] - inside[k]).abs() <= 12, "{reach:?} {inside:?}");
+            }
+            // Not the whole frame.
+            assert!(x0 > 0 || y0 > 0 || x1 < W as i32 - 1 || y1 < H as i32 - 1);
+        }
+    }
+
+    const W: u32 = 97;
+    const H: u32 = 61;
+
+    impl Ground<'_> {
+        /// `f` of every pixel, rows from the top.
+        fn pixels<T>(&self, mut f: impl FnMut(&Self, i32, i32) -> T) -> Vec<T> {
+            let mut out = Vec::new();
+            for y in 0..H as i32 {
+                for x in 0..W as i32 {
+                    out.push(f(self, x, y));
+                }
+            }
+            out
+        }
+    }
+
+    fn box_tracer(bvh: &Bvh, lo: Vec3, hi: Vec3) -> Tracer<'_> {
+        Tracer::new(
+            [Placed {
+                bvh,
+                bounds: (lo, hi),
+                world_from_object: Mat4::IDENTITY,
+            }],
+            1.0,
+        )
+    }
+
+    /// A catcher of radius 0.8 at the origin, seen from above at an angle
+    /// (`W` x `H`), without bounds.
+    fn box_ground<'a>(tracer: &'a Tracer<'a>, lights: &'a [Light]) -> Ground<'a> {
+        use crate::scene::camera::Camera;
+        let cam = Camera {
+            eye: Vec3::new(0.4, 1.6, 2.4),
+            ..Camera::framing("c".into(), Vec3::new(0.0, 0.3, 0.0), 1.0, 40.0)
+        };
+        Ground {
+            rays: CameraRays::new(&cam, W, H),
+            height: 0.0,
+            center: Vec3::ZERO,
+            radius: 0.8,
+            lights,
+            tracer,
+            ambient: 0.5,
+            ao: contact_grid(tracer, 0.0, Vec3::ZERO, 0.8),
+            open_outside: None,
+            transparent: false,
+        }
+    }
+
+    /// The grid (its kept ray table and the skip of points far from every
+    /// model) equals `occlusion_at` at every point, bit for bit: a box
+    /// standing on the plane off the center, so that some points are near
+    /// it, some under its overhang and most far from it.
+    #[test]
+    fn the_contact_grid_is_occlusion_at_every_point() {
+        let (lo, hi) = (Vec3::new(0.2, 0.0, -0.4), Vec3::new(0.9, 0.6, 0.1));
+        let bvh = box_bvh(lo, hi);
         let tracer = Tracer::new(
             [Placed {
                 bvh: &bvh,

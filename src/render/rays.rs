@@ -53,4 +53,21 @@ impl CameraRays {
             (self.eye, (self.forward + offset).normalize())
         }
     }
+
+    /// Where the ray through a pixel center meets world point `q`: its
+    /// pixel coordinates (centers at k + 1/2, as `ray` places them);
+    /// None behind the camera.
+    pub fn pixel_of(&self, q: Vec3) -> Option<(f32, f32)> {
+        let d = q - self.eye;
+        let depth = d.dot(self.forward);
+        if !self.orthographic && depth <= 0.0 {
+            return None;
+        }
+        let per = if self.orthographic { 1.0 } else { depth };
+        // `ray`'s offset is right x + up y, and right and up are
+        // orthogonal to the view: their components give x and y back.
+        let x = d.dot(self.right) / (self.right.length_squared() * per);
+        let y = d.dot(self.up) / (self.up.length_squared() * per);
+        Some(((x + 1.0) * 0.5 * self.size.0, (1.0 - y) * 0.5 * self.size.1))
+    }
 }

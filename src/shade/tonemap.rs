@@ -5,26 +5,72 @@
 use glam::{Mat3, Vec3};
 
 use crate::scene::settings::Tonemap;
+use crate::simd::{Lane, V3};
 
 /// Linear radiance `c` scaled by `exposure_scale` (2^stops) and mapped by
 /// `op` to display-linear values (in [0, 1] for every map but `clamp`,
-/// which the sRGB encoding clamps).
+/// which the sRGB encoding clamps): `tonemap_lanes` of one lane.
 #[inline]
 pub fn tonemap(c: Vec3, op: Tonemap, exposure_scale: f32) -> Vec3 {
-    let c = c * exposure_scale;
-    match op {
+    tonemap_lanes::<f32>(c.into(), op, exposure_scale).into()
+}
+
+/// `tonemap` of every lane of `c`, each lane's operations those of
+/// `Vec3`'s, in their order.
+#[inline(always)]
+pub fn tonemap_lanes<L: Lane>(c: V3<L>, op: Tonemap, exposure_scale: f32) -> V3<L> {
+    let c = c.scale(L::splat(exposure_scale));
+    let mapped = match op {
         Tonemap::Clamp => c,
-        Tonemap::Reinhard => c / (Vec3::ONE + c),
+        Tonemap::Reinhard => c.over(c.plus(1.0)),
         Tonemap::Aces => {
             // Narkowicz's fit of the ACES filmic curve.
             let (a, b, cc, d, e) = (2.51, 0.03, 2.43, 0.59, 0.14);
-            (c * (c * a + b)) / (c * (c * cc + d) + e)
+            (c * c.times(a).plus(b)).over((c * c.times(cc).plus(d)).plus(e))
         }
         Tonemap::AcesHill => aces_hill(c),
         Tonemap::PbrNeutral => pbr_neutral(c),
         Tonemap::Agx => agx(c),
+    };
+    // `Vec3::clamp(0, 1)`: max, then min.
+    mapped.max(V3::splat(Vec3::ZERO)).min(V3::splat(Vec3::ONE))
+}
+
+/// `Vec3`'s arithmetic with a scalar, lane by lane.
+trait Scalars {
+    /// `v + s`.
+    fn plus(self, s: f32) -> Self;
+    /// `v * s`.
+    fn times(self, s: f32) -> Self;
+    /// `v / w`, component by component.
+    fn over(self, w: Self) -> Self;
+    /// `m * v` as glam's `Mat3::mul_vec3` sums it.
+    fn by(self, m: Mat3) -> Self;
+}
+
+impl<L: Lane> Scalars for V3<L> {
+    #[inline(always)]
+    fn plus(self, s: f32) -> V3<L> {
+        self + V3::splat(Vec3::splat(s))
     }
-    .clamp(Vec3::ZERO, Vec3::ONE)
+    #[inline(always)]
+    fn times(self, s: f32) -> V3<L> {
+        self.scale(L::splat(s))
+    }
+    #[inline(always)]
+    fn over(self, w: V3<L>) -> V3<L> {
+        V3 {
+            x: self.x / w.x,
+            y: self.y / w.y,
+            z: self.z / w.z,
+        }
+    }
+    #[inline(always)]
+    fn by(self, m: Mat3) -> V3<L> {
+        V3::splat(m.x_axis).scale(self.x)
+            + V3::splat(m.y_axis).scale(self.y)
+            + V3::splat(m.z_axis).scale(self.z)
+    }
 }
 
 /// three.js's `ACESFilmicToneMapping` (tonemapping_pars_fragment.glsl):
@@ -32,7 +78,8 @@ pub fn tonemap(c: Vec3, op: Tonemap, exposure_scale: f32) -> Vec3 {
 /// from sRGB primaries to ACES AP1 with the RRT's saturation, through
 /// Stephen Hill's rational fit of the RRT and ODT, and back to sRGB with
 /// the ODT's saturation.
-fn aces_hill(c: Vec3) -> Vec3 {
+#[inline(always)]
+fn aces_hill<L: Lane>(c: V3<L>) -> V3<L> {
     // By column, as the GLSL source writes them.
     let input = Mat3::from_cols(
         Vec3::new(0.597_19, 0.076_00, 0.028_40),
@@ -44,37 +91,66 @@ fn aces_hill(c: Vec3) -> Vec3 {
         Vec3::new(-0.531_08, 1.108_13, -0.072_76),
         Vec3::new(-0.073_67, -0.006_05, 1.076_02),
     );
-    let v = input * (c / 0.6);
-    let a = v * (v + Vec3::splat(0.024_578_6)) - Vec3::splat(0.000_090_537);
-    let b = v * (v * 0.983_729 + Vec3::splat(0.432_951)) + Vec3::splat(0.238_081);
-    output * (a / b)
+    let v = (c / L::splat(0.6)).by(input);
+    let a = (v * v.plus(0.024_578_6)).plus(-0.000_090_537);
+    let b = (v * v.times(0.983_729).plus(0.432_951)).plus(0.238_081);
+    a.over(b).by(output)
+}
+
+/// min(x, min(y, z)) as `Vec3::min_element` takes it (`a < b ? a : b`).
+#[inline(always)]
+fn min_element<L: Lane>(c: V3<L>) -> L {
+    let min = |a: L, b: L| L::select(a.cmplt(b), a, b);
+    min(c.x, min(c.y, c.z))
+}
+
+/// max(x, max(y, z)) as `Vec3::max_element` takes it (`a > b ? a : b`).
+#[inline(always)]
+fn max_element<L: Lane>(c: V3<L>) -> L {
+    let max = |a: L, b: L| L::select(a.cmpgt(b), a, b);
+    max(c.x, max(c.y, c.z))
 }
 
 /// Khronos PBR Neutral (2024): identity below 0.76, then a soft compression
 /// of the peak toward 1 that keeps hue, desaturating only what it
 /// compresses; a base colour under white light of 1 shows as itself.
-fn pbr_neutral(c: Vec3) -> Vec3 {
+#[inline(always)]
+fn pbr_neutral<L: Lane>(c: V3<L>) -> V3<L> {
     const START: f32 = 0.8 - 0.04;
     const DESATURATION: f32 = 0.15;
-    let x = c.min_element();
-    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
-    let c = c - Vec3::splat(offset);
-    let peak = c.max_element();
-    if peak < START {
-        return c;
-    }
+    let one = L::splat(1.0);
+    let x = min_element(c);
+    let offset = L::select(
+        x.cmplt(L::splat(0.08)),
+        x - L::splat(6.25) * x * x,
+        L::splat(0.04),
+    );
+    let c = c - V3 {
+        x: offset,
+        y: offset,
+        z: offset,
+    };
+    let peak = max_element(c);
     let d = 1.0 - START;
-    let new_peak = 1.0 - d * d / (peak + d - START);
-    let c = c * (new_peak / peak);
-    let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
-    c.lerp(Vec3::splat(new_peak), g)
+    let new_peak = one - L::splat(d * d) / (peak + L::splat(d) - L::splat(START));
+    let squeezed = c.scale(new_peak / peak);
+    let g = one - one / (L::splat(DESATURATION) * (peak - new_peak) + one);
+    // `Vec3::lerp`: a (1 - g) + b g.
+    let peaks = V3 {
+        x: new_peak,
+        y: new_peak,
+        z: new_peak,
+    };
+    let compressed = squeezed.scale(one - g) + peaks.scale(g);
+    V3::select(peak.cmplt(L::splat(START)), c, compressed)
 }
 
 /// AgX (Troy Sobotka's, in the common minimal form): an inset into a
 /// wider primaries space, a log2 encoding over [-12.47, 4.03] stops, the
 /// default contrast curve (a polynomial fit of its sigmoid), the outset,
 /// and back to linear for the sRGB encoding.
-fn agx(c: Vec3) -> Vec3 {
+#[inline(always)]
+fn agx<L: Lane>(c: V3<L>) -> V3<L> {
     const MIN_EV: f32 = -12.473_931;
     const MAX_EV: f32 = 4.026_069;
     let inset = Mat3::from_cols(
@@ -87,38 +163,49 @@ fn agx(c: Vec3) -> Vec3 {
         Vec3::new(-0.098_020_88, 1.151_903_1, -0.098_043_45),
         Vec3::new(-0.099_029_74, -0.098_961_18, 1.151_073_7),
     );
-    let v = inset * c.max(Vec3::splat(1e-10));
-    let v = Vec3::new(v.x.log2(), v.y.log2(), v.z.log2())
-        .clamp(Vec3::splat(MIN_EV), Vec3::splat(MAX_EV));
-    let x = (v - Vec3::splat(MIN_EV)) / (MAX_EV - MIN_EV);
+    let v = c.max(V3::splat(Vec3::splat(1e-10))).by(inset);
+    let v = V3 {
+        x: v.x.map(f32::log2),
+        y: v.y.map(f32::log2),
+        z: v.z.map(f32::log2),
+    }
+    .max(V3::splat(Vec3::splat(MIN_EV)))
+    .min(V3::splat(Vec3::splat(MAX_EV)));
+    let x = v.plus(-MIN_EV) / L::splat(MAX_EV - MIN_EV);
     let x2 = x * x;
     let x4 = x2 * x2;
-    let curve =
-        x4 * x2 * 15.5 - x4 * x * 40.14 + x4 * 31.96 - x2 * x * 6.868 + x2 * 0.4298 + x * 0.1191
-            - Vec3::splat(0.00232);
-    let display = (outset * curve).max(Vec3::ZERO);
+    let curve = ((((((x4 * x2).times(15.5) - (x4 * x).times(40.14)) + x4.times(31.96))
+        - (x2 * x).times(6.868))
+        + x2.times(0.4298))
+        + x.times(0.1191))
+    .plus(-0.00232);
+    let display = curve.by(outset).max(V3::zero());
     // The curve's output is display-encoded (gamma 2.2): back to linear.
-    Vec3::new(
-        display.x.powf(2.2),
-        display.y.powf(2.2),
-        display.z.powf(2.2),
-    )
+    let linear = |l: L| l.map(|x| x.powf(2.2));
+    V3 {
+        x: linear(display.x),
+        y: linear(display.y),
+        z: linear(display.z),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Every tone map.
+    const ALL: [Tonemap; 6] = [
+        Tonemap::Clamp,
+        Tonemap::Reinhard,
+        Tonemap::Aces,
+        Tonemap::AcesHill,
+        Tonemap::PbrNeutral,
+        Tonemap::Agx,
+    ];
+
     #[test]
     fn tone_maps_are_monotonic_and_bounded() {
-        for op in [
-            Tonemap::Clamp,
-            Tonemap::Reinhard,
-            Tonemap::Aces,
-            Tonemap::AcesHill,
-            Tonemap::PbrNeutral,
-            Tonemap::Agx,
-        ] {
+        for op in ALL {
             let mut last = -1.0;
             for i in 0..100 {
                 let v = tonemap(Vec3::splat(i as f32 * 0.1), op, 1.0).x;
@@ -127,6 +214,49 @@ mod tests {
             }
         }
         assert!((tonemap(Vec3::ONE, Tonemap::Reinhard, 1.0).x - 0.5).abs() < 1e-6);
+    }
+
+    /// Eight lanes (`tonemap_lanes`, as the display encodes) give each
+    /// lane's one-lane value bit for bit, for every map, over darks,
+    /// highlights, saturated colours, zeros, infinities and NaN.
+    #[test]
+    fn eight_lanes_are_one_lane_bit_for_bit() {
+        use crate::simd::{F8, Lane, V3};
+        let mut colors = Vec::new();
+        let levels = [
+            0.0, 1e-6, 0.003, 0.05, 0.079, 0.081, 0.2, 0.75, 0.77, 1.0, 3.0, 40.0,
+        ];
+        for (i, &r) in levels.iter().enumerate() {
+            for (j, &g) in levels.iter().enumerate() {
+                colors.push(Vec3::new(r, g, levels[(i * 5 + j * 7) % levels.len()]));
+            }
+        }
+        colors.extend([
+            Vec3::new(f32::INFINITY, 0.5, 0.0),
+            Vec3::new(f32::NAN, 0.2, 0.3),
+            Vec3::new(-0.5, 0.3, 0.9),
+        ]);
+        for op in ALL {
+            for chunk in colors.chunks(8) {
+                let at = |k: usize| chunk[k % chunk.len()];
+                let c = V3 {
+                    x: F8::from_fn(|k| at(k).x),
+                    y: F8::from_fn(|k| at(k).y),
+                    z: F8::from_fn(|k| at(k).z),
+                };
+                let t = tonemap_lanes(c, op, 1.5);
+                for k in 0..8 {
+                    let want = tonemap(at(k), op, 1.5);
+                    let got = Vec3::new(t.x.lane(k), t.y.lane(k), t.z.lane(k));
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.to_array().map(f32::to_bits),
+                        "{op:?} {:?}",
+                        at(k)
+                    );
+                }
+            }
+        }
     }
 
     #[test]

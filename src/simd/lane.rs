@@ -352,6 +352,13 @@ mod f8 {
         }
     }
 
+    impl From<F8> for __m256 {
+        #[inline(always)]
+        fn from(v: F8) -> __m256 {
+            v.0
+        }
+    }
+
     impl From<__m256> for F8 {
         #[inline(always)]
         fn from(v: __m256) -> F8 {

@@ -46,6 +46,27 @@ pub struct Taps4 {
     far: Option<(Place4, Vec4)>,
 }
 
+/// Where four lookups of which some take anisotropic probes fall
+/// (`Chain::probe_taps`), in any texture of one size and mip chain.
+pub struct ProbeTaps {
+    /// Per probe: its taps, and 1 in the lanes that take it (0 in those
+    /// whose probes ran out).
+    probes: Vec<(Taps4, Vec4)>,
+    /// Probes per lane.
+    count: Vec4,
+}
+
+/// Where four lookups fall in any texture of one size and mip chain
+/// (`Chain::place4_into`), for the maps that share it: one trilinear
+/// probe per lane (`taps`), or anisotropic probes in some lane
+/// (`probes`); neither where some lane reads the nearest texel (`sample4`
+/// looks the lanes up) or nothing was placed yet.
+#[derive(Default)]
+pub struct Placed4 {
+    taps: Option<Taps4>,
+    probes: Option<ProbeTaps>,
+}
+
 /// Bilinear footprints in one level per lane.
 struct Place4 {
     /// Level per lane (0: the image itself, k: mip level k).
@@ -179,25 +200,57 @@ impl<'t> Chain<'t> {
     /// where some lane takes anisotropic probes or the nearest texel.
     #[inline]
     pub fn taps4(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4]) -> Option<Taps4> {
-        let mut out = None;
-        self.taps4_into(u, v, fps, &mut out);
-        out
+        let lod = Self::lods(fps)?;
+        Some(self.lod_taps4(u, v, lod))
     }
 
-    /// `*out = self.taps4(u, v, fps)`, written in place.
-    #[inline]
-    pub fn taps4_into(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], out: &mut Option<Taps4>) {
+    /// Each lane's level of detail, where every lane takes one trilinear
+    /// probe.
+    #[inline(always)]
+    fn lods(fps: &[Footprint; 4]) -> Option<[f32; 4]> {
         let mut lod = [0.0f32; 4];
         for k in 0..4 {
             match fps[k] {
                 Footprint::Lod(l) => lod[k] = l,
-                Footprint::Probes { .. } | Footprint::Nearest => {
-                    *out = None;
-                    return;
-                }
+                Footprint::Probes { .. } | Footprint::Nearest => return None,
             }
         }
-        *out = Some(self.lod_taps4(u, v, lod));
+        Some(lod)
+    }
+
+    /// `*out` = where `sample4(u, v, fps, _)` reads, in this chain or any
+    /// other of its shape (`read_placed`), written in place.
+    #[inline]
+    pub fn place4_into(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], out: &mut Placed4) {
+        out.probes = None;
+        out.taps = None;
+        match Self::lods(fps) {
+            Some(lod) => out.taps = Some(self.lod_taps4(u, v, lod)),
+            None if fps.contains(&Footprint::Nearest) => {}
+            None => {
+                let most = fps.iter().map(|f| match f {
+                    Footprint::Probes { n, .. } => *n as usize,
+                    _ => 1,
+                });
+                let mut probes = Vec::with_capacity(most.max().unwrap_or(1));
+                let count = self.each_probe(u, v, fps, 0b1111, |t, live| probes.push((t, live)));
+                out.probes = Some(ProbeTaps { probes, count });
+            }
+        }
+    }
+
+    /// What `sample4` gives at the lookups `placed` places (found in a
+    /// chain of this shape), in this texture; None where they are not
+    /// placed.
+    #[inline]
+    pub fn read_placed(&self, placed: &Placed4, mode: Wrap) -> Option<Rgb4> {
+        match placed {
+            Placed4 { taps: Some(t), .. } => Some(self.read::<3>(t, mode)),
+            Placed4 {
+                probes: Some(p), ..
+            } => Some(self.read_probes::<3>(p, mode)),
+            _ => None,
+        }
     }
 
     /// The taps of `sample_lod(mips, uv_k, mode, lod[k])` per lane: the
@@ -279,6 +332,17 @@ impl<'t> Chain<'t> {
         match &taps.far {
             None => a,
             Some((far, f)) => blend(a, self.bilinear4(far, taps.u, taps.v, mode), *f),
+        }
+    }
+
+    /// `prefetch` of the lookups `placed` places.
+    #[inline]
+    pub fn prefetch_placed(&self, placed: &Placed4) {
+        if let Some(t) = &placed.taps {
+            self.prefetch(t);
+        }
+        if let Some(p) = &placed.probes {
+            p.probes.iter().for_each(|(t, _)| self.prefetch(t));
         }
     }
 
@@ -385,11 +449,8 @@ impl<'t> Chain<'t> {
         out
     }
 
-    /// Four lanes of which some take anisotropic probes: per lane, `n`
-    /// trilinear probes spread along the footprint's longer axis (at
-    /// (k + 1/2) / n - 1/2 of it), their sum over their count, a lane
-    /// with fewer probes adding nothing after its last (x + 0 = x); a
-    /// `Lod` lane is one probe at the point itself ((0 + x) / 1 = x).
+    /// Four lanes of which some take anisotropic probes (`each_probe`):
+    /// per lane, the sum of its probes over their count.
     fn probes<const N: usize>(
         &self,
         u: Vec4,
@@ -398,6 +459,50 @@ impl<'t> Chain<'t> {
         mode: Wrap,
         used: u32,
     ) -> [Vec4; N] {
+        let mut sum = [Vec4::ZERO; N];
+        let count = self.each_probe(u, v, fps, used, |taps, live| {
+            self.add_probe(&mut sum, &taps, live, mode);
+        });
+        sum.map(|s| s / count)
+    }
+
+    /// The probes `taps` place (found in a chain of this shape), read in
+    /// this texture as `probes` reads them.
+    fn read_probes<const N: usize>(&self, taps: &ProbeTaps, mode: Wrap) -> [Vec4; N] {
+        let mut sum = [Vec4::ZERO; N];
+        for (probe, live) in &taps.probes {
+            self.add_probe(&mut sum, probe, *live, mode);
+        }
+        sum.map(|s| s / taps.count)
+    }
+
+    /// One probe's lookups added to `sum` in the lanes `live` (1) that
+    /// take it; a lane with fewer probes adds nothing after its last (x +
+    /// 0 = x).
+    #[inline(always)]
+    fn add_probe<const N: usize>(&self, sum: &mut [Vec4; N], taps: &Taps4, live: Vec4, mode: Wrap) {
+        let r: [Vec4; N] = self.read(taps, mode);
+        let live = live.cmpgt(Vec4::ZERO);
+        for c in 0..N {
+            sum[c] += Vec4::select(live, r[c], Vec4::ZERO);
+        }
+    }
+
+    /// Where four lanes of which some take anisotropic probes read: per
+    /// lane, `n` trilinear probes spread along the footprint's longer
+    /// axis (at (k + 1/2) / n - 1/2 of it); a `Lod` lane is one probe at
+    /// the point itself. Each probe's taps (only the lanes `used` read)
+    /// and 1 in the lanes that take it go to `f`, in order; returns the
+    /// probes per lane.
+    #[inline(always)]
+    fn each_probe(
+        &self,
+        u: Vec4,
+        v: Vec4,
+        fps: &[Footprint; 4],
+        used: u32,
+        mut f: impl FnMut(Taps4, Vec4),
+    ) -> Vec4 {
         let mut n = [1u32; 4];
         let mut nf = [1.0f32; 4];
         let mut lod = [0.0f32; 4];
@@ -419,9 +524,8 @@ impl<'t> Chain<'t> {
                 }
             }
         }
-        let probes = n.iter().copied().max().unwrap_or(1);
-        let mut sum = [Vec4::ZERO; N];
-        for p in 0..probes {
+        let count = n.iter().copied().max().unwrap_or(1);
+        for p in 0..count {
             let (mut pu, mut pv) = (u, v);
             let mut live = [0.0f32; 4];
             for k in 0..4 {
@@ -435,14 +539,9 @@ impl<'t> Chain<'t> {
                     }
                 }
             }
-            let r: [Vec4; N] = self.read(&self.lod_taps4(pu, pv, lod).only(used), mode);
-            let live = Vec4::from(live).cmpgt(Vec4::ZERO);
-            for c in 0..N {
-                sum[c] += Vec4::select(live, r[c], Vec4::ZERO);
-            }
+            f(self.lod_taps4(pu, pv, lod).only(used), Vec4::from(live));
         }
-        let nf = Vec4::from(nf);
-        sum.map(|s| s / nf)
+        Vec4::from(nf)
     }
 }
 

@@ -23,7 +23,7 @@ use glam::{Affine2, Vec2, Vec4};
 use super::input::Input;
 use crate::color::srgb_to_linear_table;
 use crate::error::Error;
-pub use lanes::{Chain, Rgb4, Taps4};
+pub use lanes::{Chain, Placed4, Rgb4, Taps4};
 
 /// Texture filtering, ordered from the least to the most filtering (a
 /// sampler's limit lowers a scene's filter to it, never raises it).

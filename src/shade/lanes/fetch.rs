@@ -10,7 +10,7 @@ use glam::{Affine2, Mat3, Vec2, Vec4};
 
 use super::material::{LaneMaterial, Map};
 use super::{Coords, MAX_SIZES};
-use crate::assets::texture::{Footprint, Taps4, TextureRef};
+use crate::assets::texture::{Footprint, Placed4, TextureRef};
 use crate::scene::material::{NormalMap, NormalSpace};
 use crate::shade::Fetch;
 use crate::simd::{Lane, Mask, V3};
@@ -311,8 +311,8 @@ pub(in crate::shade) fn tangent_frame<L: Lane>(n: V3<L>, (t, sign): (V3<L>, L)) 
 pub(super) struct Lookups<'f, 'p, L: Lane> {
     coords: &'f Coords<'p, L>,
     /// Per quad and slot, once found (bit k of `found` for slot k): where
-    /// its lookups fall, or None where some lane takes anisotropic probes.
-    taps: [[Option<Taps4>; MAX_SIZES]; 2],
+    /// its lookups fall.
+    taps: [[Placed4; MAX_SIZES]; 2],
     found: u32,
 }
 
@@ -320,7 +320,7 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     pub(super) fn new(coords: &'f Coords<'p, L>) -> Lookups<'f, 'p, L> {
         Lookups {
             coords,
-            taps: [[None, None, None], [None, None, None]],
+            taps: Default::default(),
             found: 0,
         }
     }
@@ -333,7 +333,7 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
         if s < MAX_SIZES && self.found & (1 << s) == 0 {
             self.found |= 1 << s;
             for q in 0..L::QUADS {
-                map.chain.taps4_into(
+                map.chain.place4_into(
                     f.uv[s].0.quad(q),
                     f.uv[s].1.quad(q),
                     &f.footprints4(s, q),
@@ -348,8 +348,8 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
     pub fn prefetch(&mut self, map: &Map) {
         self.find(map);
         for q in 0..L::QUADS {
-            if let Some(Some(t)) = self.taps[q].get(map.slot) {
-                map.chain.prefetch(t);
+            if let Some(placed) = self.taps[q].get(map.slot) {
+                map.chain.prefetch_placed(placed);
             }
         }
     }
@@ -361,9 +361,10 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
         let f = self.coords;
         let mut rgb = [[Vec4::ZERO; 3]; 2];
         for (q, out) in rgb.iter_mut().enumerate().take(L::QUADS) {
-            *out = match self.taps[q].get(map.slot) {
-                Some(Some(t)) => map.chain.read4(t, map.mode),
-                _ => map.chain.sample4(
+            let placed = self.taps[q].get(map.slot);
+            *out = match placed.and_then(|p| map.chain.read_placed(p, map.mode)) {
+                Some(rgb) => rgb,
+                None => map.chain.sample4(
                     f.uv(map).0.quad(q),
                     f.uv(map).1.quad(q),
                     &f.footprints4(map.slot, q),
