@@ -174,3 +174,59 @@ fn box_hit(lo: Vec3A, hi: Vec3A, o: Vec3A, inv: Vec3A, t_max: f32) -> bool {
     let far = t0.max(t1).min_element().min(t_max);
     near <= far
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bounds of all instances together (`may_meet`) change no answer:
+    /// two boxes apart, one turned, and rays from a grid of points towards
+    /// a spread of directions, some through the gap between them, some
+    /// past both, with and without a length, as `occluded` and `nearest`
+    /// give them without those bounds.
+    #[test]
+    fn the_scene_bounds_change_no_ray() {
+        let positions = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let bvh = Bvh::build(&positions, &[[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]);
+        let bounds = (Vec3::ZERO, Vec3::ONE);
+        let placed = [
+            Mat4::from_translation(Vec3::new(-2.0, 0.0, 0.0)),
+            Mat4::from_translation(Vec3::new(1.5, 0.5, 0.0)) * Mat4::from_rotation_y(0.7),
+        ]
+        .map(|world_from_object| Placed {
+            bvh: &bvh,
+            bounds,
+            world_from_object,
+        });
+        let tracer = Tracer::new(placed, 4.0);
+        assert!(tracer.bounds.is_some());
+        let unbounded = Tracer {
+            bounds: None,
+            ..Tracer::new(placed, 4.0)
+        };
+        let (mut hits, mut rays) = (0, 0);
+        for i in 0..9 {
+            for j in 0..9 {
+                let o = Vec3::new(i as f32 - 4.0, 3.0, j as f32 - 4.0);
+                for k in 0..24 {
+                    let a = k as f32 * 0.26;
+                    let d = Vec3::new(a.cos(), -0.4 - 0.1 * (k % 5) as f32, a.sin()).normalize();
+                    for t_max in [f32::INFINITY, 4.0] {
+                        let hit = unbounded.occluded(o, d, t_max);
+                        assert_eq!(tracer.occluded(o, d, t_max), hit, "{o} {d} {t_max}");
+                        assert_eq!(tracer.nearest(o, d, t_max), unbounded.nearest(o, d, t_max));
+                        hits += u32::from(hit);
+                        rays += 1;
+                    }
+                }
+            }
+        }
+        // Some rays meet the boxes, most miss both.
+        assert!(hits > 20 && hits < rays / 2, "{hits} of {rays}");
+    }
+}

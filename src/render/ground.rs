@@ -224,6 +224,9 @@ impl<'a> Ground<'a> {
     /// ray, or the open share of a disc's cone; 1 for a light that casts
     /// no shadows.
     fn visibility(&self, light: &Light, p: Vec3, inc: Incidence) -> f32 {
+        if !light.shadows {
+            return 1.0;
+        }
         let origin = p + Vec3::Y * self.tracer.epsilon;
         let t_max = if light.kind_is_directional() {
             f32::INFINITY
@@ -236,7 +239,6 @@ impl<'a> Ground<'a> {
             inc.l
         };
         match light.kind {
-            _ if !light.shadows => 1.0,
             LightKind::Directional { angle, .. } if angle > 0.0 => {
                 open_share(self.tracer, angle, p, Vec3::Y, inc.l)
             }

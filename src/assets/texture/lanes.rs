@@ -9,10 +9,10 @@
 //! bilinear footprint's texels (their positions in the block layout) and
 //! weights. That depends only on the texture's size and mip chain, so the
 //! maps of a material that share a size (diffuse, specular and normal map,
-//! mostly) share it. `Texture::read4` then loads, decodes and blends each
-//! map's texels. A lane whose footprint leaves the image (an address mode
-//! applies) takes the one-lookup path, and anisotropic probes are looked
-//! up probe by probe (`probes4`).
+//! mostly) share it, anisotropic probes included (`Chain::place4_into`).
+//! `Chain::read_placed` then loads, decodes and blends each map's texels.
+//! A lane whose footprint leaves the image (an address mode applies) takes
+//! the one-lookup path.
 
 // Loops over the four lanes index several per-lane arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -47,7 +47,7 @@ pub struct Taps4 {
 }
 
 /// Where four lookups of which some take anisotropic probes fall
-/// (`Chain::probe_taps`), in any texture of one size and mip chain.
+/// (`Chain::place4_into`), in any texture of one size and mip chain.
 pub struct ProbeTaps {
     /// Per probe: its taps, and 1 in the lanes that take it (0 in those
     /// whose probes ran out).
@@ -313,14 +313,9 @@ impl<'t> Chain<'t> {
         level_of(&self.texture.base, self.mips, i)
     }
 
-    /// The lookups `taps` (found in a chain of this shape) describe, in
-    /// this texture: red, green and blue.
-    #[inline]
-    pub fn read4(&self, taps: &Taps4, mode: Wrap) -> Rgb4 {
-        self.read::<3>(taps, mode)
-    }
-
-    /// `read4` of the first `N` channels.
+    /// The lookups `taps` describe, in this texture: the first `N`
+    /// channels (taps found in a chain of another shape are found again
+    /// here).
     #[inline]
     fn read<const N: usize>(&self, taps: &Taps4, mode: Wrap) -> [Vec4; N] {
         if taps.shape != self.shape() {
@@ -346,9 +341,9 @@ impl<'t> Chain<'t> {
         }
     }
 
-    /// Asks for the cache lines `read4` of `taps` will load, so that the
+    /// Asks for the cache lines `read` of `taps` will load, so that the
     /// misses of several maps overlap instead of coming one map after the
-    /// other. A hint only: what `read4` returns does not change.
+    /// other. A hint only: what `read` returns does not change.
     #[inline]
     pub fn prefetch(&self, taps: &Taps4) {
         if taps.shape != self.shape() {
@@ -391,7 +386,7 @@ impl<'t> Chain<'t> {
                 debug_assert!(i + dx + dy < t.len());
                 // SAFETY: an inside lane's footprint has x0 + 1 < width and
                 // y0 + 1 < height in its level (`Place4::new`, for a level
-                // of this size: `read4` checks the shape), so its four
+                // of this size: `read` checks the shape), so its four
                 // texels, the last at i + dx + dy, lie in the level's
                 // blocks (`Level::footprint`'s steps).
                 unsafe {
