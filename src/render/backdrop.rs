@@ -10,13 +10,13 @@
 //! computed once and read by every frame after it. The values are the
 //! lookups' own, so frames are the same bytes with or without it.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use glam::Vec4;
 use rayon::prelude::*;
 
 use super::draw_list::DrawList;
-use super::rays::CameraRays;
+use super::rays::{CameraRays, ViewCache};
 use crate::scene::light::LightKind;
 use crate::scene::settings::Background;
 use crate::shade::env::{Disc, EnvLight};
@@ -40,7 +40,7 @@ pub(super) struct EnvBackground<'a> {
 /// What a backdrop depends on: the view rays, the blur and the
 /// environment's lighting (by address: one renderer's, built once).
 #[derive(PartialEq)]
-struct Key {
+pub(super) struct Key {
     rays: CameraRays,
     blur: u32,
     env: usize,
@@ -133,41 +133,13 @@ pub(super) fn image_discs(setup: &DrawList) -> Vec<Disc> {
 type Image = Arc<Vec<Vec4>>;
 
 /// The last backdrop a renderer drew, kept while its view stays.
-#[derive(Default)]
-pub(super) struct BackdropCache {
-    last: Mutex<Option<(Key, Option<Image>)>>,
-}
+pub(super) type BackdropCache = ViewCache<Key, Vec<Vec4>>;
 
-impl BackdropCache {
-    /// Gives `bg` the whole image where the previous frame had the same
-    /// view (computing it on the second frame of a view); remembers the
-    /// view otherwise.
-    pub fn attach(&self, bg: &mut EnvBackground) {
-        let key = bg.key();
-        // A poisoned lock (a panic in another frame) only loses the cache.
-        let Ok(mut last) = self.last.lock() else {
-            return;
-        };
-        match &mut *last {
-            Some((k, image)) if *k == key => {
-                let image = image.get_or_insert_with(|| Arc::new(bg.image()));
-                bg.cached = Some(image.clone());
-            }
-            _ => *last = Some((key, None)),
-        }
-    }
-
-    /// The bytes the kept image holds.
-    #[cfg(test)]
-    fn bytes(&self) -> usize {
-        self.last
-            .lock()
-            .ok()
-            .and_then(|l| {
-                l.as_ref()
-                    .and_then(|(_, i)| i.as_ref().map(|i| i.len() * 16))
-            })
-            .unwrap_or(0)
+impl EnvBackground<'_> {
+    /// Reads the whole image from `cache` where the previous frame had the
+    /// same view (computing it on the second frame of a view).
+    pub fn attach(&mut self, cache: &BackdropCache) {
+        self.cached = cache.get(self.key(), || self.image());
     }
 }
 
@@ -201,13 +173,13 @@ mod tests {
             let eye = Vec3::new(1.0, 0.5, 3.0);
             // First frame of the view: nothing kept.
             let mut first = backdrop(&env, eye, blur);
-            cache.attach(&mut first);
+            first.attach(&cache);
             assert!(first.cached.is_none());
             // Second: the whole image, equal to the lookups.
             let mut second = backdrop(&env, eye, blur);
-            cache.attach(&mut second);
+            second.attach(&cache);
             assert!(second.cached.is_some());
-            assert_eq!(cache.bytes(), 37 * 23 * 16);
+            assert_eq!(cache.kept().map(|i| i.len()), Some(37 * 23));
             for y in 0..23 {
                 for x in 0..37 {
                     let (a, b) = (second.at(x, y), first.at(x, y));
@@ -219,7 +191,7 @@ mod tests {
             }
             // Another view is not served the kept image.
             let mut moved = backdrop(&env, eye + Vec3::X * 0.01, blur);
-            cache.attach(&mut moved);
+            moved.attach(&cache);
             assert!(moved.cached.is_none());
         }
     }

@@ -16,12 +16,12 @@
 //! center (1 beyond) and interpolated bilinearly. The catcher fades out
 //! between 2 and 3 radii from the center.
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3, Vec4};
 
 use super::draw_list::DrawList;
-use super::rays::CameraRays;
+use super::rays::{CameraRays, ViewCache};
 use crate::raytrace::Tracer;
 use crate::scene::Light;
 use crate::scene::light::LightKind;
@@ -55,7 +55,60 @@ pub(super) struct Ground<'a> {
     /// None: no such bounds.
     open_outside: Option<[i32; 4]>,
     transparent: bool,
+    /// Without lights, where each pixel of the grid's view meets the
+    /// plane (`GroundView`), when the renderer keeps it for this view.
+    view: Option<Arc<GroundView>>,
 }
+
+/// Where a pixel's view ray meets the plane, as the catcher reads it
+/// without lights: the fade there (0: no plane point shown) and the
+/// contact grid's cell (None: outside the grid, no contact shadow).
+#[derive(Clone, Copy)]
+struct Spot {
+    fade: f32,
+    cell: Option<Cell>,
+}
+
+/// A plane point's place in the contact grid: the corners of its cell
+/// (column and row of the first and second) and the blend weights.
+#[derive(Clone, Copy)]
+struct Cell {
+    x: [u8; 2],
+    z: [u8; 2],
+    f: [f32; 2],
+}
+
+/// Every pixel's `Spot` within the bounds of the whole contact grid
+/// seen through the camera (the pixels beyond see no grid point, so
+/// without lights they keep the background). The same for every frame
+/// of a camera: the plane does not move.
+pub(super) struct GroundView {
+    /// First column and row, width and height.
+    at: [i32; 4],
+    spots: Vec<Spot>,
+}
+
+impl GroundView {
+    fn spot(&self, px: i32, py: i32) -> Option<&Spot> {
+        let [x0, y0, w, h] = self.at;
+        let (x, y) = (px - x0, py - y0);
+        if x < 0 || y < 0 || x >= w || y >= h {
+            return None;
+        }
+        self.spots.get((y * w + x) as usize)
+    }
+}
+
+/// What a ground view depends on: the view rays and the plane (its
+/// height, center and radius, as bits).
+#[derive(PartialEq)]
+pub(super) struct ViewKey {
+    rays: CameraRays,
+    plane: [u32; 5],
+}
+
+/// The last ground view a renderer read, kept while its camera stays.
+pub(super) type GroundCache = ViewCache<ViewKey, GroundView>;
 
 fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
@@ -95,6 +148,7 @@ impl<'a> Ground<'a> {
             ao,
             open_outside: None,
             transparent: setup.scene.settings.background == Background::Transparent,
+            view: None,
         };
         ground.open_outside = ground.open_outside();
         Some(ground)
@@ -103,8 +157,7 @@ impl<'a> Ground<'a> {
     /// `open_outside`'s bounds: where there are no lights, those of the
     /// contact grid's shadowed part (its points below 1, two cells wider:
     /// beyond them every lookup blends four 1s, and the factor is 1) seen
-    /// through the camera, its corners all in front of it (the rectangle,
-    /// convex, then lies within their bounds).
+    /// through the camera.
     fn open_outside(&self) -> Option<[i32; 4]> {
         const NOWHERE: Option<[i32; 4]> = Some([1, 1, 0, 0]);
         if !self.lights.is_empty() {
@@ -122,6 +175,15 @@ impl<'a> Ground<'a> {
             glo = glo.min(Vec2::from(at(k)));
             ghi = ghi.max(Vec2::from(at(k)));
         }
+        self.seen_bounds(glo, ghi)
+    }
+
+    /// The pixels (first and last column, first and last row) that see
+    /// the grid's points from `glo` to `ghi` (column, row), two cells
+    /// wider, with two pixels for rounding: the rectangle's corners seen
+    /// through the camera, all in front of it (the rectangle, convex,
+    /// then lies within their bounds). None where a corner is not.
+    fn seen_bounds(&self, glo: Vec2, ghi: Vec2) -> Option<[i32; 4]> {
         let half = AO_EXTENT * self.radius;
         let step = 2.0 * half / AO_GRID as f32;
         // Grid point (i, j) lies at center - half + (i + 1/2) step.
@@ -154,9 +216,70 @@ impl<'a> Ground<'a> {
             })
     }
 
+    /// Without lights, reads where each pixel meets the plane from
+    /// `cache` where the previous frame had the same camera (computing
+    /// it on the second frame of a camera).
+    pub fn attach(&mut self, cache: &GroundCache) {
+        if !self.lights.is_empty() || self.ambient <= 0.0 {
+            return;
+        }
+        let key = ViewKey {
+            rays: self.rays.clone(),
+            plane: [
+                self.height.to_bits(),
+                self.center.x.to_bits(),
+                self.center.y.to_bits(),
+                self.center.z.to_bits(),
+                self.radius.to_bits(),
+            ],
+        };
+        self.view = cache.get(key, || self.view_of_grid());
+    }
+
+    /// Every pixel's `Spot` within the bounds of the whole grid seen
+    /// through the camera, clipped to the frame; rows in parallel.
+    fn view_of_grid(&self) -> GroundView {
+        use rayon::prelude::*;
+        let last = Vec2::splat((AO_GRID - 1) as f32);
+        let Some([x0, y0, x1, y1]) = self.seen_bounds(Vec2::ZERO, last) else {
+            return GroundView {
+                at: [0; 4],
+                spots: Vec::new(),
+            };
+        };
+        let (w, h) = self.rays.size();
+        let (x0, y0) = (x0.max(0), y0.max(0));
+        let (x1, y1) = (x1.min(w as i32 - 1), y1.min(h as i32 - 1));
+        let (vw, vh) = ((x1 - x0 + 1).max(0), (y1 - y0 + 1).max(0));
+        let none = Spot {
+            fade: 0.0,
+            cell: None,
+        };
+        let mut spots = vec![none; (vw * vh) as usize];
+        spots
+            .par_chunks_mut(vw.max(1) as usize)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, s) in row.iter_mut().enumerate() {
+                    let (px, py) = (x0 + x as i32, y0 + y as i32);
+                    if let Some((p, fade)) = self.plane_point(px, py) {
+                        *s = Spot {
+                            fade,
+                            cell: self.cell(p),
+                        };
+                    }
+                }
+            });
+        GroundView {
+            at: [x0, y0, vw, vh],
+            spots,
+        }
+    }
+
     /// `bg` with the catcher at pixel (px, py) composited over it: darkened
     /// by the catcher's factor, or, over a transparent background, black
     /// with the shadow's opacity as alpha.
+    #[inline]
     pub fn over(&self, bg: Vec4, px: i32, py: i32) -> Vec4 {
         if let Some([x0, y0, x1, y1]) = self.open_outside
             && (px < x0 || px > x1 || py < y0 || py > y1)
@@ -165,6 +288,12 @@ impl<'a> Ground<'a> {
             // background, black with alpha 0, which is `bg` there).
             return bg;
         }
+        self.over_inside(bg, px, py)
+    }
+
+    /// `over` where the pixel is not known to keep `bg`.
+    #[inline(never)]
+    fn over_inside(&self, bg: Vec4, px: i32, py: i32) -> Vec4 {
         let Some(f) = self.factor(px, py) else {
             return bg;
         };
@@ -177,6 +306,9 @@ impl<'a> Ground<'a> {
 
     /// The share of light the plane keeps at the pixel (1: none taken).
     fn factor(&self, px: i32, py: i32) -> Option<f32> {
+        if let Some(spot) = self.view.as_ref().and_then(|v| v.spot(px, py)) {
+            return self.factor_seen(spot);
+        }
         let (p, fade) = self.plane_point(px, py)?;
         let (mut total, mut kept) = (self.ambient, 0.0);
         for light in self.lights {
@@ -189,10 +321,20 @@ impl<'a> Ground<'a> {
         if self.ambient > 0.0 {
             kept += self.ambient * self.contact(p);
         }
-        if total <= 0.0 {
+        share(total, kept, fade)
+    }
+
+    /// `factor` without lights, from the view's spot: the same operations
+    /// on the same values.
+    fn factor_seen(&self, spot: &Spot) -> Option<f32> {
+        if spot.fade <= 0.0 {
             return None;
         }
-        Some(1.0 - fade * (1.0 - kept / total))
+        let mut kept = 0.0;
+        if self.ambient > 0.0 {
+            kept += self.ambient * spot.cell.as_ref().map_or(1.0, |c| self.blend(c));
+        }
+        share(self.ambient, kept, spot.fade)
     }
 
     /// The plane point pixel (px, py) sees, and the catcher's fade there;
@@ -250,22 +392,46 @@ impl<'a> Ground<'a> {
 impl Ground<'_> {
     /// Contact occlusion at plane point `p`, from the grid.
     fn contact(&self, p: Vec3) -> f32 {
+        self.cell(p).map_or(1.0, |c| self.blend(&c))
+    }
+
+    /// Where plane point `p` falls in the grid; None outside it.
+    fn cell(&self, p: Vec3) -> Option<Cell> {
         let half = AO_EXTENT * self.radius;
         let n = AO_GRID as f32;
         let gx = (p.x - self.center.x + half) / (2.0 * half) * n - 0.5;
         let gz = (p.z - self.center.z + half) / (2.0 * half) * n - 0.5;
         if !(gx > -0.5 && gz > -0.5 && gx < n - 0.5 && gz < n - 0.5) {
-            return 1.0;
+            return None;
         }
         let (gx, gz) = (gx.clamp(0.0, n - 1.0), gz.clamp(0.0, n - 1.0));
-        let (x0, z0) = (gx as usize, gz as usize);
-        let (x1, z1) = ((x0 + 1).min(AO_GRID - 1), (z0 + 1).min(AO_GRID - 1));
-        let (fx, fz) = (gx - x0 as f32, gz - z0 as f32);
-        let at = |x: usize, z: usize| self.ao[z * AO_GRID + x];
+        // Within [0, 95]: the casts are exact.
+        let (x0, z0) = (gx as u8, gz as u8);
+        let last = (AO_GRID - 1) as u8;
+        Some(Cell {
+            x: [x0, (x0 + 1).min(last)],
+            z: [z0, (z0 + 1).min(last)],
+            f: [gx - f32::from(x0), gz - f32::from(z0)],
+        })
+    }
+
+    /// The grid's occlusion blended over `c`.
+    fn blend(&self, c: &Cell) -> f32 {
+        let at = |x: u8, z: u8| self.ao[z as usize * AO_GRID + x as usize];
+        let ([x0, x1], [z0, z1], [fx, fz]) = (c.x, c.z, c.f);
         let a = at(x0, z0) + (at(x1, z0) - at(x0, z0)) * fx;
         let b = at(x0, z1) + (at(x1, z1) - at(x0, z1)) * fx;
         a + (b - a) * fz
     }
+}
+
+/// The catcher's factor from the light's total and kept luminance, and
+/// the fade; None without light.
+fn share(total: f32, kept: f32, fade: f32) -> Option<f32> {
+    if total <= 0.0 {
+        return None;
+    }
+    Some(1.0 - fade * (1.0 - kept / total))
 }
 
 /// Contact occlusion on the grid: rays of half a radius from farther than
@@ -333,6 +499,7 @@ mod tests {
     use super::*;
     use crate::raytrace::Placed;
     use crate::raytrace::bvh::Bvh;
+    use crate::scene::camera::Camera;
     use crate::shade::ao::occlusion_at;
     use glam::Mat4;
 
@@ -414,6 +581,59 @@ mod tests {
         }
     }
 
+    /// Without lights, the view a renderer keeps for its camera
+    /// (`GroundView`, read from the second frame of a camera on) gives
+    /// every pixel the bits the catcher computes without it; a moved
+    /// camera is not served it, and a catcher with lights takes none.
+    #[test]
+    fn the_kept_view_is_every_pixel_bit_for_bit() {
+        let (lo, hi) = (Vec3::new(-0.3, 0.0, -0.2), Vec3::new(0.2, 0.7, 0.3));
+        let bvh = box_bvh(lo, hi);
+        let tracer = box_tracer(&bvh, lo, hi);
+        let cache = GroundCache::default();
+        for transparent in [false, true] {
+            let mut ground = box_ground(&tracer, &[]);
+            ground.transparent = transparent;
+            let bg = Vec4::new(0.3, 0.5, 0.7, 1.0);
+            let bits = |c: Vec4| c.to_array().map(f32::to_bits);
+            let computed = ground.pixels(|g, x, y| bits(g.over(bg, x, y)));
+            // The first frame of the camera keeps nothing; the second does.
+            ground.attach(&cache);
+            assert!(ground.view.is_none() || transparent);
+            ground.attach(&cache);
+            let view = ground.view.as_ref().expect("kept");
+            // The view covers the darkened pixels and not the whole frame.
+            let [x0, y0, w, h] = view.at;
+            assert!(
+                w > 10 && h > 10 && (w < W as i32 || h < H as i32),
+                "{:?}",
+                view.at
+            );
+            assert!(x0 >= 0 && y0 >= 0);
+            let read = ground.pixels(|g, x, y| bits(g.over(bg, x, y)));
+            assert_eq!(read, computed);
+            assert!(read.iter().any(|c| *c != bits(bg)), "no contact shadow");
+        }
+        let mut moved = box_ground(&tracer, &[]);
+        moved.rays = CameraRays::new(&Camera::framing("m".into(), Vec3::Y, 1.0, 40.0), W, H);
+        moved.attach(&cache);
+        assert!(moved.view.is_none());
+        let lights = [Light {
+            kind: LightKind::Directional {
+                direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+                irradiance: 1.0,
+                angle: 0.0,
+            },
+            color: Vec3::ONE,
+            shadows: true,
+            range: None,
+        }];
+        let mut lit = box_ground(&tracer, &lights);
+        lit.attach(&cache);
+        lit.attach(&cache);
+        assert!(lit.view.is_none());
+    }
+
     const W: u32 = 97;
     const H: u32 = 61;
 
@@ -444,7 +664,6 @@ mod tests {
     /// A catcher of radius 0.8 at the origin, seen from above at an angle
     /// (`W` x `H`), without bounds.
     fn box_ground<'a>(tracer: &'a Tracer<'a>, lights: &'a [Light]) -> Ground<'a> {
-        use crate::scene::camera::Camera;
         let cam = Camera {
             eye: Vec3::new(0.4, 1.6, 2.4),
             ..Camera::framing("c".into(), Vec3::new(0.0, 0.3, 0.0), 1.0, 40.0)
@@ -460,6 +679,7 @@ mod tests {
             ao: contact_grid(tracer, 0.0, Vec3::ZERO, 0.8),
             open_outside: None,
             transparent: false,
+            view: None,
         }
     }
 

@@ -159,6 +159,8 @@ pub struct Renderer<'s> {
     /// The last camera's environment backdrop (reused while the view
     /// stays).
     backdrops: backdrop::BackdropCache,
+    /// The last camera's ground view (`ground::GroundView`).
+    grounds: ground::GroundCache,
     /// Skip, per tile, the lights that cannot reach it (`light_tiles`);
     /// off only to compare.
     light_culling: bool,
@@ -194,6 +196,7 @@ impl<'s> Renderer<'s> {
             env_sampler: OnceLock::new(),
             shadow_maps: Default::default(),
             backdrops: Default::default(),
+            grounds: Default::default(),
             light_culling: true,
             lane_width: crate::simd::lane_width()
                 .ok()
@@ -548,7 +551,10 @@ impl<'s> Renderer<'s> {
             },
         );
         if let Some(bg) = &mut data.env_bg {
-            self.backdrops.attach(bg);
+            bg.attach(&self.backdrops);
+        }
+        if let Some(g) = &mut data.ground {
+            g.attach(&self.grounds);
         }
         let overlay = !s.shading.is_data_view() && lines::any(setup);
         let fused = if overlay {
