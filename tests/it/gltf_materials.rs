@@ -512,6 +512,66 @@ fn upside_down_through_the_ball(mode: &str, extra: &str) {
     }
 }
 
+/// An opaque core inside a solid glass ball (a bulb's filament): a cube
+/// glowing green, 0.24 wide, at the ball's centre. Through the ball's
+/// middle it shows, in screen space (the default: the opaque frame holds
+/// it, and the refracted ray lands on it) and traced (`sampled`: the
+/// path meets it inside the volume); around it the ball still turns the
+/// backdrop upside down.
+#[test]
+fn an_opaque_core_inside_a_glass_ball_shows_through_it() {
+    for (mode, extra) in [("", ""), ("_sampled", SAMPLED_DARK)] {
+        let dir = common::scratch(&format!("gltf_refraction_core_obj{mode}"));
+        let mut obj = String::from("mtllib core.mtl\n");
+        for k in 0..8 {
+            let c = |bit: u32| if k & bit == 0 { -0.12 } else { 0.12 };
+            obj += &format!("v {} {} {}\n", c(1), c(2), c(4));
+        }
+        obj += "usemtl green\n";
+        for q in [
+            [1, 3, 4, 2],
+            [5, 6, 8, 7],
+            [1, 2, 6, 5],
+            [3, 7, 8, 4],
+            [1, 5, 7, 3],
+            [2, 4, 8, 6],
+        ] {
+            obj += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                q[0], q[1], q[2], q[0], q[2], q[3]
+            );
+        }
+        std::fs::write(dir.join("core.obj"), obj).unwrap();
+        std::fs::write(
+            dir.join("core.mtl"),
+            "newmtl green\nKd 0 0 0\nKs 0 0 0\nKe 0 1 0\n",
+        )
+        .unwrap();
+        let core = format!("{extra}[[model]]\npath = {:?}\n", dir.join("core.obj"));
+        let row = ball_over_backdrop(
+            &format!("gltf_refraction_core{mode}"),
+            r#", "KHR_materials_volume": {"thicknessFactor": 1.0}"#,
+            &core,
+        );
+        let green = |c: Vec3| c.y > 0.5 && c.x < 0.1 && c.z < 0.1;
+        for x in [31, 32] {
+            assert!(green(row[x]), "{mode} core at x = {x}: {}", row[x]);
+        }
+        // Beyond the core, the lens as before: the backdrop's right half
+        // on the left, its left half on the right.
+        assert!(
+            row[24].z > 0.5 && row[24].x < 0.1,
+            "{mode} x = 24: {}",
+            row[24]
+        );
+        assert!(
+            row[39].x > 0.5 && row[39].z < 0.1,
+            "{mode} x = 39: {}",
+            row[39]
+        );
+    }
+}
+
 /// Writes `dir/file`: a 2x2 plate (z = 0, facing +z; u along +x, v down
 /// y) of one material, `material` (JSON members), with extension
 /// `ext.0` whose JSON is `ext.1` (none where it is empty).
