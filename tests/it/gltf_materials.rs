@@ -522,26 +522,8 @@ fn upside_down_through_the_ball(mode: &str, extra: &str) {
 fn an_opaque_core_inside_a_glass_ball_shows_through_it() {
     for (mode, extra) in [("", ""), ("_sampled", SAMPLED_DARK)] {
         let dir = common::scratch(&format!("gltf_refraction_core_obj{mode}"));
-        let mut obj = String::from("mtllib core.mtl\n");
-        for k in 0..8 {
-            let c = |bit: u32| if k & bit == 0 { -0.12 } else { 0.12 };
-            obj += &format!("v {} {} {}\n", c(1), c(2), c(4));
-        }
-        obj += "usemtl green\n";
-        for q in [
-            [1, 3, 4, 2],
-            [5, 6, 8, 7],
-            [1, 2, 6, 5],
-            [3, 7, 8, 4],
-            [1, 5, 7, 3],
-            [2, 4, 8, 6],
-        ] {
-            obj += &format!(
-                "f {} {} {}\nf {} {} {}\n",
-                q[0], q[1], q[2], q[0], q[2], q[3]
-            );
-        }
-        std::fs::write(dir.join("core.obj"), obj).unwrap();
+        let obj = softraster::procedural::cube([0.0; 3], 0.12).to_obj("core", "core.mtl", "green");
+        std::fs::write(dir.join("core.obj"), obj.text).unwrap();
         std::fs::write(
             dir.join("core.mtl"),
             "newmtl green\nKd 0 0 0\nKs 0 0 0\nKe 0 1 0\n",
