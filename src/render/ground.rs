@@ -71,6 +71,9 @@ struct Spot {
     cell: Option<Cell>,
 }
 
+/// The bytes of one pixel's `Spot` (the memory estimate's).
+pub(super) const SPOT_BYTES: u64 = std::mem::size_of::<Spot>() as u64;
+
 /// A plane point's place in the contact grid: the corners of its cell
 /// (column and row of the first and second) and the blend weights.
 #[derive(Clone, Copy)]

@@ -60,6 +60,23 @@ const BVH_PER_TRIANGLE: u64 = 48 + 4 + 40 + 48;
 /// position and normal) and its projected corner for set-up.
 const VERTEX: u64 = 64 + super::geometry::CORNER_BYTES as u64;
 
+/// What a renderer keeps of a camera that stays (`rays::ViewCache`), for
+/// a frame of `pixels`: the backdrop (`render::backdrop`), and the ground
+/// view (`render::ground`, without lights: at most a spot per pixel).
+fn kept_views(scene: &Scene, pixels: u64, parts: &mut Vec<(&'static str, u64)>) {
+    let s = &scene.settings;
+    if matches!(
+        s.background,
+        Background::Environment | Background::Blurred(_)
+    ) && scene.environment.is_some()
+    {
+        parts.push(("backdrop", pixels * size_of::<Vec4>() as u64));
+    }
+    if scene.ground.is_some() {
+        parts.push(("ground view", pixels * super::ground::SPOT_BYTES));
+    }
+}
+
 /// The estimate for rendering `scene` with `threads` workers.
 pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
     let s = &scene.settings;
@@ -151,14 +168,7 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
         frame += w * h * px;
     }
     parts.push(("frame", frame));
-    if matches!(
-        s.background,
-        Background::Environment | Background::Blurred(_)
-    ) && scene.environment.is_some()
-    {
-        // The kept backdrop of a camera that stays (`render::backdrop`).
-        parts.push(("backdrop", w * k * h * k * size_of::<Vec4>() as u64));
-    }
+    kept_views(scene, w * k * h * k, &mut parts);
     if s.ao.method != AoMethod::Off {
         let g = size_of::<crate::shade::ao::GPixel>() as u64;
         parts.push(("AO buffers", w * k * h * k * (g + 4)));
