@@ -40,7 +40,7 @@ impl<'a> DrawList<'a> {
             cam.target = turn.transform_point3(cam.target);
             cam.up = turn.transform_vector3(cam.up);
         }
-        let world_from_object = scene
+        let world_from_object: Vec<Mat4> = scene
             .models
             .iter()
             .map(|m| {
@@ -95,6 +95,14 @@ impl<'a> DrawList<'a> {
             }
             lights
         };
+        let mut lights = lights;
+        lights.extend(
+            scene
+                .emitters
+                .iter()
+                .map(|p| p.light(world_from_object[p.model]))
+                .filter(placed_ok),
+        );
         let s = &scene.settings;
         let aspect = s.width as f32 / s.height as f32;
         let clip_from_world = cam.clip_from_view(aspect, s.depth) * cam.view_from_world();
@@ -129,6 +137,7 @@ fn keep_in_range(posed: &mut Posed, rest: &[Vec3], rest_normals: &[Vec3]) {
 fn placed_ok(l: &Light) -> bool {
     match l.kind {
         LightKind::Point { position, .. } => position.is_finite(),
+        LightKind::Area { position, axis, .. } => position.is_finite() && axis.is_finite(),
         LightKind::Directional { direction, .. } => direction.is_finite(),
         LightKind::Spot {
             position,

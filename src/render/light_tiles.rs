@@ -37,7 +37,7 @@ impl Culling {
     ) -> Option<Culling> {
         let cullable = lights.iter().any(|l| match l.kind {
             LightKind::Directional { .. } => false,
-            LightKind::Point { .. } => l.range.is_some_and(|r| r > 0.0),
+            LightKind::Point { .. } | LightKind::Area { .. } => l.range.is_some_and(|r| r > 0.0),
             LightKind::Spot { .. } => true,
         });
         let m = clip_from_world.as_dmat4();

@@ -145,8 +145,8 @@ pub fn estimate(scene: &Scene, threads: usize) -> MemoryEstimate {
         parts.push(("environment", img * 2 + (2 << 20)));
     }
 
-    let shadow_rays =
-        s.shadows == ShadowMethod::Raytraced && scene.lights.iter().any(|l| l.shadows);
+    let shadow_rays = s.shadows == ShadowMethod::Raytraced
+        && (scene.lights.iter().any(|l| l.shadows) || !scene.emitters.is_empty());
     let sampled_env = scene.environment.as_ref().is_some_and(|e| {
         matches!(
             e.method,

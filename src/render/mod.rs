@@ -346,7 +346,10 @@ impl<'s> Renderer<'s> {
     pub fn prepare(&self) {
         self.build_all_mips();
         let _ = self.env_light();
-        if self.traces_rays(&self.scene.lights) {
+        // The emissive pieces' area lights cast shadows too.
+        let emitter_rays = self.scene.settings.shadows == ShadowMethod::Raytraced
+            && !self.scene.emitters.is_empty();
+        if self.traces_rays(&self.scene.lights) || emitter_rays {
             self.meshes.par_iter().zip(&self.bvhs).for_each(|(m, b)| {
                 b.get_or_init(|| bvh_of(m));
             });

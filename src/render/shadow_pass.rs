@@ -206,6 +206,12 @@ fn light_shadows(
                         cone: 0.0,
                     }
                 }
+                LightKind::Area {
+                    position, radius, ..
+                } => LightShadow::Ray {
+                    position: Some(position),
+                    cone: radius,
+                },
             }
         } else {
             match light.kind {
@@ -218,7 +224,9 @@ fn light_shadows(
                     cos_outer,
                     ..
                 } => spot(verts, position, direction, cos_outer, size, spare),
-                LightKind::Point { position, .. } => point(verts, position, size, spare),
+                LightKind::Point { position, .. } | LightKind::Area { position, .. } => {
+                    point(verts, position, size, spare)
+                }
             }
         };
         out.push(ls);
@@ -280,6 +288,16 @@ fn casts_nothing(verts: &[Geo], k: usize, plane: Plane, light: &LightKind, eps: 
         LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
             let s = plane.n.dot(position) - plane.d;
             if s.is_nan() || s.abs() <= eps {
+                return false;
+            }
+            s
+        }
+        // A disc: the plane must clear all of it.
+        LightKind::Area {
+            position, radius, ..
+        } => {
+            let s = plane.n.dot(position) - plane.d;
+            if s.is_nan() || s.abs() <= eps.max(radius) {
                 return false;
             }
             s

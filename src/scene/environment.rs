@@ -41,7 +41,14 @@ pub struct Environment {
     /// Prefiltered: width of the sharpest glossy level (default
     /// `DEFAULT_PREFILTER_SIZE`).
     pub prefilter_size: u32,
+    /// Prefiltered: how many emissive surfaces light the scene as area
+    /// lights (default `DEFAULT_EMITTERS`; sampled: 0, its rays find them).
+    pub emitters: u32,
 }
+
+/// `environment.emitters` when the scene does not give it and the method
+/// is prefiltered.
+pub const DEFAULT_EMITTERS: i64 = 4;
 
 /// `environment.prefilter_size` when the scene does not give it.
 pub const DEFAULT_PREFILTER_SIZE: u32 = 128;

@@ -43,6 +43,25 @@ pub enum LightKind {
         /// Cosine of the angle outside which there is no light.
         cos_outer: f32,
     },
+    /// An emissive surface of the scene taken as a light
+    /// (`environment.emitters`): from a disc of radius `radius` at
+    /// `position`, radiant intensity `along * |cos| + around` towards a
+    /// direction at angle cos to `axis` (a flat two-sided emitter of area
+    /// A and radiance 1 has along = A, around = 0), times `color`.
+    Area {
+        /// The centre of the emitting surface.
+        position: Vec3,
+        /// Unit normal of its main plane (either side).
+        axis: Vec3,
+        /// Radiant intensity along the axis, less `around`.
+        along: f32,
+        /// Radiant intensity every way (the share of a surface that is
+        /// not flat).
+        around: f32,
+        /// Radius of the disc of the surface's area: what softens its
+        /// ray-traced shadows.
+        radius: f32,
+    },
 }
 
 /// A light of the scene (`[[light]]`, or a glTF file's lights).
@@ -69,7 +88,9 @@ impl Light {
     /// A point or spot light's position, or `otherwise`.
     pub fn position_or(&self, otherwise: Vec3) -> Vec3 {
         match self.kind {
-            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+            LightKind::Point { position, .. }
+            | LightKind::Spot { position, .. }
+            | LightKind::Area { position, .. } => position,
             LightKind::Directional { .. } => otherwise,
         }
     }
@@ -107,6 +128,19 @@ impl Light {
                 intensity,
                 cos_inner,
                 cos_outer,
+            },
+            LightKind::Area {
+                position,
+                axis,
+                along,
+                around,
+                radius,
+            } => LightKind::Area {
+                position: m.transform_point3(position),
+                axis: dir(axis),
+                along,
+                around,
+                radius,
             },
         };
         Light { kind, ..*self }

@@ -10,6 +10,7 @@ pub mod animation;
 pub mod assemble;
 pub mod camera;
 mod desc;
+pub mod emitters;
 pub mod environment;
 pub mod light;
 pub mod material;
@@ -103,6 +104,9 @@ pub struct Scene {
     pub node_lights: Vec<animation::NodeLight>,
     /// Image-based lighting (`[environment]`).
     pub environment: Option<environment::Environment>,
+    /// The emissive pieces that light the scene as area lights
+    /// (`environment.emitters`; `DrawList` places them each frame).
+    pub emitters: Vec<emitters::Patch>,
     /// The shadow catcher under the models (`[ground] shadow = true`).
     pub ground: Option<GroundPlane>,
     /// The cameras, in the file's order (a fitted camera when none is

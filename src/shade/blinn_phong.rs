@@ -20,7 +20,7 @@ use super::env::sampled::{self as env_sampled, Lobes};
 use super::lanes::{Lanes, Lit};
 use super::{Fetch, ShadeContext};
 use crate::scene::Material;
-use crate::scene::light::LightKind;
+use crate::scene::light::{Light, LightKind};
 use crate::scene::material::roughness_from_ns;
 use crate::simd::{Lane, Mask, V3};
 
@@ -149,12 +149,10 @@ impl ShadeContext<'_> {
         let mut spec = V3::zero();
         f.light_set(self.lights).for_each(|i, light| {
             let Lit { l, e, lit, .. } = self.lit_lanes(i, light, f, n);
-            if let LightKind::Directional { angle, .. } = light.kind
-                && angle > 0.0
-            {
-                // Taken out of the environment: lit as the environment
-                // lit these surfaces.
-                let (d, s) = image_light([n, v, l], e, ns, angle);
+            if let Some(w2) = disc(light, f.position) {
+                // Taken out of the environment, or an emissive surface:
+                // lit as the environment lit these surfaces.
+                let (d, s) = image_light([n, v, l], e, ns, w2);
                 diffuse = diffuse + V3::select(lit, d, V3::zero());
                 if specular {
                     spec = spec + V3::select(lit, s, V3::zero());
@@ -228,27 +226,43 @@ impl ShadeContext<'_> {
     }
 }
 
-/// A light taken out of the environment image (`environment.lights`; a
-/// disc of angular radius `angle`) as the environment term shaded it:
+/// For a light with a disc, (tan(angle) / 2)^2 of the disc's angular
+/// radius as the points `p` see it: a light taken out of the image
+/// (`environment.lights`) or an emissive surface (`environment.emitters`,
+/// tan = radius / distance). None for the others.
+#[inline(always)]
+fn disc<L: Lane>(light: &Light, p: V3<L>) -> Option<L> {
+    match light.kind {
+        LightKind::Directional { angle, .. } if angle > 0.0 => {
+            let w = 0.5 * angle.tan();
+            Some(L::splat(w * w))
+        }
+        LightKind::Area {
+            position, radius, ..
+        } => {
+            let d = V3::splat(position) - p;
+            let w = L::splat(0.5 * radius) / d.dot(d).sqrt();
+            Some(w * w)
+        }
+        _ => None,
+    }
+}
+
+/// A light with a disc (`disc`: w2 = (tan(angle) / 2)^2 of its angular
+/// radius) as the environment term shaded it:
 /// (E n.l / pi, E n.l D(r.h) / 4), with which Kd and Ks make Kd E(n) / pi
 /// and Ks times the radiance along the reflection r weighted by the GGX
 /// lobe matching Ns (D over the reflected directions, around r, is a
 /// distribution: D(r.h) / 4 is its density at l; alpha^2 = 2 / (Ns + 2),
 /// widened by the disc as `PbrColor::widened` does).
 #[inline(always)]
-fn image_light<L: Lane>(
-    [n, v, l]: [V3<L>; 3],
-    e: V3<L>,
-    ns: Exponent<L>,
-    angle: f32,
-) -> (V3<L>, V3<L>) {
+fn image_light<L: Lane>([n, v, l]: [V3<L>; 3], e: V3<L>, ns: Exponent<L>, w2: L) -> (V3<L>, V3<L>) {
     let one = L::splat(1.0);
     let ns = match ns {
         Exponent::One(ns) => L::splat(ns),
         Exponent::PerLane(ns) => ns,
     };
-    let w = 0.5 * angle.tan();
-    let a2 = (L::splat(2.0) / (ns.max(L::splat(0.0)) + L::splat(2.0)) + L::splat(w * w)).min(one);
+    let a2 = (L::splat(2.0) / (ns.max(L::splat(0.0)) + L::splat(2.0)) + w2).min(one);
     let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
     let h = (l + r).normalize_or(V3::zero());
     let c = r.dot(h).max(L::splat(0.0));

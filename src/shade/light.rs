@@ -63,6 +63,25 @@ pub fn incidence(light: &Light, p: Vec3) -> Option<Incidence> {
                 e: light.color * (intensity * f * w / r2),
             })
         }
+        LightKind::Area {
+            position,
+            axis,
+            along,
+            around,
+            radius,
+        } => {
+            let (l, r2) = towards(position, p)?;
+            let f = along * l.dot(axis).abs() + around;
+            let w = window(light, r2);
+            if f <= 0.0 || w <= 0.0 {
+                return None;
+            }
+            // r^2 + radius^2: a disc's own on-axis law, finite at the disc.
+            Some(Incidence {
+                l,
+                e: light.color * (f * w / (r2 + radius * radius)),
+            })
+        }
     }
 }
 
@@ -166,7 +185,9 @@ impl<'a> LightSet<'a> {
 pub fn may_reach(light: &Light, lo: Vec3, hi: Vec3) -> bool {
     let position = match light.kind {
         LightKind::Directional { .. } => return true,
-        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+        LightKind::Point { position, .. }
+        | LightKind::Spot { position, .. }
+        | LightKind::Area { position, .. } => position,
     };
     if !(lo.is_finite() && hi.is_finite() && position.is_finite()) {
         return true;
@@ -233,6 +254,41 @@ pub fn spot_falloff(cos_a: f32, cos_inner: f32, cos_outer: f32) -> f32 {
 mod tests {
     use super::*;
     use crate::scene::light::LightKind;
+
+    #[test]
+    fn an_area_light_falls_off_with_the_cosine_either_side() {
+        let l = Light {
+            kind: LightKind::Area {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                axis: Vec3::Y,
+                along: 3.0,
+                around: 1.0,
+                radius: 0.5,
+            },
+            color: Vec3::new(1.0, 0.5, 2.0),
+            shadows: true,
+            range: None,
+        };
+        // On the axis: (along + around) / (r^2 + radius^2).
+        let i = incidence(&l, Vec3::ZERO).unwrap();
+        assert!((i.e - l.color * (4.0 / 4.25)).length() < 1e-5, "{:?}", i.e);
+        assert!((i.l - Vec3::Y).length() < 1e-6);
+        // The same above it: both sides emit.
+        let up = incidence(&l, Vec3::new(0.0, 4.0, 0.0)).unwrap();
+        assert!((up.e - i.e).length() < 1e-5);
+        // At 60 degrees from the axis, along counts half.
+        let p = Vec3::new(2.0 * 3f32.sqrt(), 0.0, 0.0);
+        let e = incidence(&l, p).unwrap().e.x;
+        assert!((e - 2.5 / (16.0 + 0.25)).abs() < 1e-5, "{e}");
+        // In the disc's plane only `around` is left; without it, nothing.
+        let side = incidence(&l, Vec3::new(3.0, 2.0, 0.0)).unwrap().e.x;
+        assert!((side - 1.0 / 9.25).abs() < 1e-5, "{side}");
+        let mut flat = l;
+        if let LightKind::Area { around, .. } = &mut flat.kind {
+            *around = 0.0;
+        }
+        assert!(incidence(&flat, Vec3::new(3.0, 2.0, 0.0)).is_none());
+    }
 
     #[test]
     fn point_light_follows_inverse_square() {

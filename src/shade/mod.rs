@@ -18,7 +18,7 @@ pub mod tonemap;
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::assets::texture::{Filtering, Gradients, Level, TextureRef};
-use crate::scene::material::{Native, NormalMap};
+use crate::scene::material::NormalMap;
 use crate::scene::settings::{AddressMode, Background, ShadingMode, TextureFilter};
 use crate::scene::{Light, Material};
 use crate::simd::{Lane, V3};
@@ -62,11 +62,7 @@ pub struct ShadeContext<'a> {
 /// Whether shading mode `mode` shades a point of `m` with
 /// metallic-roughness.
 pub(crate) fn shades_pbr(mode: ShadingMode, m: &Material) -> bool {
-    match mode {
-        ShadingMode::Pbr => true,
-        ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
-        _ => false,
-    }
+    crate::scene::emitters::shades_pbr(mode, m)
 }
 
 impl ShadeContext<'_> {

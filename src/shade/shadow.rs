@@ -195,9 +195,11 @@ pub enum LightShadow {
         position: Vec3,
         faces: Box<[ShadowMap; 6]>,
     },
-    /// Rays towards the light: to its position (point, spot), or unbounded
-    /// (directional); a directional light with an angular radius `cone`
-    /// (radians, > 0) gets `SOFT_RAYS` rays spread over its disc.
+    /// Rays towards the light: to its position (point, spot, area), or
+    /// unbounded (directional); a directional light with an angular
+    /// radius `cone` (radians, > 0) gets soft shadows from rays spread
+    /// over its disc (`soft_shadow`), and so does an area light, whose
+    /// `cone` is its disc's radius (world units).
     Ray {
         position: Option<Vec3>,
         cone: f32,
@@ -305,10 +307,10 @@ impl Shadows<'_> {
             }
             LightShadow::Ray { position, cone } => {
                 for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
-                    out[k] = if *cone > 0.0 && position.is_none() {
-                        self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k))
-                    } else {
-                        self.ray(position, p.lane(k), ng[k], l.lane(k))
+                    out[k] = match position {
+                        None if *cone > 0.0 => self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k)),
+                        Some(q) if *cone > 0.0 => self.soft_ray_to(*q, *cone, p.lane(k), ng[k]),
+                        _ => self.ray(position, p.lane(k), ng[k], l.lane(k)),
                     };
                 }
             }

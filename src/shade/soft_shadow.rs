@@ -34,13 +34,44 @@ impl Shadows<'_> {
             None => f32::from(u8::from(ng.dot(l) > 0.0)),
         }
     }
+
+    /// `open_share_to` with the frame's tracer; without one, 1 where the
+    /// surface faces the light.
+    pub(super) fn soft_ray_to(&self, q: Vec3, radius: f32, p: Vec3, ng: Vec3) -> f32 {
+        match &self.tracer {
+            Some(t) => open_share_to(t, q, radius, p, ng),
+            None => f32::from(u8::from(ng.dot(q - p) > 0.0)),
+        }
+    }
 }
 
 /// The unoccluded share of the rays from `p` (lifted along `ng`) towards
 /// a light in the cone of half angle `cone` around `l`. A ray under the
 /// surface's plane counts as blocked: the surface shadows itself.
 pub fn open_share(tracer: &Tracer, cone: f32, p: Vec3, ng: Vec3, l: Vec3) -> f32 {
-    let cone = Cone::new(tracer, p, ng, l, cone);
+    share(&Cone::new(tracer, p, ng, l, cone, f32::INFINITY), p)
+}
+
+/// The unoccluded share of the rays from `p` (lifted along `ng`) towards
+/// a disc of radius `radius` facing it at `q` (an emissive surface taken
+/// as a light): the cone the disc subtends, each ray stopped 1.5 radii
+/// short of `q` so that the emitter does not shadow its own light.
+pub fn open_share_to(tracer: &Tracer, q: Vec3, radius: f32, p: Vec3, ng: Vec3) -> f32 {
+    let to = q - p;
+    let dist = to.length();
+    if !(dist > 0.0 && ng.dot(to) > 0.0) {
+        return 0.0;
+    }
+    let reach = dist - 1.5 * radius;
+    if reach <= tracer.epsilon {
+        return 1.0;
+    }
+    let angle = (radius / dist).min(1.0).asin();
+    share(&Cone::new(tracer, p, ng, to / dist, angle, reach), p)
+}
+
+/// Three probes, and where they disagree the penumbra's rays.
+fn share(cone: &Cone, p: Vec3) -> f32 {
     let (su, sv) = point_hash(p);
     let probes: u32 = (0..PROBES)
         .map(|k| cone.open(PROBE_U, (sv + k as f32 / PROBES as f32).fract()))
@@ -67,10 +98,19 @@ struct Cone<'t, 'a> {
     tx: Vec3,
     ty: Vec3,
     one_minus_cos: f32,
+    /// How far a ray looks for an occluder.
+    reach: f32,
 }
 
 impl<'t, 'a> Cone<'t, 'a> {
-    fn new(tracer: &'t Tracer<'a>, p: Vec3, ng: Vec3, axis: Vec3, angle: f32) -> Cone<'t, 'a> {
+    fn new(
+        tracer: &'t Tracer<'a>,
+        p: Vec3,
+        ng: Vec3,
+        axis: Vec3,
+        angle: f32,
+        reach: f32,
+    ) -> Cone<'t, 'a> {
         let (tx, ty) = axis.any_orthonormal_pair();
         Cone {
             tracer,
@@ -80,6 +120,7 @@ impl<'t, 'a> Cone<'t, 'a> {
             tx,
             ty,
             one_minus_cos: 1.0 - angle.cos(),
+            reach,
         }
     }
 
@@ -90,7 +131,7 @@ impl<'t, 'a> Cone<'t, 'a> {
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * v;
         let d = self.tx * (sin * phi.cos()) + self.ty * (sin * phi.sin()) + self.axis * cos;
-        u32::from(self.ng.dot(d) > 0.0 && !self.tracer.occluded(self.o, d, f32::INFINITY))
+        u32::from(self.ng.dot(d) > 0.0 && !self.tracer.occluded(self.o, d, self.reach))
     }
 }
 

@@ -1,6 +1,7 @@
-//! Emissive surfaces light the scene under `method = "sampled"`, as a
-//! path tracer's do: the radiance of a Lambertian plane under a small
-//! emissive square against the closed form.
+//! Emissive surfaces light the scene as a path tracer's do: under
+//! `method = "sampled"` by points drawn on them, under the prefiltered
+//! default as area lights (`environment.emitters`). The radiance of a
+//! Lambertian plane under an emissive square against the closed form.
 
 use std::f32::consts::PI;
 
@@ -12,6 +13,16 @@ use crate::common::{self, render_frame};
 /// the centre of an emissive square (side `side`, radiance 10, facing
 /// down) at height 1, seen from the side: its environment is black.
 fn floor_under_lamp(name: &str, side: f32, method: &str) -> f32 {
+    let more = if method == "sampled" {
+        "samples = 256\n"
+    } else {
+        ""
+    };
+    floor_under_lamp_with(name, side, method, more)
+}
+
+/// `floor_under_lamp` with more `[environment]` keys.
+fn floor_under_lamp_with(name: &str, side: f32, method: &str, more: &str) -> f32 {
     let dir = common::scratch(name);
     let h = side / 2.0;
     let obj = format!(
@@ -31,7 +42,7 @@ fn floor_under_lamp(name: &str, side: f32, method: &str) -> f32 {
     .unwrap();
     let scene = format!(
         "[output]\nwidth = 16\nheight = 16\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
-         [environment]\npreset = \"neutral\"\nintensity = 0.0\nmethod = \"{method}\"\nsamples = 256\n\
+         [environment]\npreset = \"neutral\"\nintensity = 0.0\nmethod = \"{method}\"\n{more}\
          [[model]]\npath = \"m.obj\"\n\
          [[camera]]\neye = [3.0, 0.6, 0.0]\ntarget = [0.0, 0.0, 0.0]\n\
          projection = \"orthographic\"\nheight = 0.05\n"
@@ -64,7 +75,55 @@ fn a_lamp_lights_a_lambertian_floor_as_the_closed_form_says() {
             "side {side}: {got} vs {expect}"
         );
     }
-    // The prefiltered default shows the lamp without lighting with it.
-    let dark = floor_under_lamp("emitter_floor_prefiltered", 1.0, "prefiltered");
+}
+
+#[test]
+fn under_the_prefiltered_default_a_lamp_is_an_area_light() {
+    // One light at the square's centre, from a disc of its area: on the
+    // axis E = l A / (h^2 + A / pi), the disc's own law, within 1% of the
+    // square's at side 1 and closer for a smaller lamp.
+    for side in [0.2f32, 1.0] {
+        let expect = 0.5 / PI * square_irradiance(10.0, side, 1.0);
+        let got = floor_under_lamp(&format!("emitter_area_{side}"), side, "prefiltered");
+        assert!(
+            (got - expect).abs() < 0.02 * expect,
+            "side {side}: {got} vs {expect}"
+        );
+    }
+    // `emitters = 0`: the lamp is shown and lights nothing, as the GPU
+    // viewers show it.
+    let dark = floor_under_lamp_with("emitter_area_off", 1.0, "prefiltered", "emitters = 0\n");
     assert!(dark < 1e-6, "{dark}");
+}
+
+/// A box under a lamp in a dim sky: the floor lit by the lamp around the
+/// box's soft shadow, the box's top and sides lit, the lamp itself shown.
+fn box_under_lamp(name: &str, shading: &str) -> Scene {
+    let dir = common::scratch(name);
+    let obj = "mtllib m.mtl\n\
+         v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\n\
+         v -0.3 2 -0.3\nv 0.3 2 -0.3\nv 0.3 2 0.3\nv -0.3 2 0.3\n\
+         v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0.5 0 0.5\nv -0.5 0 0.5\n\
+         v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n\
+         usemtl floor\nf 4 3 2 1\n\
+         usemtl lamp\nf 5 6 7 8\n\
+         usemtl floor\nf 13 16 15 14\nf 9 10 14 13\nf 10 11 15 14\nf 11 12 16 15\nf 12 9 13 16\n";
+    let mtl = "newmtl floor\nKd 0.6 0.5 0.4\nKs 0.2 0.2 0.2\nNs 40\nillum 2\n\
+         newmtl lamp\nKd 0 0 0\nKs 0 0 0\nKe 8 8 8\nillum 1\n";
+    let scene = format!(
+        "[output]\nwidth = 48\nheight = 40\n[render]\nshading = \"{shading}\"\nmsaa = 4\n\
+         [environment]\npreset = \"neutral\"\nintensity = 0.05\n\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\neye = [2.5, 2.2, 3.0]\ntarget = [0.0, 0.5, 0.0]\n"
+    );
+    common::scene_in(&dir, &scene, &[("m.obj", obj), ("m.mtl", mtl)])
+}
+
+#[test]
+fn area_lights_are_the_same_at_every_lane_width() {
+    for shading in ["auto", "pbr"] {
+        let scene = box_under_lamp(&format!("emitter_widths_{shading}"), shading);
+        assert_eq!(scene.emitters.len(), 1, "{shading}");
+        crate::widths::same_at_every_width(&scene, &[0], &format!("box under a lamp, {shading}"));
+    }
 }

@@ -520,6 +520,7 @@ fn fbx_lights_and_cameras_arrive_where_blender_put_them() {
                     && (cos_outer - 30f32.to_radians().cos()).abs() < 1e-3
                     && cos_inner > cos_outer;
             }
+            LightKind::Area { .. } => panic!("a file's light read as an area light: {l:?}"),
         }
     }
     assert!(point && sun && spot, "{point} {sun} {spot}");

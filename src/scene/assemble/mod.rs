@@ -18,7 +18,9 @@ use glam::Vec3;
 use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, SceneDesc, Spanned};
-use super::environment::{DEFAULT_ENV_LIGHTS, DEFAULT_PREFILTER_SIZE, EnvMethod, Environment};
+use super::environment::{
+    DEFAULT_EMITTERS, DEFAULT_ENV_LIGHTS, DEFAULT_PREFILTER_SIZE, EnvMethod, Environment,
+};
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::{EnvImage, TakenLight};
 use crate::assets::input::Input;
@@ -270,8 +272,19 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             intensity: 1.0,
             rotation: 0.0,
             prefilter_size: DEFAULT_PREFILTER_SIZE,
+            emitters: DEFAULT_EMITTERS as u32,
         }),
         None => None,
+    };
+    let emitters = match &environment {
+        Some(env) if env.emitters > 0 => super::emitters::patches(
+            &models.models,
+            settings.shading,
+            env.emitters as usize,
+            super::emitters::irradiance(env),
+            bounds.radius,
+        ),
+        _ => Vec::new(),
     };
     shadow_warnings(d, ctx, &settings, &lights, &mut warnings);
     if let Some(w) = still_frames(d, ctx, &animation, cameras_move(&cameras)) {
@@ -286,6 +299,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
         lights,
         node_lights,
         environment,
+        emitters,
         ground,
         cameras,
         animation,
@@ -522,6 +536,11 @@ fn environment(
             intensity,
             rotation,
             prefilter_size: get(&e.prefilter_size, DEFAULT_PREFILTER_SIZE as i64) as u32,
+            emitters: if sampled {
+                0
+            } else {
+                get(&e.emitters, DEFAULT_EMITTERS) as u32
+            },
         },
         sun,
         lights,

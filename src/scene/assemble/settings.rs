@@ -360,6 +360,10 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
                 e.prefilter_size.as_ref().map(|v| v.span()),
                 "environment.prefilter_size has no effect: environment.method is \"sampled\"",
             );
+            warn(
+                e.emitters.as_ref().map(|v| v.span()),
+                "environment.emitters has no effect: environment.method \"sampled\" lights with every emissive surface",
+            );
         }
     }
     for c in &d.cameras {

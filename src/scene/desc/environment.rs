@@ -37,6 +37,9 @@ pub struct EnvironmentDesc {
     /// How many compact bright regions become shadow-casting lights
     /// (default 4 prefiltered, 0 sampled).
     pub lights: Option<Spanned<i64>>,
+    /// How many emissive surfaces become shadow-casting area lights
+    /// (default 4 prefiltered; sampled lights with all of them).
+    pub emitters: Option<Spanned<i64>>,
 }
 
 /// The built-in environments.

@@ -64,6 +64,7 @@ pub(super) fn validate_environment(c: &Ctx, e: &Spanned<EnvironmentDesc>) -> Res
     c.int_range(&e.bounces, "environment.bounces", 0, 1)?;
     c.int_range(&e.prefilter_size, "environment.prefilter_size", 8, 2048)?;
     c.int_range(&e.lights, "environment.lights", 0, 16)?;
+    c.int_range(&e.emitters, "environment.emitters", 0, 16)?;
     Ok(())
 }
 

@@ -486,7 +486,9 @@ fn incidence<L: Lane>(light: &Light, p: V3<L>) -> (V3<L>, V3<L>, L::Mask) {
                 one.cmpgt(zero),
             );
         }
-        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+        LightKind::Point { position, .. }
+        | LightKind::Spot { position, .. }
+        | LightKind::Area { position, .. } => position,
     };
     // `towards`: only r2 <= 0 misses.
     let d = V3::splat(position) - p;
@@ -522,6 +524,18 @@ fn incidence<L: Lane>(light: &Light, p: V3<L>) -> (V3<L>, V3<L>, L::Mask) {
             };
             reaches = reaches & !f.cmple(zero);
             L::splat(intensity) * f * w / r2
+        }
+        LightKind::Area {
+            axis,
+            along,
+            around,
+            radius,
+            ..
+        } => {
+            // `incidence`'s along |l.axis| + around, over r^2 + radius^2.
+            let f = L::splat(along) * l.dot(V3::splat(axis)).abs() + L::splat(around);
+            reaches = reaches & !f.cmple(zero);
+            f * w / (r2 + L::splat(radius * radius))
         }
         LightKind::Point { intensity, .. } => L::splat(intensity) * w / r2,
         LightKind::Directional { .. } => zero,

@@ -133,7 +133,12 @@ impl<L: Lane> PbrColor<L> {
     #[inline(always)]
     pub fn widened(&self, angle: f32) -> PbrColor<L> {
         let w = 0.5 * angle.tan();
-        let w2 = L::splat(w * w);
+        self.widened_by(L::splat(w * w))
+    }
+
+    /// `widened` with (tan(angle) / 2)^2 per lane given.
+    #[inline(always)]
+    pub fn widened_by(&self, w2: L) -> PbrColor<L> {
         let mut c = *self;
         c.a2 = (c.a2 + w2).min(L::splat(1.0));
         if let Some(coat) = &mut c.coat {

@@ -377,7 +377,7 @@ impl ShadeContext<'_> {
             let Lit { l, ndl, e, lit } = self.lit_lanes(i, light, f, n);
             if lit.any() {
                 let mut widened = None;
-                let c = seen_by(c, light, &mut widened);
+                let c = seen_by(c, light, f.position, &mut widened);
                 let added = out + e * brdf(n, v, l, ndl, c);
                 out = V3::select(lit, added, out);
             }
@@ -437,7 +437,7 @@ impl ShadeContext<'_> {
             if lit.any() {
                 // e carries n.l, and so does f_cos.
                 let mut widened = None;
-                let c = seen_by(c, light, &mut widened);
+                let c = seen_by(c, light, f.position, &mut widened);
                 let added = direct + e * (f_cos(n, v, l, ndl, c) / ndl);
                 direct = V3::select(lit, added, direct);
             }
@@ -474,16 +474,25 @@ impl ShadeContext<'_> {
     }
 }
 
-/// `c` as `light` sees it: widened by the light's disc (kept in `slot`),
-/// if it has one.
+/// `c` as `light` sees it from the points `p`: widened by the light's
+/// disc (kept in `slot`), if it has one. An area light's disc subtends
+/// tan = radius / distance.
 #[inline(always)]
 fn seen_by<'c, L: Lane>(
     c: &'c PbrColor<L>,
     light: &Light,
+    p: V3<L>,
     slot: &'c mut Option<PbrColor<L>>,
 ) -> &'c PbrColor<L> {
     match light.kind {
         LightKind::Directional { angle, .. } if angle > 0.0 => slot.insert(c.widened(angle)),
+        LightKind::Area {
+            position, radius, ..
+        } if radius > 0.0 => {
+            let d = V3::splat(position) - p;
+            let w = L::splat(0.5 * radius) / d.dot(d).sqrt();
+            slot.insert(c.widened_by(w * w))
+        }
         _ => c,
     }
 }

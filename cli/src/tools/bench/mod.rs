@@ -458,7 +458,12 @@ pub fn run_case(case: &str, args: &BenchArgs) -> Result<BenchResult, Error> {
 fn lights_toml(lights: &[Light]) -> String {
     let v = |v: Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
     let mut s = String::new();
-    for l in lights {
+    // Area lights are the renderer's (from emissive surfaces), not a
+    // scene file's.
+    for l in lights
+        .iter()
+        .filter(|l| !matches!(l.kind, LightKind::Area { .. }))
+    {
         s.push_str("\n[[light]]\n");
         match l.kind {
             LightKind::Directional {
@@ -490,6 +495,7 @@ fn lights_toml(lights: &[Light]) -> String {
                 cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
                 cos_outer.clamp(-1.0, 1.0).acos().to_degrees()
             )),
+            LightKind::Area { .. } => {}
         }
         if let Some(r) = l.range {
             s.push_str(&format!("range = {r}\n"));
