@@ -151,7 +151,7 @@ pub(super) fn shadows<'a>(
                         LightShadow::Cube { faces, .. } => {
                             spare.extend(faces.iter_mut().map(Spare::take))
                         }
-                        LightShadow::None | LightShadow::Ray { .. } => {}
+                        LightShadow::None | LightShadow::Ray { .. } | LightShadow::Disc { .. } => {}
                     }
                 }
             }
@@ -207,10 +207,14 @@ fn light_shadows(
                     }
                 }
                 LightKind::Area {
-                    position, radius, ..
-                } => LightShadow::Ray {
-                    position: Some(position),
-                    cone: radius,
+                    position,
+                    axis,
+                    radius,
+                    ..
+                } => LightShadow::Disc {
+                    center: position,
+                    axis,
+                    radius,
                 },
             }
         } else {

@@ -195,14 +195,20 @@ pub enum LightShadow {
         position: Vec3,
         faces: Box<[ShadowMap; 6]>,
     },
-    /// Rays towards the light: to its position (point, spot, area), or
+    /// Rays towards the light: to its position (point, spot), or
     /// unbounded (directional); a directional light with an angular
     /// radius `cone` (radians, > 0) gets soft shadows from rays spread
-    /// over its disc (`soft_shadow`), and so does an area light, whose
-    /// `cone` is its disc's radius (world units).
+    /// over its disc (`soft_shadow`).
     Ray {
         position: Option<Vec3>,
         cone: f32,
+    },
+    /// Rays towards points of an area light's disc (`soft_shadow::
+    /// open_share_to`): centre, unit axis, radius.
+    Disc {
+        center: Vec3,
+        axis: Vec3,
+        radius: f32,
     },
 }
 
@@ -307,11 +313,21 @@ impl Shadows<'_> {
             }
             LightShadow::Ray { position, cone } => {
                 for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
-                    out[k] = match position {
-                        None if *cone > 0.0 => self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k)),
-                        Some(q) if *cone > 0.0 => self.soft_ray_to(*q, *cone, p.lane(k), ng[k]),
-                        _ => self.ray(position, p.lane(k), ng[k], l.lane(k)),
+                    out[k] = if *cone > 0.0 && position.is_none() {
+                        self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k))
+                    } else {
+                        self.ray(position, p.lane(k), ng[k], l.lane(k))
                     };
+                }
+            }
+            LightShadow::Disc {
+                center,
+                axis,
+                radius,
+            } => {
+                for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
+                    let disc = (*center, *axis, *radius);
+                    out[k] = self.soft_ray_to(disc, p.lane(k), ng[k]);
                 }
             }
         }

@@ -37,10 +37,10 @@ impl Shadows<'_> {
 
     /// `open_share_to` with the frame's tracer; without one, 1 where the
     /// surface faces the light.
-    pub(super) fn soft_ray_to(&self, q: Vec3, radius: f32, p: Vec3, ng: Vec3) -> f32 {
+    pub(super) fn soft_ray_to(&self, disc: (Vec3, Vec3, f32), p: Vec3, ng: Vec3) -> f32 {
         match &self.tracer {
-            Some(t) => open_share_to(t, q, radius, p, ng),
-            None => f32::from(u8::from(ng.dot(q - p) > 0.0)),
+            Some(t) => open_share_to(t, disc, p, ng),
+            None => f32::from(u8::from(ng.dot(disc.0 - p) > 0.0)),
         }
     }
 }
@@ -49,32 +49,43 @@ impl Shadows<'_> {
 /// a light in the cone of half angle `cone` around `l`. A ray under the
 /// surface's plane counts as blocked: the surface shadows itself.
 pub fn open_share(tracer: &Tracer, cone: f32, p: Vec3, ng: Vec3, l: Vec3) -> f32 {
-    share(&Cone::new(tracer, p, ng, l, cone, f32::INFINITY), p)
+    let cone = Cone::new(tracer, p, ng, l, cone);
+    share(p, |u, v| cone.open(u, v))
 }
 
-/// The unoccluded share of the rays from `p` (lifted along `ng`) towards
-/// a disc of radius `radius` facing it at `q` (an emissive surface taken
-/// as a light): the cone the disc subtends, each ray stopped 1.5 radii
-/// short of `q` so that the emitter does not shadow its own light.
-pub fn open_share_to(tracer: &Tracer, q: Vec3, radius: f32, p: Vec3, ng: Vec3) -> f32 {
-    let to = q - p;
-    let dist = to.length();
-    if !(dist > 0.0 && ng.dot(to) > 0.0) {
-        return 0.0;
-    }
-    let reach = dist - 1.5 * radius;
-    if reach <= tracer.epsilon {
-        return 1.0;
-    }
-    let angle = (radius / dist).min(1.0).asin();
-    share(&Cone::new(tracer, p, ng, to / dist, angle, reach), p)
+/// The unoccluded share of the rays from `p` (lifted along `ng`) to
+/// points of a disc (an emissive surface taken as a light: centre `q`,
+/// unit `axis`, `radius`), spread evenly over its area. Each ray stops
+/// just short of the disc's plane, so the emitter's own triangles, and
+/// what stands behind them, do not shadow its light.
+pub fn open_share_to(
+    tracer: &Tracer,
+    (q, axis, radius): (Vec3, Vec3, f32),
+    p: Vec3,
+    ng: Vec3,
+) -> f32 {
+    let o = p + ng * tracer.epsilon;
+    let (tx, ty) = axis.any_orthonormal_pair();
+    share(p, |u, v| {
+        // u: the share of the disc's area inside the point's circle.
+        let r = radius * u.sqrt();
+        let phi = std::f32::consts::TAU * v;
+        let to = q + tx * (r * phi.cos()) + ty * (r * phi.sin()) - o;
+        let t = to.length();
+        if t.is_nan() || t <= 0.0 {
+            return 1;
+        }
+        let d = to / t;
+        u32::from(ng.dot(d) > 0.0 && !tracer.occluded(o, d, t * (1.0 - 1e-3)))
+    })
 }
 
-/// Three probes, and where they disagree the penumbra's rays.
-fn share(cone: &Cone, p: Vec3) -> f32 {
+/// Three probes `open(u, v)`, evenly turned near the rim; where they
+/// disagree, the penumbra's rays join them. `u` and `v` in [0, 1).
+fn share(p: Vec3, open: impl Fn(f32, f32) -> u32) -> f32 {
     let (su, sv) = point_hash(p);
     let probes: u32 = (0..PROBES)
-        .map(|k| cone.open(PROBE_U, (sv + k as f32 / PROBES as f32).fract()))
+        .map(|k| open(PROBE_U, (sv + k as f32 / PROBES as f32).fract()))
         .sum();
     if probes == 0 || probes == PROBES {
         return (probes / PROBES) as f32;
@@ -83,7 +94,7 @@ fn share(cone: &Cone, p: Vec3) -> f32 {
         .map(|i| {
             let u = (i as f32 + 0.5) / PENUMBRA_RAYS as f32 + su;
             let v = i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0) + sv;
-            cone.open(u.fract(), v.fract())
+            open(u.fract(), v.fract())
         })
         .sum();
     (probes + rest) as f32 / (PENUMBRA_RAYS + PROBES) as f32
@@ -98,19 +109,10 @@ struct Cone<'t, 'a> {
     tx: Vec3,
     ty: Vec3,
     one_minus_cos: f32,
-    /// How far a ray looks for an occluder.
-    reach: f32,
 }
 
 impl<'t, 'a> Cone<'t, 'a> {
-    fn new(
-        tracer: &'t Tracer<'a>,
-        p: Vec3,
-        ng: Vec3,
-        axis: Vec3,
-        angle: f32,
-        reach: f32,
-    ) -> Cone<'t, 'a> {
+    fn new(tracer: &'t Tracer<'a>, p: Vec3, ng: Vec3, axis: Vec3, angle: f32) -> Cone<'t, 'a> {
         let (tx, ty) = axis.any_orthonormal_pair();
         Cone {
             tracer,
@@ -120,7 +122,6 @@ impl<'t, 'a> Cone<'t, 'a> {
             tx,
             ty,
             one_minus_cos: 1.0 - angle.cos(),
-            reach,
         }
     }
 
@@ -131,7 +132,7 @@ impl<'t, 'a> Cone<'t, 'a> {
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * v;
         let d = self.tx * (sin * phi.cos()) + self.ty * (sin * phi.sin()) + self.axis * cos;
-        u32::from(self.ng.dot(d) > 0.0 && !self.tracer.occluded(self.o, d, self.reach))
+        u32::from(self.ng.dot(d) > 0.0 && !self.tracer.occluded(self.o, d, f32::INFINITY))
     }
 }
 
@@ -223,5 +224,69 @@ mod tests {
         // A surface facing away from the light shadows itself.
         let below = shadows.soft_ray(cone, Vec3::new(5.0, 0.0, 0.0), -Vec3::Y, Vec3::Y);
         assert_eq!(below, 0.0);
+    }
+
+    #[test]
+    fn an_emitter_does_not_shadow_its_own_light_but_a_ceiling_shadows_above_it() {
+        // A square lamp (side 1) at y = 2, under a ceiling at y = 2.05,
+        // and a plate at y = 1 over x in [-1, 0], z in [-1, 1].
+        let positions = [
+            Vec3::new(-0.5, 2.0, -0.5),
+            Vec3::new(0.5, 2.0, -0.5),
+            Vec3::new(0.5, 2.0, 0.5),
+            Vec3::new(-0.5, 2.0, 0.5),
+            Vec3::new(-9.0, 2.05, -9.0),
+            Vec3::new(9.0, 2.05, -9.0),
+            Vec3::new(9.0, 2.05, 9.0),
+            Vec3::new(-9.0, 2.05, 9.0),
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(-1.0, 1.0, 1.0),
+        ];
+        let tris = [
+            [0, 1, 2],
+            [0, 2, 3],
+            [4, 5, 6],
+            [4, 6, 7],
+            [8, 9, 10],
+            [8, 10, 11],
+        ];
+        let bvh = Bvh::build(&positions, &tris);
+        let tracer = Tracer::new(
+            [Placed {
+                bvh: &bvh,
+                bounds: (Vec3::new(-9.0, 1.0, -9.0), Vec3::new(9.0, 2.05, 9.0)),
+                world_from_object: Mat4::IDENTITY,
+            }],
+            1.0,
+        );
+        let disc = (
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::Y,
+            (1.0 / std::f32::consts::PI).sqrt(),
+        );
+        // Floor points away from the plate see the whole lamp, though the
+        // rays aim at its own triangles and the ceiling behind them.
+        for p in [
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::new(-3.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 3.0),
+            Vec3::new(0.0, 0.0, -3.0),
+        ] {
+            assert_eq!(open_share_to(&tracer, disc, p, Vec3::Y), 1.0, "{p}");
+        }
+        // Under the plate's edge, which hides half the lamp, the share is
+        // partial: the lamp is a disc, not a point.
+        let under = open_share_to(&tracer, disc, Vec3::ZERO, Vec3::Y);
+        assert!(under > 0.0 && under < 1.0, "{under}");
+        // A floor facing away, and a point on the ceiling's far side (the
+        // ceiling stands between it and the lamp), get nothing.
+        assert_eq!(
+            open_share_to(&tracer, disc, Vec3::new(1.0, 0.0, 0.0), -Vec3::Y),
+            0.0
+        );
+        let above = open_share_to(&tracer, disc, Vec3::new(0.3, 3.0, 0.0), -Vec3::Y);
+        assert_eq!(above, 0.0);
     }
 }
