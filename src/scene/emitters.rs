@@ -63,10 +63,12 @@ impl Patch {
         // mean stretch squared.
         let flat = det * normal.length();
         let round = det.powf(2.0 / 3.0);
+        // A placement that flattens the model (scale 0) leaves no area:
+        // the light gives nothing.
         let (flat, round) = if flat.is_finite() && round.is_finite() {
             (flat, round)
         } else {
-            (1.0, 1.0)
+            (0.0, 0.0)
         };
         let area = self.area * flat;
         Light {
@@ -325,6 +327,12 @@ mod tests {
         assert!((along - 1.0).abs() < 1e-5);
         assert!((radius - (1.0 / std::f32::consts::PI).sqrt()).abs() < 1e-5);
         assert_eq!(light.color, Vec3::splat(10.0));
+        // Scaled to nothing, it gives nothing.
+        let gone = p.light(Mat4::from_scale(Vec3::ZERO));
+        let LightKind::Area { along, around, .. } = gone.kind else {
+            panic!("{gone:?}");
+        };
+        assert_eq!((along, around), (0.0, 0.0));
     }
 
     #[test]
