@@ -68,7 +68,7 @@ impl<'a> DrawList<'a> {
                 Some((posed, p.clip.local_time(time)))
             })
             .collect();
-        let lights = if scene.lights.is_empty() && scene.environment.is_none() {
+        let mut lights = if scene.lights.is_empty() && scene.environment.is_none() {
             // Headlight: a directional light travelling along the view.
             vec![Light {
                 kind: LightKind::Directional {
@@ -95,7 +95,7 @@ impl<'a> DrawList<'a> {
             }
             lights
         };
-        let mut lights = lights;
+        // The emissive pieces' area lights, placed with their models.
         lights.extend(
             scene
                 .emitters

@@ -20,7 +20,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 use super::Model;
 use super::environment::Environment;
 use super::light::{Light, LightKind};
-use super::material::{Material, Native};
+use super::material::{Material, shades_pbr};
 use super::settings::ShadingMode;
 use crate::assets::mesh::Mesh;
 use crate::assets::texture::TextureRef;
@@ -229,15 +229,6 @@ pub fn emitted(mode: ShadingMode, m: &Material) -> Vec3 {
     match map {
         Some(t) if color != Vec3::ZERO => color * mean_color(t),
         _ => color,
-    }
-}
-
-/// Whether shading mode `mode` shades material `m` as metallic-roughness.
-pub fn shades_pbr(mode: ShadingMode, m: &Material) -> bool {
-    match mode {
-        ShadingMode::Pbr => true,
-        ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
-        _ => false,
     }
 }
 

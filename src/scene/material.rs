@@ -445,3 +445,13 @@ impl Material {
         .flatten()
     }
 }
+
+/// Whether shading mode `mode` shades material `m` as metallic-roughness.
+pub fn shades_pbr(mode: super::settings::ShadingMode, m: &Material) -> bool {
+    use super::settings::ShadingMode;
+    match mode {
+        ShadingMode::Pbr => true,
+        ShadingMode::Auto => m.native == Native::Pbr && !m.unlit,
+        _ => false,
+    }
+}

@@ -62,7 +62,7 @@ pub struct ShadeContext<'a> {
 /// Whether shading mode `mode` shades a point of `m` with
 /// metallic-roughness.
 pub(crate) fn shades_pbr(mode: ShadingMode, m: &Material) -> bool {
-    crate::scene::emitters::shades_pbr(mode, m)
+    crate::scene::material::shades_pbr(mode, m)
 }
 
 impl ShadeContext<'_> {
