@@ -93,6 +93,9 @@ impl Encoder {
     /// The encoder of settings `s` at `exposure` stops.
     pub(super) fn new(s: &RenderSettings, exposure: f32) -> Encoder {
         let alpha = s.background == Background::Transparent;
+        if s.tonemap == Tonemap::Agx {
+            crate::shade::agx::prepare();
+        }
         Encoder {
             alpha,
             channels: if alpha { 4 } else { 3 },

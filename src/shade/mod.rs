@@ -1,6 +1,7 @@
 //! Shading: what color a visible surface point gets, per `render.shading`.
 //! Shading reads the scene (materials, lights) and never writes to it.
 
+pub mod agx;
 pub mod ao;
 pub mod blinn_phong;
 pub mod env;

@@ -1,6 +1,6 @@
 //! From linear radiance to display values: exposure and a tone map (clamp,
 //! Reinhard, ACES as Narkowicz and as Hill fit it, Khronos PBR Neutral,
-//! AgX); the sRGB encoding that follows is `color::encode_srgb`.
+//! Blender's AgX); the sRGB encoding that follows is `color::encode_srgb`.
 
 use glam::{Mat3, Vec3};
 
@@ -145,47 +145,22 @@ fn pbr_neutral<L: Lane>(c: V3<L>) -> V3<L> {
     V3::select(peak.cmplt(L::splat(START)), c, compressed)
 }
 
-/// AgX (Troy Sobotka's, in the common minimal form): an inset into a
-/// wider primaries space, a log2 encoding over [-12.47, 4.03] stops, the
-/// default contrast curve (a polynomial fit of its sigmoid), the outset,
-/// and back to linear for the sRGB encoding.
+/// `agx::agx` of each lane (the formation table is read lane by lane).
 #[inline(always)]
 fn agx<L: Lane>(c: V3<L>) -> V3<L> {
-    const MIN_EV: f32 = -12.473_931;
-    const MAX_EV: f32 = 4.026_069;
-    let inset = Mat3::from_cols(
-        Vec3::new(0.842_479_06, 0.042_328_24, 0.042_375_65),
-        Vec3::new(0.078_433_6, 0.878_468_6, 0.078_433_6),
-        Vec3::new(0.079_223_75, 0.079_166_13, 0.879_143),
-    );
-    let outset = Mat3::from_cols(
-        Vec3::new(1.196_879, -0.052_896_85, -0.052_971_635),
-        Vec3::new(-0.098_020_88, 1.151_903_1, -0.098_043_45),
-        Vec3::new(-0.099_029_74, -0.098_961_18, 1.151_073_7),
-    );
-    let v = c.max(V3::splat(Vec3::splat(1e-10))).by(inset);
-    let v = V3 {
-        x: v.x.map(f32::log2),
-        y: v.y.map(f32::log2),
-        z: v.z.map(f32::log2),
-    }
-    .max(V3::splat(Vec3::splat(MIN_EV)))
-    .min(V3::splat(Vec3::splat(MAX_EV)));
-    let x = v.plus(-MIN_EV) / L::splat(MAX_EV - MIN_EV);
-    let x2 = x * x;
-    let x4 = x2 * x2;
-    let curve = ((((((x4 * x2).times(15.5) - (x4 * x).times(40.14)) + x4.times(31.96))
-        - (x2 * x).times(6.868))
-        + x2.times(0.4298))
-        + x.times(0.1191))
-    .plus(-0.00232);
-    let display = curve.by(outset).max(V3::zero());
-    // The curve's output is display-encoded (gamma 2.2): back to linear.
-    let linear = |l: L| l.map(|x| x.powf(2.2));
+    const MAX: usize = 16;
+    debug_assert!(L::WIDTH <= MAX);
+    let mapped: [Vec3; MAX] = std::array::from_fn(|k| {
+        if k < L::WIDTH {
+            super::agx::agx(Vec3::new(c.x.lane(k), c.y.lane(k), c.z.lane(k)))
+        } else {
+            Vec3::ZERO
+        }
+    });
     V3 {
-        x: linear(display.x),
-        y: linear(display.y),
-        z: linear(display.z),
+        x: L::from_fn(|k| mapped[k].x),
+        y: L::from_fn(|k| mapped[k].y),
+        z: L::from_fn(|k| mapped[k].z),
     }
 }
 
