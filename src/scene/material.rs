@@ -151,7 +151,8 @@ pub struct IridescenceLayer {
     pub thickness_map: Option<TextureRef>,
 }
 
-/// The fuzz of cloth: a Charlie lobe of this colour and roughness.
+/// The fuzz of cloth: a sheen layer (`shade::sheen`) of this colour and
+/// roughness.
 #[derive(Debug, Clone)]
 pub struct SheenLayer {
     /// Linear.

@@ -27,8 +27,8 @@
 //!   uniform environment is invisible) and attenuation
 //!   attenuation_color^(thickness / attenuation_distance) (Beer's law,
 //!   KHR_materials_volume). Thin-walled: no refraction offset.
-//! - sheen (`shade::sheen`): a Charlie lobe over the base, which it
-//!   scales by 1 - max(C) E (under the clearcoat; emission is not scaled).
+//! - sheen (`shade::sheen`): Zeltner et al.'s fibre lobe over the base,
+//!   which it scales by 1 - max(C) R (under the clearcoat; emission is not scaled).
 //! - anisotropy (`pbr::anisotropy`): the GGX lobe rougher along a
 //!   direction t of the tangent plane (the tangent turned by the rotation,
 //!   or the map's direction) than across it (b = n x t), alpha_t =
