@@ -73,6 +73,7 @@ use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
 use crate::shade::env::bounce::Surfaces;
 use crate::shade::env::emitters::Emitters;
+use crate::shade::env::reflect::Reflections;
 use crate::shade::env::sampled::{EnvSampler, Sampled};
 use crate::shade::refraction::{self, OpaqueFrame};
 use crate::shade::shadow::Shadows;
@@ -420,12 +421,22 @@ impl<'s> Renderer<'s> {
     /// Whether frames lit by `lights` trace rays through the BVHs:
     /// ray-traced shadows of a light that casts them, ray-traced AO, the
     /// sampled environment or the ground's shadow catcher.
+    /// Whether the prefiltered environment's reflections are traced
+    /// (`environment.reflections`).
+    fn reflects(&self) -> bool {
+        self.scene
+            .environment
+            .as_ref()
+            .is_some_and(|e| e.reflections)
+    }
+
     fn traces_rays(&self, lights: &[Light]) -> bool {
         let s = &self.scene.settings;
         (s.shadows == ShadowMethod::Raytraced && lights.iter().any(|l| l.shadows))
             || s.ao.method == AoMethod::Raytraced
             || self.env_sampler().is_some()
             || self.scene.ground.is_some()
+            || self.reflects()
     }
 
     /// The frame's meshes as placed, for rays. `posed`: the BVHs of this
@@ -540,6 +551,15 @@ impl<'s> Renderer<'s> {
                     surfaces: bounces.then_some(&surfaces as &dyn Surfaces),
                     light: env,
                 });
+        ctx.env_reflections = match (env, tracer.as_ref()) {
+            (Some(light), Some(tracer)) if self.reflects() => Some(Reflections {
+                tracer,
+                surfaces: &surfaces,
+                light,
+                lights: &setup.lights,
+            }),
+            _ => None,
+        };
         // Wireframe lines keep their width in output pixels.
         ctx.pixel_scale = width as f32 / s.width as f32;
         let mut data = fragment::BandInputs::new(
@@ -789,6 +809,7 @@ fn shade_context<'a>(
         shadows,
         env,
         env_sampled: None,
+        env_reflections: None,
         pixel_scale: 1.0,
         refraction: Default::default(),
     }

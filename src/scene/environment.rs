@@ -44,6 +44,9 @@ pub struct Environment {
     /// Prefiltered: how many emissive surfaces light the scene as area
     /// lights (default `DEFAULT_EMITTERS`; sampled: 0, its rays find them).
     pub emitters: u32,
+    /// Prefiltered: whether the specular lobes' dominant directions are
+    /// traced against the models (`shade::env::reflect`); sampled: false.
+    pub reflections: bool,
 }
 
 /// `environment.emitters` when the scene does not give it and the method

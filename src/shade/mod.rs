@@ -51,6 +51,9 @@ pub struct ShadeContext<'a> {
     /// its emissive triangles and the sample count; replaces the
     /// prefiltered light of `env`.
     pub env_sampled: Option<env::sampled::Sampled<'a>>,
+    /// `environment.reflections` under the prefiltered method: the rays
+    /// along the specular lobes' dominant directions.
+    pub env_reflections: Option<env::reflect::Reflections<'a>>,
     /// Rendered pixels per output pixel along an axis (the supersampling
     /// factor): wireframe lines keep their width in output pixels.
     pub pixel_scale: f32,
@@ -213,6 +216,7 @@ pub(crate) mod testing {
             shadows,
             env: None,
             env_sampled: None,
+            env_reflections: None,
             pixel_scale: 1.0,
             refraction: Default::default(),
         }

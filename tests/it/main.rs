@@ -14,6 +14,7 @@ mod gltf_materials;
 mod gltf_pose;
 mod known_answers;
 mod points_lines;
+mod reflections;
 mod shadows;
 mod specular_aa;
 mod textures;

@@ -273,6 +273,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             rotation: 0.0,
             prefilter_size: DEFAULT_PREFILTER_SIZE,
             emitters: DEFAULT_EMITTERS as u32,
+            reflections: false,
         }),
         None => None,
     };
@@ -541,6 +542,9 @@ fn environment(
             } else {
                 get(&e.emitters, DEFAULT_EMITTERS) as u32
             },
+            // An image's reflections by default; the presets' soft panels
+            // (the default look) keep their speed.
+            reflections: !sampled && get(&e.reflections, e.path.is_some()),
         },
         sun,
         lights,

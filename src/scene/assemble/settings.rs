@@ -364,6 +364,10 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
                 e.emitters.as_ref().map(|v| v.span()),
                 "environment.emitters has no effect: environment.method \"sampled\" lights with every emissive surface",
             );
+            warn(
+                e.reflections.as_ref().map(|v| v.span()),
+                "environment.reflections has no effect: environment.method \"sampled\" traces every reflection",
+            );
         }
     }
     for c in &d.cameras {

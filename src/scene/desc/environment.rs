@@ -40,6 +40,9 @@ pub struct EnvironmentDesc {
     /// How many emissive surfaces become shadow-casting area lights
     /// (default 4 prefiltered; sampled lights with all of them).
     pub emitters: Option<Spanned<i64>>,
+    /// Prefiltered: trace the specular lobes' reflections of the models
+    /// (default true with an image, false with a preset).
+    pub reflections: Option<Spanned<bool>>,
 }
 
 /// The built-in environments.

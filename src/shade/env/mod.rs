@@ -32,6 +32,7 @@ pub mod emitters;
 mod image_sampler;
 mod octahedral;
 mod pattern;
+pub mod reflect;
 pub mod sampled;
 
 use octahedral::Octahedral;

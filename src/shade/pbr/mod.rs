@@ -60,6 +60,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use super::env::reflect::At;
 use super::env::{EnvLight, dominant_direction_lanes};
 pub use super::sheen::Sheen;
 use crate::simd::{Lane, MAX_WIDTH, Mask, V3, clamp01};
@@ -515,8 +516,14 @@ pub fn env_brdf<L: Lane>(roughness: L, ndv: L) -> (L, L) {
 /// reference than the GGX level at its roughness); a clearcoat is a
 /// dielectric lobe, F0 0.04, about its own normal, over both.
 #[inline(always)]
-pub fn environment<L: Lane>(env: &EnvLight, [n, v]: [V3<L>; 2], c: &PbrColor<L>, ao: L) -> V3<L> {
-    let mut base = base_environment(env, n, v, c, ao);
+pub fn environment<L: Lane>(
+    env: &EnvLight,
+    [n, v]: [V3<L>; 2],
+    c: &PbrColor<L>,
+    ao: L,
+    traced: Option<&At<'_, L>>,
+) -> V3<L> {
+    let mut base = base_environment(env, [n, v], c, ao, traced);
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs().max(L::splat(1e-4));
         let irradiance = env.irradiance_lanes(n);
@@ -541,18 +548,27 @@ pub fn environment<L: Lane>(env: &EnvLight, [n, v]: [V3<L>; 2], c: &PbrColor<L>,
     let r = dominant_direction_lanes(nc, r, rough);
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), rough.lane(k)));
     let r0 = rough.lane(0);
-    let light = if rough.cmpeq(L::splat(r0)).all() {
+    let mut light = if rough.cmpeq(L::splat(r0)).all() {
         env.prefiltered_lanes(r, r0)
     } else {
         V3::from_fn(|k| env.prefiltered(r.lane(k), rough.lane(k)))
     };
+    if let Some(t) = traced {
+        light = t.blend(light, r, rough);
+    }
     let layer = light.scale((L::splat(COAT_F0) * a + b) * so);
     base.scale(L::splat(1.0) - coat.weight(v)) + layer.scale(coat.factor * c.occlusion)
 }
 
 /// `environment` without the sheen and the clearcoat.
 #[inline(always)]
-fn base_environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &PbrColor<L>, ao: L) -> V3<L> {
+fn base_environment<L: Lane>(
+    env: &EnvLight,
+    [n, v]: [V3<L>; 2],
+    c: &PbrColor<L>,
+    ao: L,
+    traced: Option<&At<'_, L>>,
+) -> V3<L> {
     let ndv = n.dot(v).abs().max(L::splat(1e-4));
     let (mut a, mut b) = ([0.0f32; MAX_WIDTH], [0.0f32; MAX_WIDTH]);
     for k in 0..L::WIDTH {
@@ -574,7 +590,10 @@ fn base_environment<L: Lane>(env: &EnvLight, n: V3<L>, v: V3<L>, c: &PbrColor<L>
     };
     let r = nr.scale(L::splat(2.0) * nr.dot(v)) - v;
     let r = dominant_direction_lanes(nr, r, c.roughness);
-    let light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
+    let mut light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
+    if let Some(t) = traced {
+        light = t.blend(light, r, c.roughness);
+    }
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
     let specular = (light * spec).scale(so);
     (diffuse + specular).scale(c.occlusion)

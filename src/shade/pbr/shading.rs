@@ -10,6 +10,7 @@ use super::{
 };
 use crate::scene::Material;
 use crate::scene::light::{Light, LightKind};
+use crate::shade::env::reflect::At;
 use crate::shade::env::sampled::{self as env_sampled, Lobes};
 use crate::shade::lanes::{Lanes, Lit};
 use crate::shade::{Fetch, ShadeContext};
@@ -362,7 +363,14 @@ impl ShadeContext<'_> {
             return direct + l.scale(c.occlusion);
         }
         match self.env {
-            Some(env) => direct + environment(env, [n, v], &c, f.ao),
+            Some(env) => {
+                let traced = self.env_reflections.as_ref().map(|with| At {
+                    with,
+                    position: f.position,
+                    geo_normal: &f.geo_normal[..],
+                });
+                direct + environment(env, [n, v], &c, f.ao, traced.as_ref())
+            }
             None => direct,
         }
     }

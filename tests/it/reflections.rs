@@ -1,0 +1,78 @@
+//! Traced reflections under the prefiltered environment
+//! (`environment.reflections`): a mirror shows the surface its dominant
+//! direction meets, not the environment behind it; a rough lobe keeps the
+//! environment; every lane width gives the same bytes.
+
+use glam::Vec3;
+use softraster::scene::Scene;
+
+use crate::common::{self, render_frame};
+use crate::widths::same_at_every_width;
+
+/// A metal floor (white, roughness `roughness`) seen from 45 degrees
+/// above, whose mirror direction meets a wall emitting (2, 0, 0) and
+/// reflecting nothing, under a uniform white environment: the linear
+/// colour of the floor's middle pixel, and the scene.
+fn mirror_floor(name: &str, roughness: f32, reflections: &str) -> (Vec3, Scene) {
+    let dir = common::scratch(name);
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\n\
+         v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\n\
+         v -20 -1 -3\nv 20 -1 -3\nv 20 20 -3\nv -20 20 -3\n\
+         usemtl floor\nf 4 3 2 1\n\
+         usemtl wall\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        format!(
+            "newmtl floor\nKd 1 1 1\nPm 1\nPr {roughness}\n\
+             newmtl wall\nKd 0 0 0\nKs 0 0 0\nKe 2 0 0\nPm 0\nPr 1\n"
+        ),
+    )
+    .unwrap();
+    let scene = format!(
+        "[output]\nwidth = 16\nheight = 16\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
+         [environment]\npreset = \"neutral\"\nemitters = 0\n{reflections}\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\neye = [0.0, 1.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         projection = \"orthographic\"\nheight = 0.05\n"
+    );
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let c = render_frame(&s, 0, 0).color[8 * 16 + 8].truncate();
+    (c, s)
+}
+
+#[test]
+fn a_mirror_shows_the_wall_its_reflection_meets() {
+    // Traced: the wall's radiance, times the white metal's specular
+    // albedo at roughness 0 (about 1).
+    let (on, scene) = mirror_floor("reflect_on", 0.0, "reflections = true\n");
+    assert!(
+        (on.x - 2.0).abs() < 0.06 && on.y < 0.02 && on.z < 0.02,
+        "traced: {on}"
+    );
+    // Without: the uniform environment behind the wall, white.
+    let (off, _) = mirror_floor("reflect_off", 0.0, "");
+    assert!(
+        (off - Vec3::ONE).abs().max_element() < 0.03,
+        "prefiltered: {off}"
+    );
+    // The presets do not trace by default; `reflections = false` is the
+    // same picture.
+    let (no, _) = mirror_floor("reflect_no", 0.0, "reflections = false\n");
+    assert_eq!(no, off);
+    // A lobe of roughness 1 keeps the environment.
+    let (rough_on, _) = mirror_floor("reflect_rough_on", 1.0, "reflections = true\n");
+    let (rough_off, _) = mirror_floor("reflect_rough_off", 1.0, "");
+    assert_eq!(rough_on, rough_off);
+    // Half way, the wall shows in part.
+    let (half, _) = mirror_floor("reflect_half", 0.5, "reflections = true\n");
+    assert!(
+        half.x > half.y + 0.3 && half.y > 0.1,
+        "roughness 0.5: {half}"
+    );
+    same_at_every_width(&scene, &[0], "a mirror floor's traced reflection");
+}
