@@ -237,16 +237,45 @@ impl Bvh {
 
     /// Any hit with t in (t_min, t_max) along `o + t d` (d need not be unit).
     pub fn occluded(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> bool {
-        self.traverse(o, d, t_min, t_max, true).is_some()
+        self.traverse(o, d, t_min, t_max, true, |_| true).is_some()
     }
 
     /// The nearest hit with t in (t_min, t_max).
     pub fn nearest(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
-        self.traverse(o, d, t_min, t_max, false)
+        self.traverse(o, d, t_min, t_max, false, |_| true)
+    }
+
+    /// `occluded`, counting only the hits `keep` keeps (a ray goes on
+    /// through the others: the holes of a cut-out leaf).
+    pub fn occluded_where(
+        &self,
+        (o, d): (Vec3, Vec3),
+        (t_min, t_max): (f32, f32),
+        keep: impl Fn(Hit) -> bool,
+    ) -> bool {
+        self.traverse(o, d, t_min, t_max, true, keep).is_some()
+    }
+
+    /// `nearest`, counting only the hits `keep` keeps.
+    pub fn nearest_where(
+        &self,
+        (o, d): (Vec3, Vec3),
+        (t_min, t_max): (f32, f32),
+        keep: impl Fn(Hit) -> bool,
+    ) -> Option<Hit> {
+        self.traverse(o, d, t_min, t_max, false, keep)
     }
 
     #[inline]
-    fn traverse(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32, any: bool) -> Option<Hit> {
+    fn traverse(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: f32,
+        any: bool,
+        keep: impl Fn(Hit) -> bool,
+    ) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -273,10 +302,14 @@ impl Bvh {
                 let first = n.index as usize;
                 for k in first..first + n.count as usize {
                     if let Some(t) = intersect(&self.tris[k], o, d, t_min, t_max) {
-                        best = Some(Hit {
+                        let hit = Hit {
                             t,
                             prim: self.prim[k],
-                        });
+                        };
+                        if !keep(hit) {
+                            continue;
+                        }
+                        best = Some(hit);
                         if any {
                             return best;
                         }

@@ -11,9 +11,12 @@ use glam::{Mat4, Vec3, Vec3A};
 use bvh::Bvh;
 
 /// A mesh as one frame places it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct Placed<'a> {
     pub bvh: &'a Bvh,
+    /// What a ray may pass through on this mesh (masked and blended
+    /// materials); None: every triangle stops it.
+    pub cutout: Option<&'a dyn Cutout>,
     /// The mesh's object-space bounds (lo, hi).
     pub bounds: (Vec3, Vec3),
     pub world_from_object: Mat4,
@@ -23,10 +26,25 @@ struct Instance<'a> {
     /// Its place in the `placed` list the tracer was made from.
     index: usize,
     bvh: &'a Bvh,
+    cutout: Option<&'a dyn Cutout>,
     object_from_world: Mat4,
     /// World-space bounds (a quick reject before the transform).
     lo: Vec3A,
     hi: Vec3A,
+}
+
+/// What a ray may pass through on one mesh: the holes of a masked
+/// material, a share of a blended one.
+pub trait Cutout: Sync {
+    /// The share of light the triangle `hit` met on the object-space ray
+    /// `o + t d` lets through: 1 in a hole, 0 where it is solid, 1 -
+    /// opacity where it is blended.
+    fn pass(&self, hit: bvh::Hit, o: Vec3, d: Vec3) -> f32;
+
+    /// Whether the triangle stops the ray, for queries that take all or
+    /// nothing: a share is let through where a number of the ray and the
+    /// triangle falls below it.
+    fn stops(&self, hit: bvh::Hit, o: Vec3, d: Vec3) -> bool;
 }
 
 /// The scene's triangles as placed in one frame.
@@ -67,6 +85,7 @@ impl<'a> Tracer<'a> {
                 Instance {
                     index,
                     bvh: p.bvh,
+                    cutout: p.cutout,
                     object_from_world: w.inverse(),
                     lo: wlo,
                     hi: whi,
@@ -110,8 +129,13 @@ impl<'a> Tracer<'a> {
         self.instances.iter().any(|i| {
             box_hit(i.lo, i.hi, oa, inv, t_max) && {
                 let m = &i.object_from_world;
-                i.bvh
-                    .occluded(m.transform_point3(o), m.transform_vector3(d), 0.0, t_max)
+                let (oo, od) = (m.transform_point3(o), m.transform_vector3(d));
+                match i.cutout {
+                    None => i.bvh.occluded(oo, od, 0.0, t_max),
+                    Some(c) => i
+                        .bvh
+                        .occluded_where((oo, od), (0.0, t_max), |h| c.stops(h, oo, od)),
+                }
             }
         })
     }
@@ -140,6 +164,44 @@ pub struct TraceHit {
 }
 
 impl Tracer<'_> {
+    /// The share of light that comes through along `o + t d` for t in
+    /// (0, t_max): 0 past a solid triangle, the product of what blended
+    /// ones let through otherwise (`Cutout::pass`), 1 where nothing is in
+    /// the way.
+    pub fn transmittance(&self, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
+        if !self.may_meet(oa, inv, t_max) {
+            return 1.0;
+        }
+        let mut through = 1.0;
+        for i in &self.instances {
+            if !box_hit(i.lo, i.hi, oa, inv, t_max) {
+                continue;
+            }
+            let m = &i.object_from_world;
+            let (oo, od) = (m.transform_point3(o), m.transform_vector3(d));
+            let blocked = match i.cutout {
+                None => i.bvh.occluded(oo, od, 0.0, t_max),
+                Some(c) => {
+                    // Every triangle met is seen once; the walk stops at
+                    // the first solid one.
+                    let share = std::cell::Cell::new(1.0f32);
+                    let solid = i.bvh.occluded_where((oo, od), (0.0, t_max), |h| {
+                        let p = c.pass(h, oo, od);
+                        share.set(share.get() * p);
+                        p <= 0.0
+                    });
+                    through *= share.get();
+                    solid
+                }
+            };
+            if blocked {
+                return 0.0;
+            }
+        }
+        through
+    }
+
     /// The nearest surface on `o + t d` for t in (0, t_max).
     pub fn nearest(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<TraceHit> {
         let (oa, inv) = (Vec3A::from(o), Vec3A::from(d).recip());
@@ -154,7 +216,13 @@ impl Tracer<'_> {
             }
             let m = &i.object_from_world;
             let (oo, od) = (m.transform_point3(o), m.transform_vector3(d));
-            if let Some(h) = i.bvh.nearest(oo, od, 0.0, reach) {
+            let hit = match i.cutout {
+                None => i.bvh.nearest(oo, od, 0.0, reach),
+                Some(c) => i
+                    .bvh
+                    .nearest_where((oo, od), (0.0, reach), |h| c.stops(h, oo, od)),
+            };
+            if let Some(h) = hit {
                 best = Some(TraceHit {
                     mesh: i.index,
                     prim: h.prim,
@@ -179,6 +247,64 @@ fn box_hit(lo: Vec3A, hi: Vec3A, o: Vec3A, inv: Vec3A, t_max: f32) -> bool {
 mod tests {
     use super::*;
 
+    /// Lets through half the light at every triangle, or none.
+    struct Half(f32);
+
+    impl Cutout for Half {
+        fn pass(&self, _: bvh::Hit, _: Vec3, _: Vec3) -> f32 {
+            self.0
+        }
+        fn stops(&self, _: bvh::Hit, _: Vec3, _: Vec3) -> bool {
+            self.0 <= 0.0
+        }
+    }
+
+    #[test]
+    fn transmittance_multiplies_what_each_surface_lets_through() {
+        // Two unit squares in the planes z = 0 and z = 1.
+        let (pos, tris) = (
+            vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(1.0, 0.0, 1.0),
+                Vec3::new(1.0, 1.0, 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
+        );
+        let bvh = Bvh::build(&pos, &tris);
+        let (half, none) = (Half(0.5), Half(0.0));
+        for (cutout, through, occluded) in [
+            (None, 0.0, true),
+            (Some(&half as &dyn Cutout), 0.25, false),
+            (Some(&none as &dyn Cutout), 0.0, true),
+        ] {
+            let t = Tracer::new(
+                [Placed {
+                    bvh: &bvh,
+                    cutout,
+                    bounds: (Vec3::ZERO, Vec3::ONE),
+                    world_from_object: Mat4::IDENTITY,
+                }],
+                1.0,
+            );
+            let (o, d) = (Vec3::new(0.3, 0.4, -1.0), Vec3::Z);
+            assert_eq!(t.transmittance(o, d, f32::INFINITY), through);
+            assert_eq!(t.occluded(o, d, f32::INFINITY), occluded);
+            // Beyond both, or beside them: all of it.
+            assert_eq!(t.transmittance(o, d, 0.5), 1.0);
+            assert_eq!(
+                t.transmittance(Vec3::new(3.0, 0.4, -1.0), d, f32::INFINITY),
+                1.0
+            );
+            // The nearest surface the cutout keeps.
+            assert_eq!(t.nearest(o, d, f32::INFINITY).is_some(), occluded);
+        }
+    }
+
     /// The bounds of all instances together (`may_meet`) change no answer:
     /// two boxes apart, one turned, and rays from a grid of points towards
     /// a spread of directions, some through the gap between them, some
@@ -200,6 +326,7 @@ mod tests {
         ]
         .map(|world_from_object| Placed {
             bvh: &bvh,
+            cutout: None,
             bounds,
             world_from_object,
         });

@@ -14,7 +14,10 @@ use glam::{Vec2, Vec3, Vec4};
 use super::draw_list::DrawList;
 use super::vertex::ModelVertices;
 use crate::assets::texture::{TextureRef, Wrap};
-use crate::raytrace::TraceHit;
+use crate::raytrace::bvh::Hit;
+use crate::raytrace::{Cutout, TraceHit};
+use crate::scene::Model;
+use crate::scene::material::AlphaMode;
 use crate::scene::material::{Material, roughness_from_ns};
 use crate::scene::settings::ShadingMode;
 use crate::shade::env::bounce::{Bounce, Surfaces};
@@ -100,9 +103,11 @@ impl Reading {
     /// The map's linear RGBA at the point; white where the mesh has no
     /// coordinates for it.
     fn map(&self, t: &Option<TextureRef>) -> Vec4 {
-        let Some(t) = t else {
-            return Vec4::ONE;
-        };
+        t.as_ref().map_or(Vec4::ONE, |t| self.rgba(t))
+    }
+
+    /// `map` of a map that is there.
+    fn rgba(&self, t: &TextureRef) -> Vec4 {
         let uv = if t.texcoord == 1 {
             self.uv.1
         } else {
@@ -168,6 +173,113 @@ fn reflectance(mode: ShadingMode, m: &Material, read: &Reading, tint: Vec4) -> R
             emitted: m.ke * read.map(&m.map_ke).truncate(),
         }
     }
+}
+
+/// What rays pass through on one model: the holes of its masked
+/// materials (opacity below the cutoff at the point met) and a share of
+/// its blended ones (a ray goes through where its own number, a hash of
+/// the ray and the triangle, is at least the opacity: over the rays of a
+/// soft shadow or a pixel's neighbours, the share 1 - opacity). Opacity
+/// as the rasterizer reads it (`ShadeContext::opacity_of`: d, map_d,
+/// map_kd's alpha, the vertex colours' alpha), the maps read bilinear at
+/// full size. Transmissive materials stop rays, as opaque ones do.
+pub(super) struct ModelCutout<'a> {
+    model: &'a Model,
+    wrap: Wrap,
+}
+
+impl<'a> ModelCutout<'a> {
+    /// The model's cutout; None where every one of its materials stops
+    /// rays.
+    pub fn of(model: &'a Model, wrap: Wrap) -> Option<ModelCutout<'a>> {
+        model
+            .materials
+            .iter()
+            .any(|m| cut_at(m).is_some())
+            .then_some(ModelCutout { model, wrap })
+    }
+}
+
+/// How material `m` lets rays through: Some(false) for a mask's holes,
+/// Some(true) for a blend's share; None: it stops them.
+fn cut_at(m: &Material) -> Option<bool> {
+    match m.alpha {
+        AlphaMode::Mask(_) => Some(false),
+        AlphaMode::Blend if m.pbr.transmission.is_none() => Some(true),
+        _ => None,
+    }
+}
+
+impl Cutout for ModelCutout<'_> {
+    fn pass(&self, hit: Hit, o: Vec3, d: Vec3) -> f32 {
+        match self.opacity(hit, o, d) {
+            None => 0.0,
+            Some((opacity, Some(cutoff))) => f32::from(u8::from(opacity < cutoff)),
+            Some((opacity, None)) => (1.0 - opacity).clamp(0.0, 1.0),
+        }
+    }
+
+    fn stops(&self, hit: Hit, o: Vec3, d: Vec3) -> bool {
+        match self.opacity(hit, o, d) {
+            None => true,
+            Some((opacity, Some(cutoff))) => opacity >= cutoff,
+            Some((opacity, None)) => opacity > ray_number(hit.prim, o, d),
+        }
+    }
+}
+
+impl ModelCutout<'_> {
+    /// The opacity at the point `hit` met, with the mask's cutoff (None
+    /// for a blend); None where the triangle is solid (an opaque or
+    /// transmissive material, or one that cannot be read).
+    fn opacity(&self, hit: Hit, o: Vec3, d: Vec3) -> Option<(f32, Option<f32>)> {
+        let mesh = &self.model.mesh;
+        let &tri = mesh.triangles.get(hit.prim as usize)?;
+        let m = mesh
+            .groups
+            .iter()
+            .find(|g| g.triangles.contains(&hit.prim))
+            .and_then(|g| self.model.materials.get(g.material))?;
+        let cutoff = match m.alpha {
+            AlphaMode::Mask(c) => Some(c),
+            _ if cut_at(m).is_some() => None,
+            _ => return None,
+        };
+        let corner = |i: u32| mesh.positions.get(i as usize).copied();
+        let (a, b, c) = (corner(tri[0])?, corner(tri[1])?, corner(tri[2])?);
+        let w = barycentric(o + d * hit.t, (a, b, c))?;
+        let read = Reading {
+            uv: (
+                interpolate(&mesh.uvs, tri, w),
+                interpolate(&mesh.uvs1, tri, w),
+            ),
+            wrap: self.wrap,
+        };
+        let tint = interpolate(&mesh.colors, tri, w).map_or(1.0, |c| c.w);
+        let mut opacity = m.d * tint;
+        if let Some(t) = &m.map_d {
+            let c = read.rgba(t);
+            opacity *= if t.texture.has_alpha { c.w } else { c.x };
+        }
+        if let Some(t) = &m.map_kd
+            && t.texture.has_alpha
+        {
+            opacity *= read.rgba(t).w;
+        }
+        Some((opacity, cutoff))
+    }
+}
+
+/// A number in [0, 1) of the ray `o + t d` and triangle `prim`.
+fn ray_number(prim: u32, o: Vec3, d: Vec3) -> f32 {
+    let mut h = prim.wrapping_mul(0x9E37_79B9);
+    for x in [o.x, o.y, o.z, d.x, d.y, d.z] {
+        h = (h ^ x.to_bits()).wrapping_mul(0x85EB_CA6B);
+        h ^= h >> 13;
+    }
+    h = h.wrapping_mul(0xC2B2_AE35);
+    h ^= h >> 16;
+    (h >> 8) as f32 / (1u32 << 24) as f32
 }
 
 /// A vertex attribute at the point of triangle `tri` with barycentric

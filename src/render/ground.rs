@@ -731,6 +731,7 @@ mod tests {
         Tracer::new(
             [Placed {
                 bvh,
+                cutout: None,
                 bounds: (lo, hi),
                 world_from_object: Mat4::IDENTITY,
             }],
@@ -771,6 +772,7 @@ mod tests {
         let tracer = Tracer::new(
             [Placed {
                 bvh: &bvh,
+                cutout: None,
                 bounds: (lo, hi),
                 world_from_object: Mat4::from_rotation_y(0.3),
             }],

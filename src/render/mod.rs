@@ -63,7 +63,7 @@ use crate::error::Error;
 use crate::raster::coverage::{Visibility, sample_pattern};
 use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
-use crate::raytrace::{Placed, Tracer};
+use crate::raytrace::{Cutout, Placed, Tracer};
 use crate::scene::camera::Projection;
 use crate::scene::environment::EnvMethod;
 use crate::scene::material::{Native, roughness_from_ns};
@@ -445,19 +445,25 @@ impl<'s> Renderer<'s> {
         &'a self,
         setup: &DrawList,
         posed: &'a [Option<(Bvh, (Vec3, Vec3))>],
+        cutouts: &'a [Option<bounce::ModelCutout<'a>>],
     ) -> Tracer<'a> {
         let placed = self
             .model_mesh
             .iter()
             .zip(&setup.world_from_object)
             .zip(posed)
-            .map(|((&k, &world_from_object), posed)| {
+            .enumerate()
+            .map(|(i, ((&k, &world_from_object), posed))| {
                 let (bvh, bounds) = match posed {
                     Some(b) => b,
                     None => self.bvhs[k].get_or_init(|| bvh_of(self.meshes[k])),
                 };
                 Placed {
                     bvh,
+                    cutout: cutouts
+                        .get(i)
+                        .and_then(|c| c.as_ref())
+                        .map(|c| c as &dyn Cutout),
                     bounds: *bounds,
                     world_from_object,
                 }
@@ -513,7 +519,18 @@ impl<'s> Renderer<'s> {
         } else {
             Vec::new()
         };
-        let tracer = traced.then(|| self.tracer(setup, &posed_bvhs));
+        let cutouts: Vec<Option<bounce::ModelCutout>> = if traced {
+            let wrap = s.address.into();
+            setup
+                .scene
+                .models
+                .iter()
+                .map(|m| bounce::ModelCutout::of(m, wrap))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let tracer = traced.then(|| self.tracer(setup, &posed_bvhs, &cutouts));
 
         let mut verts = vertex::transform_all(setup);
         let shadows = shadow_pass::shadows(setup, &verts, tracer.as_ref(), &self.shadow_maps);

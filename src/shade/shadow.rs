@@ -342,11 +342,10 @@ impl Shadows<'_> {
         }
         let Some(t) = &self.tracer else { return 1.0 };
         let o = p + ng * t.epsilon;
-        let occluded = match position {
-            Some(q) => t.occluded(o, *q - o, 1.0 - 1e-4),
-            None => t.occluded(o, l, f32::INFINITY),
-        };
-        if occluded { 0.0 } else { 1.0 }
+        match position {
+            Some(q) => t.transmittance(o, *q - o, 1.0 - 1e-4),
+            None => t.transmittance(o, l, f32::INFINITY),
+        }
     }
 }
 

@@ -73,31 +73,35 @@ pub fn open_share_to(
         let to = q + tx * (r * phi.cos()) + ty * (r * phi.sin()) - o;
         let t = to.length();
         if t.is_nan() || t <= 0.0 {
-            return 1;
+            return 1.0;
         }
         let d = to / t;
-        u32::from(ng.dot(d) > 0.0 && !tracer.occluded(o, d, t * (1.0 - 1e-3)))
+        if ng.dot(d) > 0.0 {
+            tracer.transmittance(o, d, t * (1.0 - 1e-3))
+        } else {
+            0.0
+        }
     })
 }
 
 /// Three probes `open(u, v)`, evenly turned near the rim; where they
 /// disagree, the penumbra's rays join them. `u` and `v` in [0, 1).
-fn share(p: Vec3, open: impl Fn(f32, f32) -> u32) -> f32 {
+fn share(p: Vec3, open: impl Fn(f32, f32) -> f32) -> f32 {
     let (su, sv) = point_hash(p);
-    let probes: u32 = (0..PROBES)
+    let probes: f32 = (0..PROBES)
         .map(|k| open(PROBE_U, (sv + k as f32 / PROBES as f32).fract()))
         .sum();
-    if probes == 0 || probes == PROBES {
-        return (probes / PROBES) as f32;
+    if probes == 0.0 || probes == PROBES as f32 {
+        return probes / PROBES as f32;
     }
-    let rest: u32 = (0..PENUMBRA_RAYS)
+    let rest: f32 = (0..PENUMBRA_RAYS)
         .map(|i| {
             let u = (i as f32 + 0.5) / PENUMBRA_RAYS as f32 + su;
             let v = i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0) + sv;
             open(u.fract(), v.fract())
         })
         .sum();
-    (probes + rest) as f32 / (PENUMBRA_RAYS + PROBES) as f32
+    (probes + rest) / (PENUMBRA_RAYS + PROBES) as f32
 }
 
 /// The rays' common part: origin, the frame around the axis, the cone.
@@ -125,14 +129,19 @@ impl<'t, 'a> Cone<'t, 'a> {
         }
     }
 
-    /// 1 if the ray at (u, v) in [0, 1)^2 is open: u the share of the
+    /// The share of light the ray at (u, v) in [0, 1)^2 lets through (1
+    /// where it is open): u the share of the
     /// cone's solid angle inside its circle, v the turn around the axis.
-    fn open(&self, u: f32, v: f32) -> u32 {
+    fn open(&self, u: f32, v: f32) -> f32 {
         let cos = 1.0 - u * self.one_minus_cos;
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let phi = std::f32::consts::TAU * v;
         let d = self.tx * (sin * phi.cos()) + self.ty * (sin * phi.sin()) + self.axis * cos;
-        u32::from(self.ng.dot(d) > 0.0 && !self.tracer.occluded(self.o, d, f32::INFINITY))
+        if self.ng.dot(d) > 0.0 {
+            self.tracer.transmittance(self.o, d, f32::INFINITY)
+        } else {
+            0.0
+        }
     }
 }
 
@@ -189,6 +198,7 @@ mod tests {
         let tracer = Tracer::new(
             [Placed {
                 bvh: &bvh,
+                cutout: None,
                 bounds: (Vec3::new(-50.0, 1.0, -50.0), Vec3::new(0.0, 1.0, 50.0)),
                 world_from_object: Mat4::IDENTITY,
             }],
@@ -256,6 +266,7 @@ mod tests {
         let tracer = Tracer::new(
             [Placed {
                 bvh: &bvh,
+                cutout: None,
                 bounds: (Vec3::new(-9.0, 1.0, -9.0), Vec3::new(9.0, 2.05, 9.0)),
                 world_from_object: Mat4::IDENTITY,
             }],

@@ -15,6 +15,7 @@ mod gltf_pose;
 mod known_answers;
 mod points_lines;
 mod reflections;
+mod see_through;
 mod shadows;
 mod specular_aa;
 mod textures;

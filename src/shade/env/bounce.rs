@@ -219,6 +219,7 @@ mod tests {
         let tracer = Tracer::new(
             [Placed {
                 bvh: &bvh,
+                cutout: None,
                 bounds: (Vec3::new(-w, 1.0, -w), Vec3::new(w, 1.0, w)),
                 world_from_object: Mat4::IDENTITY,
             }],
