@@ -25,6 +25,7 @@ import argparse
 import csv
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -116,10 +117,16 @@ def table(rows, a):
     print("|---|---|" + "---|" * len(keys))
     for r in rows:
         print(f"| {r['scene']} | {r['hdri']} | " + " | ".join(f"{r[k]:.4f}" for k in keys) + " |")
-    flips = sorted(r["flip_prefiltered"] for r in rows)
-    if flips:
-        print(f"\nFLIP (prefiltered): median {flips[len(flips) // 2]:.4f}, max {flips[-1]:.4f}, "
-              f"{len(rows)} frames")
+    for method in ("prefiltered", "sampled"):
+        flips = sorted(r[f"flip_{method}"] for r in rows if f"flip_{method}" in r)
+        if not flips:
+            continue
+        # The median of an even count is the mean of the middle two; both
+        # are printed, so that a frame just either side of a target shows.
+        lo, hi = flips[(len(flips) - 1) // 2], flips[len(flips) // 2]
+        print(f"\nFLIP ({method}): median {statistics.median(flips):.4f} (middle frames "
+              f"{lo:.4f}, {hi:.4f}), max {flips[-1]:.4f}, {sum(f > 0.10 for f in flips)} above "
+              f"0.10, {len(flips)} frames")
     for path in [os.path.join(a.out, "cycles.csv")] + ([a.csv] if a.csv else []):
         with open(path, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=["scene", "hdri"] + keys)

@@ -423,11 +423,13 @@ impl<'s> Renderer<'s> {
     /// sampled environment or the ground's shadow catcher.
     /// Whether the prefiltered environment's reflections are traced
     /// (`environment.reflections`).
-    fn reflects(&self) -> bool {
+    /// Whether the prefiltered environment traces reflections and
+    /// gathers bounced light (`shade::env::reflect`).
+    fn traced_env(&self) -> (bool, bool) {
         self.scene
             .environment
             .as_ref()
-            .is_some_and(|e| e.reflections)
+            .map_or((false, false), |e| (e.reflections, e.bounce))
     }
 
     fn traces_rays(&self, lights: &[Light]) -> bool {
@@ -436,7 +438,7 @@ impl<'s> Renderer<'s> {
             || s.ao.method == AoMethod::Raytraced
             || self.env_sampler().is_some()
             || self.scene.ground.is_some()
-            || self.reflects()
+            || self.traced_env() != (false, false)
     }
 
     /// The frame's meshes as placed, for rays. `posed`: the BVHs of this
@@ -568,12 +570,15 @@ impl<'s> Renderer<'s> {
                     surfaces: bounces.then_some(&surfaces as &dyn Surfaces),
                     light: env,
                 });
+        let (mirror, bounce) = self.traced_env();
         ctx.env_reflections = match (env, tracer.as_ref()) {
-            (Some(light), Some(tracer)) if self.reflects() => Some(Reflections {
+            (Some(light), Some(tracer)) if mirror || bounce => Some(Reflections {
                 tracer,
                 surfaces: &surfaces,
                 light,
                 lights: &setup.lights,
+                mirror,
+                bounce,
             }),
             _ => None,
         };

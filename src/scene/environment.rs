@@ -47,6 +47,29 @@ pub struct Environment {
     /// Prefiltered: whether the specular lobes' dominant directions are
     /// traced against the models (`shade::env::reflect`); sampled: false.
     pub reflections: bool,
+    /// Prefiltered: whether light bounced once between surfaces is
+    /// gathered (`environment.bounces = 1`, `shade::env::reflect`);
+    /// sampled: false (`EnvMethod::Sampled::bounces`).
+    pub bounce: bool,
+}
+
+impl Environment {
+    /// The default look's environment: the built-in studio, prefiltered,
+    /// its emitters as lights, without traced light (its soft panels keep
+    /// the default look's speed).
+    pub fn default_look() -> Environment {
+        Environment {
+            method: EnvMethod::Prefiltered,
+            image: EnvImage::studio(),
+            backdrop: None,
+            intensity: 1.0,
+            rotation: 0.0,
+            prefilter_size: DEFAULT_PREFILTER_SIZE,
+            emitters: DEFAULT_EMITTERS as u32,
+            reflections: false,
+            bounce: false,
+        }
+    }
 }
 
 /// `environment.emitters` when the scene does not give it and the method

@@ -1,7 +1,9 @@
 //! Traced reflections under the prefiltered environment
 //! (`environment.reflections`): a mirror shows the surface its dominant
-//! direction meets, not the environment behind it; a rough lobe keeps the
-//! environment; every lane width gives the same bytes.
+//! direction meets, not the environment behind it, whatever its
+//! roughness; a lobe whose dominant direction misses the wall keeps the
+//! environment; light bounced once (`environment.bounces = 1`) tints a
+//! floor by the wall beside it; every lane width gives the same bytes.
 
 use glam::Vec3;
 use softraster::scene::Scene;
@@ -64,15 +66,79 @@ fn a_mirror_shows_the_wall_its_reflection_meets() {
     // same picture.
     let (no, _) = mirror_floor("reflect_no", 0.0, "reflections = false\n");
     assert_eq!(no, off);
-    // A lobe of roughness 1 keeps the environment.
+    // A lobe of roughness 1 reads along the normal (the dominant
+    // direction), which misses the wall: the environment.
     let (rough_on, _) = mirror_floor("reflect_rough_on", 1.0, "reflections = true\n");
     let (rough_off, _) = mirror_floor("reflect_rough_off", 1.0, "");
     assert_eq!(rough_on, rough_off);
-    // Half way, the wall shows in part.
+    // Half way, the dominant direction still meets the wall: its red
+    // replaces the environment, times the lobe's (lower) albedo.
     let (half, _) = mirror_floor("reflect_half", 0.5, "reflections = true\n");
     assert!(
-        half.x > half.y + 0.3 && half.y > 0.1,
+        half.x > 1.0 && half.x < on.x && half.y < 0.03,
         "roughness 0.5: {half}"
     );
     same_at_every_width(&scene, &[0], "a mirror floor's traced reflection");
+}
+
+/// A white Lambertian floor beside a red Lambertian wall (the wall from
+/// x = 0.5 on, facing -x), under a uniform white environment, seen from
+/// straight above: the linear colour of the pixel at `x` (of 32 across
+/// [-2, 2]) on the floor's middle row.
+fn floor_by_a_wall(name: &str, bounces: u32, x: usize) -> (Vec3, Scene) {
+    let dir = common::scratch(name);
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\n\
+         v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\n\
+         v 0.5 0 -4\nv 0.5 0 4\nv 0.5 8 4\nv 0.5 8 -4\n\
+         usemtl floor\nf 4 3 2 1\n\
+         usemtl wall\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl floor\nKd 1 1 1\nPm 0\nPr 1\nPs 0\n\
+         newmtl wall\nKd 1 0 0\nPm 0\nPr 1\n",
+    )
+    .unwrap();
+    let scene = format!(
+        "[output]\nwidth = 32\nheight = 32\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
+         [environment]\npreset = \"neutral\"\nemitters = 0\nbounces = {bounces}\n\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\neye = [-1.5, 6.0, 0.0]\ntarget = [-1.5, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+         projection = \"orthographic\"\nheight = 4.0\n"
+    );
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let c = render_frame(&s, 0, 0).color[16 * 32 + x].truncate();
+    (c, s)
+}
+
+#[test]
+fn bounced_light_tints_a_floor_by_the_wall_beside_it() {
+    // The view spans x in [-3.5, 0.5]: pixel 31 lies against the wall,
+    // pixel 0 four units from it.
+    let (near0, _) = floor_by_a_wall("bounce_off_near", 0, 31);
+    let (near1, scene) = floor_by_a_wall("bounce_on_near", 1, 31);
+    let (far1, _) = floor_by_a_wall("bounce_on_far", 1, 0);
+    // Without the bounce, the floor sees the whole white sky: grey-white.
+    assert!(
+        (near0.x - near0.y).abs() < 0.01 && (near0.y - near0.z).abs() < 0.01,
+        "no bounce: {near0}"
+    );
+    // With it, at the foot of the wall, the wall fills half the floor's
+    // cosine-weighted hemisphere: green and blue lose half the sky, and
+    // the wall, lit as an open point (radiance: its red albedo times the
+    // sky's 1), gives red back: (1, 0.5, 0.5).
+    assert!(
+        (near1 - Vec3::new(1.0, 0.5, 0.5)).abs().max_element() < 0.05,
+        "bounce, at the wall's foot: {near1}"
+    );
+    // Far from the wall, the floor sees little of it.
+    assert!(
+        (far1 - near0).abs().max_element() < 0.1 && far1.x - far1.y < 0.1,
+        "bounce, far: {far1} against {near0}"
+    );
+    same_at_every_width(&scene, &[0], "a floor's bounced light");
 }

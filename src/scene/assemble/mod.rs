@@ -265,16 +265,7 @@ fn build(d: &SceneDesc, ctx: &Ctx, opts: &LoadOptions) -> Result<Scene, Error> {
             lights.extend(env_lights);
             Some(env)
         }
-        None if default_look => Some(Environment {
-            method: EnvMethod::Prefiltered,
-            image: EnvImage::studio(),
-            backdrop: None,
-            intensity: 1.0,
-            rotation: 0.0,
-            prefilter_size: DEFAULT_PREFILTER_SIZE,
-            emitters: DEFAULT_EMITTERS as u32,
-            reflections: false,
-        }),
+        None if default_look => Some(Environment::default_look()),
         None => None,
     };
     let emitters = match &environment {
@@ -545,6 +536,9 @@ fn environment(
             // An image's reflections by default; the presets' soft panels
             // (the default look) keep their speed.
             reflections: !sampled && get(&e.reflections, e.path.is_some()),
+            // Prefiltered: bounced light where the scene asks for it (it
+            // doubles a frame's time); sampled bounces in its own rays.
+            bounce: !sampled && get(&e.bounces, 0) > 0,
         },
         sun,
         lights,

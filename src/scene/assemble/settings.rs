@@ -351,10 +351,6 @@ pub(super) fn no_effect_warnings(d: &SceneDesc, ctx: &Ctx, s: &RenderSettings) -
                 e.samples.as_ref().map(|v| v.span()),
                 "environment.samples has no effect: environment.method is not \"sampled\"",
             );
-            warn(
-                e.bounces.as_ref().map(|v| v.span()),
-                "environment.bounces has no effect: environment.method is not \"sampled\"",
-            );
         } else {
             warn(
                 e.prefilter_size.as_ref().map(|v| v.span()),

@@ -27,7 +27,8 @@ pub struct EnvironmentDesc {
     pub method: Option<Spanned<EnvMethodName>>,
     /// Sampled: direction pairs a point (default 64).
     pub samples: Option<Spanned<i64>>,
-    /// Sampled: bounces of light between surfaces, 0 or 1 (default 1).
+    /// Bounces of light between surfaces, 0 or 1 (sampled: default 1;
+    /// prefiltered: default 0).
     pub bounces: Option<Spanned<i64>>,
     /// Prefiltered: width in texels of the sharpest glossy level
     /// (roughness 0.2; the rougher levels get half); default 128.

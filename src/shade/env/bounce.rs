@@ -165,7 +165,8 @@ impl Scene<'_> {
 /// wall right by a lamp would otherwise leave a lone bright pixel.
 pub const INDIRECT_CLAMP: f32 = 10.0;
 
-fn clamped(c: Vec3) -> Vec3 {
+/// `c` scaled down to `INDIRECT_CLAMP` in its largest channel.
+pub(crate) fn clamped(c: Vec3) -> Vec3 {
     let m = c.max_element();
     if m > INDIRECT_CLAMP {
         c * (INDIRECT_CLAMP / m)

@@ -1,51 +1,70 @@
-//! Traced reflections for the prefiltered environment
-//! (`environment.reflections`): where the specular lobe's dominant
-//! direction meets another surface of the scene, the prefiltered
-//! environment along it is replaced by what that surface sends back.
+//! Traced light for the prefiltered environment: reflections
+//! (`environment.reflections`) and light bounced once between surfaces
+//! (`environment.bounces = 1`).
 //!
 //! The split sum lights every point as if nothing stood between it and
 //! the environment. A path tracer's sphere beside another shows its
 //! neighbour, dark or lit, in its reflection; a metal disc under another
-//! shows the other's back. One ray per point, along the direction the
-//! split sum reads the environment, finds the surface met (`bounce::
-//! Surfaces`); that surface is lit as the prefiltered method lights an
-//! open point: its Lambertian colour times the irradiance E(n) / pi, its
-//! specular colour times the split sum along its own mirror direction,
-//! its emission, and the shadow-free light of the scene's directional
-//! lights on its Lambertian colour (the lights taken out of the image
-//! among them). What lies behind it, and its own shadows, are not
-//! counted.
+//! shows the other's back; a Cornell box's walls light each other.
 //!
-//! One ray stands for a lobe: a mirror's reflection is the ray's, a rough
-//! lobe's is wider than the surface the ray met. The ray's share fades
-//! with the roughness, from 1 at 0 to none at `FADE_END`: wide lobes
-//! keep the prefiltered light (the AO's specular occlusion stands for
-//! them).
+//! - **Reflections.** One ray per point, along the direction the split
+//!   sum reads the environment, finds the surface met (`bounce::
+//!   Surfaces`); where it meets one, what that surface sends back
+//!   replaces the prefiltered environment, whatever the lobe's roughness
+//!   (a fade towards the prefiltered light for rough lobes measured worse
+//!   against Cycles on every frame of the set but one).
+//! - **Bounced light.** `GATHER_RAYS` cosine-weighted rays per point; the
+//!   irradiance is the environment's E(n), less what the rays that meet a
+//!   surface would have brought from it (E along the ray, a smooth
+//!   stand-in for its radiance), plus what those surfaces send back.
+//!
+//! A surface met is lit as the prefiltered method lights an open point:
+//! its Lambertian colour times the irradiance E(n) / pi and the scene's
+//! lights (the lights taken out of the image among them), its specular
+//! colour times the split sum along its own mirror direction, and (for
+//! the reflections) its emission. With the bounce on, the lights are
+//! tested for shadow at the point met (the CornellBox in the studio
+//! against Cycles, eight rays: 0.121 unshadowed, 0.106 shadowed); without
+//! it the reflections light their surfaces unshadowed, which measured
+//! closer to Cycles where nothing else brings the walls' light (the
+//! CornellBox 0.180 against 0.183). The bounce leaves out the emission
+//! (the emitters light the point as area lights already) and clamps what
+//! a surface sends to `bounce::INDIRECT_CLAMP`, as the sampled bounce
+//! does.
 
 use glam::Vec3;
 
 use super::EnvLight;
-use super::bounce::{Bounce, Surfaces};
+use super::bounce::{Bounce, Surfaces, clamped};
+use super::pattern::{point, position_hash};
 use crate::raytrace::Tracer;
-use crate::scene::light::Light;
+use crate::scene::light::{Light, LightKind};
+use crate::shade::ao::cosine_direction;
 use crate::shade::light::incidence;
 use crate::simd::{Lane, V3};
 
-/// Roughness from which the traced reflection has no share.
-pub const FADE_END: f32 = 1.0;
+/// Rays per shaded point of the bounced light (the CornellBox under the
+/// studio HDRI against Cycles: 1: 0.121, 2: 0.113, 4: 0.109, 8: 0.108,
+/// 16: 0.107).
+pub const GATHER_RAYS: u32 = 4;
 
-/// What the traced reflections read: the frame's rays and surfaces, the
-/// prefiltered environment and the scene's lights.
+/// What the traced light reads: the frame's rays and surfaces, the
+/// prefiltered environment and the scene's lights, and which of the two
+/// it traces.
 #[derive(Clone, Copy)]
 pub struct Reflections<'a> {
     pub tracer: &'a Tracer<'a>,
     pub surfaces: &'a dyn Surfaces,
     pub light: &'a EnvLight,
     pub lights: &'a [Light],
+    /// Trace the specular lobes' dominant directions.
+    pub mirror: bool,
+    /// Gather light bounced once.
+    pub bounce: bool,
 }
 
-/// The traced reflections at a group of points: their positions and
-/// geometric normals.
+/// The traced light at a group of points: their positions and geometric
+/// normals.
 #[derive(Clone, Copy)]
 pub struct At<'a, L: Lane> {
     pub with: &'a Reflections<'a>,
@@ -54,105 +73,134 @@ pub struct At<'a, L: Lane> {
 }
 
 impl<L: Lane> At<'_, L> {
-    /// `Reflections::along` at these points.
+    /// `light` (the prefiltered environment along `r`), replaced by what
+    /// a ray along `r` meets where it meets a surface.
     #[inline]
-    pub fn along(&self, r: V3<L>, roughness: L) -> (V3<L>, L) {
-        self.with
-            .along(self.position, self.geo_normal, r, roughness)
+    pub fn blend(&self, light: V3<L>, r: V3<L>) -> V3<L> {
+        if !self.with.mirror {
+            return light;
+        }
+        self.with.along(self.position, self.geo_normal, r, light)
     }
 
-    /// `light` (the prefiltered environment along `r`) with the traced
-    /// reflection along `r` in its share.
+    /// The irradiance `e` (the environment's, about unit normals `n`)
+    /// with the light bounced once in place of what the surfaces around
+    /// hide, where the scene gathers it; else `e`.
     #[inline]
-    pub fn blend(&self, light: V3<L>, r: V3<L>, roughness: L) -> V3<L> {
-        let (seen, share) = self.along(r, roughness);
-        light.scale(L::splat(1.0) - share) + seen.scale(share)
+    pub fn irradiance(&self, e: V3<L>, n: V3<L>) -> V3<L> {
+        if !self.with.bounce {
+            return e;
+        }
+        self.with.gather(self.position, self.geo_normal, n, e)
     }
-}
-
-/// The traced reflection's share at `roughness`: 1 - (r / FADE_END)^2,
-/// 0 from `FADE_END` on.
-#[inline]
-pub fn share(roughness: f32) -> f32 {
-    let x = (roughness / FADE_END).clamp(0.0, 1.0);
-    1.0 - x * x
 }
 
 impl Reflections<'_> {
     /// Per lane: the radiance arriving at `p` along unit `r` from the
-    /// surface the ray meets, and its share (0 where the ray meets
-    /// nothing or the lobe is too rough), for lobes of `roughness`. `ng`:
-    /// the geometric normals, toward the viewer (the rays' offset).
-    pub fn along<L: Lane>(&self, p: V3<L>, ng: &[Vec3], r: V3<L>, roughness: L) -> (V3<L>, L) {
-        let mut seen = [Vec3::ZERO; 16];
-        let mut shares = [0.0f32; 16];
-        for k in 0..L::WIDTH {
-            let s = share(roughness.lane(k));
-            if s <= 0.0 {
-                continue;
-            }
+    /// surface the ray meets, or `open` where it meets nothing. `ng`: the
+    /// geometric normals, toward the viewer (the rays' offset).
+    pub fn along<L: Lane>(&self, p: V3<L>, ng: &[Vec3], r: V3<L>, open: V3<L>) -> V3<L> {
+        V3::from_fn(|k| {
             let d = r.lane(k);
             let n = ng[k];
             let off = if n.dot(d) < 0.0 { -n } else { n };
-            if let Some(c) = self.incoming(p.lane(k) + off * self.tracer.epsilon, d) {
-                seen[k] = c;
-                shares[k] = s;
+            self.incoming(p.lane(k) + off * self.tracer.epsilon, d)
+                .unwrap_or_else(|| open.lane(k))
+        })
+    }
+
+    /// Per lane: irradiance `e` at `p` about unit `n`, less E along each
+    /// gathering ray that meets a surface, plus pi / `GATHER_RAYS` times
+    /// what that surface sends back.
+    pub fn gather<L: Lane>(&self, p: V3<L>, ng: &[Vec3], n: V3<L>, e: V3<L>) -> V3<L> {
+        V3::from_fn(|k| {
+            let (pk, nk) = (p.lane(k), n.lane(k));
+            let g = ng[k];
+            let off = if g.dot(nk) < 0.0 { -g } else { g };
+            let o = pk + off * self.tracer.epsilon;
+            let (shift, pair) = (position_hash(pk), nk.any_orthonormal_pair());
+            let (mut met, mut hidden) = (Vec3::ZERO, Vec3::ZERO);
+            for i in 0..GATHER_RAYS {
+                let xi = point(i, GATHER_RAYS, shift);
+                let d = cosine_direction(nk, pair, (xi.x, xi.y));
+                if d.dot(off) <= 0.0 {
+                    continue;
+                }
+                let Some(b) = self.met(o, d) else {
+                    continue;
+                };
+                hidden += self.light.irradiance(d);
+                if let Some(b) = b {
+                    met += clamped(self.lit(&b, -d, true));
+                }
             }
-        }
-        (V3::from_fn(|k| seen[k]), L::from_fn(|k| shares[k]))
+            let rays = GATHER_RAYS as f32;
+            (e.lane(k) - hidden / rays).max(Vec3::ZERO) + met * (std::f32::consts::PI / rays)
+        })
     }
 
     /// The radiance along the ray `o + t d` from the first surface that
-    /// reflects (through up to 8 that mostly transmit); None where it
-    /// leaves the scene.
-    fn incoming(&self, mut o: Vec3, d: Vec3) -> Option<Vec3> {
+    /// reflects (`met`); None where it leaves the scene.
+    fn incoming(&self, o: Vec3, d: Vec3) -> Option<Vec3> {
+        Some(match self.met(o, d)? {
+            Some(b) => self.lit(&b, -d, self.bounce) + b.emitted,
+            None => Vec3::ZERO,
+        })
+    }
+
+    /// The first surface along the ray `o + t d` that reflects, through
+    /// up to 8 that mostly transmit (as thin walls): None where the ray
+    /// leaves the scene, Some(None) where the surface cannot be read or
+    /// the ray goes no further (counted as dark).
+    fn met(&self, mut o: Vec3, d: Vec3) -> Option<Option<Bounce>> {
         for _ in 0..8 {
             let hit = self.tracer.nearest(o, d, f32::INFINITY)?;
             let Some(b) = self.surfaces.at(hit, o, d) else {
-                return Some(Vec3::ZERO);
+                return Some(None);
             };
             if b.transmission >= 0.5 {
                 o = b.position - b.geometric * self.tracer.epsilon;
                 continue;
             }
-            return Some(self.leaving(&b, -d));
+            return Some(Some(b));
         }
-        Some(Vec3::ZERO)
+        Some(None)
     }
 
-    /// What surface `b` sends towards unit `wo`, lit as an open point.
-    fn leaving(&self, b: &Bounce, wo: Vec3) -> Vec3 {
+    /// What surface `b` reflects towards unit `wo`, lit as an open point
+    /// (without its emission); `shadowed`: the lights tested for shadow.
+    fn lit(&self, b: &Bounce, wo: Vec3, shadowed: bool) -> Vec3 {
         let env = self.light;
         let n = b.normal;
         let ndv = n.dot(wo).clamp(1e-4, 1.0);
+        let o = b.position + b.geometric * self.tracer.epsilon;
         let mut diffuse_light = env.irradiance(n) / std::f32::consts::PI;
         for light in self.lights {
             if let Some(i) = incidence(light, b.position) {
-                diffuse_light += i.e * (n.dot(i.l).max(0.0) / std::f32::consts::PI);
+                let cos = n.dot(i.l);
+                if cos > 0.0 && (!shadowed || self.reaches(light, o, i.l)) {
+                    diffuse_light += i.e * (cos / std::f32::consts::PI);
+                }
             }
         }
         let mirror = n * (2.0 * n.dot(wo)) - wo;
         let ab = env.brdf(ndv, b.roughness);
         let specular = env.prefiltered(mirror, b.roughness) * (b.specular * ab.x + ab.y);
-        b.diffuse * diffuse_light + specular + b.emitted
+        b.diffuse * diffuse_light + specular
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_share_fades_from_one_at_a_mirror_to_none_at_fade_end() {
-        assert_eq!(share(0.0), 1.0);
-        assert_eq!(share(FADE_END), 0.0);
-        assert_eq!(share(2.0 * FADE_END), 0.0);
-        assert!((share(0.5 * FADE_END) - 0.75).abs() < 1e-6);
-        let mut last = 1.0;
-        for i in 1..=20 {
-            let s = share(i as f32 / 20.0 * FADE_END);
-            assert!(s < last, "{i}: {s}");
-            last = s;
-        }
+    /// Whether `light` reaches `o` (already off its surface) along unit
+    /// `l`: past what a shadow ray meets, for lights that cast shadows.
+    /// An area light's centre lies on its own surface: taken as reaching.
+    fn reaches(&self, light: &Light, o: Vec3, l: Vec3) -> bool {
+        let t_max = match light.kind {
+            _ if !light.shadows => return true,
+            LightKind::Area { .. } => return true,
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                (position - o).length() * (1.0 - 1e-4)
+            }
+            LightKind::Directional { .. } => f32::INFINITY,
+        };
+        self.tracer.transmittance(o, l, t_max) > 0.5
     }
 }

@@ -278,7 +278,7 @@ impl PbrColor<f32> {
         let ndv = n.dot(v).abs();
         let spec: Vec3 = self.specular_albedo(ndv).into();
         let coat = self.coat.map_or(1.0, |k| 1.0 - k.weight(v.into()));
-        let sheen = self.sheen.map_or(1.0, |s| s.at(0).scaling(ndv, None));
+        let sheen = self.sheen.map_or(1.0, |s| s.at(0).scaling(ndv));
         (Vec3::ONE - spec)
             * Vec3::from(self.base)
             * Vec3::from(self.attenuation)
@@ -456,7 +456,10 @@ pub fn f_cos<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> 
     let mut base = brdf(n, v, l, ndl, c).scale(ndl_0);
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs();
-        let k = s.keep(s.albedo(ndv)).min(s.keep(s.albedo(ndl_0)));
+        // The light below is kept by the view's side alone, as Cycles
+        // layers its sheen (the extension's min with the light's side
+        // darkened the sheen cloth: 0.064 against 0.036).
+        let k = s.keep(s.albedo(ndv));
         let lobe = L::from_fn(|k| s.at(k).lobe_cos(n.lane(k), v.lane(k), l.lane(k)));
         base = base.scale(k) + s.color.scale(lobe);
     }
@@ -523,14 +526,20 @@ pub fn environment<L: Lane>(
     ao: L,
     traced: Option<&At<'_, L>>,
 ) -> V3<L> {
-    let mut base = base_environment(env, [n, v], c, ao, traced);
+    // Where the bounce is gathered, its rays see what hides the
+    // environment: the AO does not darken that diffuse light again.
+    let gathered = traced.filter(|t| t.with.bounce);
+    let (irradiance, ao_diffuse) = match gathered {
+        Some(t) => (t.irradiance(env.irradiance_lanes(n), n), L::splat(1.0)),
+        None => (env.irradiance_lanes(n), ao),
+    };
+    let mut base = base_environment(env, [n, v], c, [ao, ao_diffuse], irradiance, traced);
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs().max(L::splat(1e-4));
-        let irradiance = env.irradiance_lanes(n);
         let e = s.albedo(ndv);
         let lobe = irradiance * (s.reflectance(e) / L::splat(PI));
         let k = s.keep(e);
-        base = base.scale(k) + lobe.scale(ao.min(L::splat(1.0)) * c.occlusion);
+        base = base.scale(k) + lobe.scale(ao_diffuse.min(L::splat(1.0)) * c.occlusion);
     }
     let Some(coat) = &c.coat else {
         return base;
@@ -554,19 +563,22 @@ pub fn environment<L: Lane>(
         V3::from_fn(|k| env.prefiltered(r.lane(k), rough.lane(k)))
     };
     if let Some(t) = traced {
-        light = t.blend(light, r, rough);
+        light = t.blend(light, r);
     }
     let layer = light.scale((L::splat(COAT_F0) * a + b) * so);
     base.scale(L::splat(1.0) - coat.weight(v)) + layer.scale(coat.factor * c.occlusion)
 }
 
-/// `environment` without the sheen and the clearcoat.
+/// `environment` without the sheen and the clearcoat: `irradiance` the
+/// diffuse light about `n` (the environment's, or with the bounce), `ao`
+/// the occlusion of the specular lobe and `ao_diffuse` of the diffuse.
 #[inline(always)]
 fn base_environment<L: Lane>(
     env: &EnvLight,
     [n, v]: [V3<L>; 2],
     c: &PbrColor<L>,
-    ao: L,
+    [ao, ao_diffuse]: [L; 2],
+    irradiance: V3<L>,
     traced: Option<&At<'_, L>>,
 ) -> V3<L> {
     let ndv = n.dot(v).abs().max(L::splat(1e-4));
@@ -577,12 +589,12 @@ fn base_environment<L: Lane>(
     }
     let spec = c.split_sum(ndv, L::from_fn(|k| a[k]), L::from_fn(|k| b[k]));
     let one = V3::splat(Vec3::ONE);
-    let mut diffuse = c.c_diff * (one - spec) * env.irradiance_lanes(n);
+    let mut diffuse = c.c_diff * (one - spec) * irradiance;
     if let Some(behind) = c.behind {
         // The light from behind, let through diffusely.
         diffuse = diffuse + behind * (one - spec) * env.irradiance_lanes(-n);
     }
-    let diffuse = diffuse.scale(ao / L::splat(PI));
+    let diffuse = diffuse.scale(ao_diffuse / L::splat(PI));
     // The reflection about the normal (bent by an anisotropic lobe).
     let nr = match &c.aniso {
         Some(a) => a.bent_normal(n, v, c.roughness),
@@ -592,7 +604,7 @@ fn base_environment<L: Lane>(
     let r = dominant_direction_lanes(nr, r, c.roughness);
     let mut light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
     if let Some(t) = traced {
-        light = t.blend(light, r, c.roughness);
+        light = t.blend(light, r);
     }
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
     let specular = (light * spec).scale(so);
