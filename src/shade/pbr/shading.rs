@@ -156,6 +156,12 @@ pub(crate) fn valid_reflection<L: Lane>(ng: V3<L>, v: V3<L>, n: V3<L>) -> V3<L> 
 }
 
 impl ShadeContext<'_> {
+    /// Whether the environment's light is found by rays that see what
+    /// hides it: `sampled`, or the prefiltered bounce.
+    fn traces_occlusion(&self) -> bool {
+        self.env_sampled.is_some() || self.env_reflections.is_some_and(|r| r.bounce)
+    }
+
     /// The material's metallic-roughness factors times its maps (and the
     /// vertex colour) at the lanes' points.
     pub(crate) fn pbr_color<L: Lane>(
@@ -183,7 +189,13 @@ impl ShadeContext<'_> {
             metallic = metallic * x.x;
         }
         let mut c = PbrColor::new(base, clamp01(metallic), clamp01(roughness));
-        if let Some(o) = fetch.rgb_of(&p.occlusion_map) {
+        // A baked occlusion map stands for the rays the split sum does
+        // not cast; where rays find what hides the environment (`sampled`,
+        // the prefiltered bounce) it would count it twice, as a path
+        // tracer does not.
+        if !self.traces_occlusion()
+            && let Some(o) = fetch.rgb_of(&p.occlusion_map)
+        {
             c.occlusion = one + L::splat(p.occlusion_strength) * (o.x - one);
         }
         if p.emissive != Vec3::ZERO {
