@@ -11,8 +11,8 @@
 //!   sum reads the environment, finds the surface met (`bounce::
 //!   Surfaces`); where it meets one, what that surface sends back
 //!   replaces the prefiltered environment, whatever the lobe's roughness
-//!   (a fade towards the prefiltered light for rough lobes measured worse
-//!   against Cycles on every frame of the set but one).
+//!   (a fade towards the prefiltered light for rough lobes, 1 - r^2, was
+//!   further from Cycles on 14 frames of the set and closer on 2).
 //! - **Bounced light.** `GATHER_RAYS` cosine-weighted rays per point; the
 //!   irradiance is the environment's E(n), less what the rays that meet a
 //!   surface would have brought from it (E along the ray, a smooth
