@@ -39,7 +39,11 @@ Tangent node gives, as the importer links when there is a texture.
 Anything else it lacks renders as Blender reads
 it, and the table says so.
 
-Usage: python3.11 cycles_render.py SCENE.toml OUT [--samples 128]
+Usage: python3.11 cycles_render.py SCENE.toml OUT [--samples 128] [--no-denoise]
+
+(--no-denoise with 1024 samples: FLIP 0.015-0.030 from the denoised
+128-sample frame on five scenes of the set, and softraster's FLIP against
+either within 0.002.)
 """
 import argparse
 import json
@@ -172,13 +176,13 @@ def world(scene, base):
     nt.links.new(bg.outputs["Background"], out.inputs["Surface"])
 
 
-def settings(scene, samples):
+def settings(scene, samples, denoise=True):
     s = bpy.context.scene
     out = scene.get("output", {})
     s.render.engine = "CYCLES"
     s.cycles.device = "CPU"
     s.cycles.samples = samples
-    s.cycles.use_denoising = True
+    s.cycles.use_denoising = denoise
     s.cycles.seed = 1
     s.render.resolution_x = out.get("width", 256)
     s.render.resolution_y = out.get("height", 256)
@@ -210,6 +214,8 @@ def main():
     p.add_argument("scene")
     p.add_argument("out")
     p.add_argument("--samples", type=int, default=128)
+    p.add_argument("--no-denoise", action="store_true",
+                   help="leave the denoiser out (a converged reference needs many samples)")
     a = p.parse_args()
     with open(a.scene, "rb") as f:
         scene = tomllib.load(f)
@@ -218,7 +224,7 @@ def main():
     import_models(scene, base)
     camera(scene)
     world(scene, base)
-    settings(scene, a.samples)
+    settings(scene, a.samples, not a.no_denoise)
     write(os.path.abspath(a.out))
 
 

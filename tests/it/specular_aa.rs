@@ -1,8 +1,9 @@
 //! Specular anti-aliasing (`render.specular_aa`) against supersampling: a
 //! polished metal plate covered in bumps a pixel or two wide, under a
 //! sharp light, shaded once per pixel is closer to the same view at SSAA
-//! 8x8 with its lobes widened by the normal map's change across a pixel
-//! than without; and a plate without a normal map is untouched.
+//! 8x8 with it than without (its bumps turn far faster than its lobe is
+//! wide: four of the pixel's normals are shaded); and a plate without a
+//! normal map is untouched.
 
 use crate::common;
 
@@ -88,7 +89,8 @@ fn widened_lobes_are_closer_to_supersampling() {
         let on = plate(&format!("saa_on{msaa}"), true, &format!("msaa = {msaa}"));
         let (e_off, e_on) = (error(&off, &reference), error(&on, &reference));
         eprintln!("MSAA {msaa}: error against SSAA 8x8 {e_off:.6} without, {e_on:.6} with");
-        assert!(e_on < 0.9 * e_off, "MSAA {msaa}: {e_on} against {e_off}");
+        // Widening alone: 0.98 against 1.17; with the pixel's normals 0.65.
+        assert!(e_on < 0.7 * e_off, "MSAA {msaa}: {e_on} against {e_off}");
     }
 }
 

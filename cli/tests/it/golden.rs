@@ -220,7 +220,9 @@ fn a_material_with_five_slots() {
     // the others per call. The golden was the one-fragment path's frame
     // (byte-identical to the lanes'); its blended cube's triangle edges
     // are now composited per MSAA sample, and its noisy normal map's
-    // lobes widened by specular anti-aliasing (fewer lone bright texels).
+    // lobes widened by specular anti-aliasing (fewer lone bright texels),
+    // or, where the map turns far faster than the lobe is wide, shaded
+    // at four of the pixel's normals.
     check(
         "many_slots",
         &root().join("tests/data/many_slots/scene.toml"),

@@ -16,6 +16,18 @@ use crate::shade::lanes::{Lanes, Lit};
 use crate::shade::{Fetch, ShadeContext};
 use crate::simd::{Lane, Mask, V3, clamp01};
 
+/// Where a normal map's spread (`Fetch::normal_spread`: the squared turn
+/// of the mapped normal over a pixel's step along each axis, summed) is
+/// more than this many times the lobe's alpha^2, the map's detail is far
+/// sharper than the lobe, and `prefiltered` shades four normals of the
+/// pixel (the lights and the environment; `sampled`, its environment,
+/// always). The bumpy metal ball against Cycles: 0.130 -> 0.103
+/// (courtyard), 0.130 -> 0.101 (studio) FLIP. In FlightHelmet 0.6% of the
+/// shaded groups take it (16 times alpha^2: 2.4%, with no gain).
+const FAST_TURN: f32 = 64.0;
+/// The least alpha^2 `FAST_TURN` compares with.
+const MIN_LOBE: f32 = 1e-4;
+
 impl<L: Lane> PbrColor<L> {
     /// Lane `k`'s point alone.
     pub fn at(&self, k: usize) -> PbrColor<f32> {
@@ -323,23 +335,34 @@ impl ShadeContext<'_> {
         let v = self.view_lanes(f.position);
         // `sampled` integrates a normal map's normals over the pixel
         // (`Fetch::normal_samples`) where the lobe is isotropic, with the
-        // material as it is; the lights see it widened.
+        // material as it is, and so does `prefiltered` where the normals
+        // turn fast (`FAST_TURN`); elsewhere the lights see the lobe
+        // widened.
         let mut spread_normals = None;
+        let mut fast = None;
         let plain = c;
         let n = match &m.normal_map {
             Some(map) => {
                 let mapped = fetch.normal(map);
                 let towards = geometric_towards(f, v);
-                if self.env_sampled.is_some() && c.aniso.is_none() {
+                // The spread is the map's own, before any raising.
+                let lit = !f.light_set(self.lights).is_empty();
+                let spread = (self.env.is_some() || self.env_sampled.is_some() || lit)
+                    .then(|| fetch.normal_spread(map, mapped));
+                // Four normals of the pixel: always under `sampled`, and
+                // under `prefiltered` where the map turns fast across it.
+                // Lane by lane, so that every lane width shades alike.
+                fast = spread.map(|s| s.cmpgt(L::splat(FAST_TURN) * c.a2.max(L::splat(MIN_LOBE))));
+                let any_fast = fast.is_some_and(|m| m.any());
+                if (self.env_sampled.is_some() || any_fast) && c.aniso.is_none() {
                     spread_normals = fetch
                         .normal_samples(map)
                         .map(|ns| ns.map(|m| valid_reflection(towards, v, m)));
                 }
                 // The widened lobe is the lights' and the sampled
                 // environment's: without either, not measured at all.
-                // The spread is the map's own, before any raising.
-                if self.env_sampled.is_some() || !f.light_set(self.lights).is_empty() {
-                    c.widen(fetch.normal_spread(map, mapped));
+                if let Some(spread) = spread.filter(|_| self.env_sampled.is_some() || lit) {
+                    c.widen(spread);
                 }
                 // Tilted by the map, the normal may reflect the view
                 // into the surface: raised as a path tracer raises it.
@@ -355,10 +378,21 @@ impl ShadeContext<'_> {
                 None => c.aniso = None,
             }
         }
-        let direct = if c.coat.is_some() || c.sheen.is_some() {
-            self.layered_radiance(f, [n, v], &c)
-        } else {
-            self.radiance(f, [n, v], &c)
+        // Under `prefiltered`, the lights too read the four normals where
+        // the map turns fast, with the lobe as it is.
+        let four = spread_normals
+            .zip(fast)
+            .filter(|_| self.env_sampled.is_none());
+        let direct = self.direct(f, [n, v], &c);
+        let direct = match four {
+            Some((ns, fast)) => {
+                let mean = ns
+                    .iter()
+                    .fold(V3::zero(), |sum, &n| sum + self.direct(f, [n, v], &plain))
+                    .scale(L::splat(0.25));
+                V3::select(fast, mean, direct)
+            }
+            None => direct,
         };
         if let Some(sampled) = &self.env_sampled {
             let l = V3::from_fn(|k| match &spread_normals {
@@ -381,9 +415,33 @@ impl ShadeContext<'_> {
                     position: f.position,
                     geo_normal: &f.geo_normal[..],
                 });
-                direct + environment(env, [n, v], &c, f.ao, traced.as_ref())
+                let light = environment(env, [n, v], &c, f.ao, traced.as_ref());
+                let light = match four {
+                    Some((ns, fast)) => {
+                        let mean = ns
+                            .iter()
+                            .fold(V3::zero(), |sum, &n| {
+                                sum + environment(env, [n, v], &plain, f.ao, traced.as_ref())
+                            })
+                            .scale(L::splat(0.25));
+                        V3::select(fast, mean, light)
+                    }
+                    None => light,
+                };
+                direct + light
             }
             None => direct,
+        }
+    }
+
+    /// The lights' radiance with the material's layers, plus the
+    /// emission.
+    #[inline(always)]
+    fn direct<L: Lane>(&self, f: &Lanes<L>, nv: [V3<L>; 2], c: &PbrColor<L>) -> V3<L> {
+        if c.coat.is_some() || c.sheen.is_some() {
+            self.layered_radiance(f, nv, c)
+        } else {
+            self.radiance(f, nv, c)
         }
     }
 
