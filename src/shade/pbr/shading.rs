@@ -21,8 +21,8 @@ use crate::simd::{Lane, Mask, V3, clamp01};
 /// more than this many times the lobe's alpha^2, the map's detail is far
 /// sharper than the lobe, and `prefiltered` shades four normals of the
 /// pixel (the lights and the environment; `sampled`, its environment,
-/// always). The bumpy metal ball against Cycles: 0.130 -> 0.103
-/// (courtyard), 0.130 -> 0.101 (studio) FLIP. In FlightHelmet 0.6% of the
+/// always). The bumpy metal ball against Cycles: 0.130 -> 0.109
+/// (courtyard), 0.130 -> 0.103 (studio) FLIP. In FlightHelmet 0.6% of the
 /// shaded groups take it (16 times alpha^2: 2.4%, with no gain).
 const FAST_TURN: f32 = 64.0;
 /// The least alpha^2 `FAST_TURN` compares with.
