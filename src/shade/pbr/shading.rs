@@ -28,6 +28,22 @@ const FAST_TURN: f32 = 64.0;
 /// The least alpha^2 `FAST_TURN` compares with.
 const MIN_LOBE: f32 = 1e-4;
 
+/// `one` in the lanes `fast` leaves clear; in the others, the mean of
+/// `shade` over the pixel's four normals `ns`. `four`: `(ns, fast)`, or
+/// None for `one` everywhere.
+#[inline(always)]
+fn over_pixel<L: Lane>(
+    four: Option<([V3<L>; 4], L::Mask)>,
+    one: V3<L>,
+    mut shade: impl FnMut(V3<L>) -> V3<L>,
+) -> V3<L> {
+    let Some((ns, fast)) = four else {
+        return one;
+    };
+    let sum = ns.iter().fold(V3::zero(), |sum, &n| sum + shade(n));
+    V3::select(fast, sum.scale(L::splat(0.25)), one)
+}
+
 impl<L: Lane> PbrColor<L> {
     /// Lane `k`'s point alone.
     pub fn at(&self, k: usize) -> PbrColor<f32> {
@@ -383,17 +399,9 @@ impl ShadeContext<'_> {
         let four = spread_normals
             .zip(fast)
             .filter(|_| self.env_sampled.is_none());
-        let direct = self.direct(f, [n, v], &c);
-        let direct = match four {
-            Some((ns, fast)) => {
-                let mean = ns
-                    .iter()
-                    .fold(V3::zero(), |sum, &n| sum + self.direct(f, [n, v], &plain))
-                    .scale(L::splat(0.25));
-                V3::select(fast, mean, direct)
-            }
-            None => direct,
-        };
+        let direct = over_pixel(four, self.direct(f, [n, v], &c), |n| {
+            self.direct(f, [n, v], &plain)
+        });
         if let Some(sampled) = &self.env_sampled {
             let l = V3::from_fn(|k| match &spread_normals {
                 Some(ns) => {
@@ -416,19 +424,10 @@ impl ShadeContext<'_> {
                     geo_normal: &f.geo_normal[..],
                 });
                 let light = environment(env, [n, v], &c, f.ao, traced.as_ref());
-                let light = match four {
-                    Some((ns, fast)) => {
-                        let mean = ns
-                            .iter()
-                            .fold(V3::zero(), |sum, &n| {
-                                sum + environment(env, [n, v], &plain, f.ao, traced.as_ref())
-                            })
-                            .scale(L::splat(0.25));
-                        V3::select(fast, mean, light)
-                    }
-                    None => light,
-                };
-                direct + light
+                direct
+                    + over_pixel(four, light, |n| {
+                        environment(env, [n, v], &plain, f.ao, traced.as_ref())
+                    })
             }
             None => direct,
         }
