@@ -10,7 +10,7 @@ use glam::Vec4;
 
 use super::bin::TileRect;
 use super::setup::{Edge, SUBPIXEL, Tri};
-use crate::simd::{RAMP_LIMIT, ramp4};
+use crate::simd::{RAMP_LIMIT, exact4, ramp4};
 
 /// The standard Direct3D sample positions for 1, 2, 4, 8 and 16 samples:
 /// offsets from the pixel center in 1/16 pixel, x right and y down (the
@@ -261,6 +261,57 @@ pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
     });
 }
 
+/// `raster_samples` for four-sample patterns, the samples side by side:
+/// `visit(px, py, mask, z)` with the four depths as lanes (bit for bit
+/// `raster_samples`' where the mask has them; the others unspecified).
+#[inline]
+pub fn raster_samples4<F: FnMut(i32, i32, u32, Vec4)>(
+    t: &Tri,
+    rect: TileRect,
+    pattern: &[(i8, i8); 4],
+    mut visit: F,
+) {
+    let e = t.edges();
+    debug_assert!(e.iter().all(|e| e.a % SUBPIXEL == 0 && e.b % SUBPIXEL == 0));
+    let off: [[i64; 4]; 3] = std::array::from_fn(|k| {
+        pattern.map(|(ox, oy)| (e[k].a * ox as i64 + e[k].b * oy as i64) / 16)
+    });
+    let reach = off.map(|o| o.into_iter().max().unwrap_or(0));
+    let plane = DepthPlane::new(t, &e);
+    let (z0, dz1, dz2) = (
+        Vec4::splat(plane.z0),
+        Vec4::splat(plane.dz1),
+        Vec4::splat(plane.dz2),
+    );
+    // Below it, a pixel center's edge values plus a sample's offset (at
+    // most half a pixel's step) less the bias stay within `RAMP_LIMIT`.
+    const CENTER_LIMIT: i64 = RAMP_LIMIT / 2;
+    let (b1, b2) = (plane.bias1, plane.bias2);
+    let small = off
+        .iter()
+        .flatten()
+        .chain(&[b1, b2])
+        .all(|v| v.abs() < CENTER_LIMIT);
+    walk(t, &e, rect, reach, |px, py, w| {
+        let at = |k: usize| off[k].map(|o| w[k] + o);
+        let (a, b, c) = (at(0), at(1), at(2));
+        let mut mask = 0u32;
+        for s in 0..4 {
+            mask |= (((a[s] | b[s] | c[s]) >= 0) as u32) << s;
+        }
+        if mask == 0 {
+            return;
+        }
+        let z = if small && w[1].abs() < CENTER_LIMIT && w[2].abs() < CENTER_LIMIT {
+            // `plane.at`, lane by lane, in its order.
+            z0 + exact4(b.map(|v| v - b1)) * dz1 + exact4(c.map(|v| v - b2)) * dz2
+        } else {
+            Vec4::from_array(std::array::from_fn(|s| plane.at(b[s], c[s])))
+        };
+        visit(px, py, mask, z);
+    });
+}
+
 /// Calls `visit(px, py, z)` for every pixel center inside `rect` covered by
 /// `t` (top-left rule), row by row.
 #[inline]
@@ -445,7 +496,7 @@ impl Visibility {
     /// triangle (submission order decides coplanar ties, deterministically).
     #[inline]
     pub fn draw<const REVERSE_Z: bool>(&mut self, t: &Tri, id: u32) {
-        self.draw_if::<REVERSE_Z>(t, id, |_, _, _| true);
+        self.tested::<REVERSE_Z, true>(t, id, |_, _, _| true);
     }
 
     /// As `draw`, for samples that also pass `keep(px, py, offset)` (the
@@ -455,6 +506,18 @@ impl Visibility {
     /// by coverage like triangle edges.
     #[inline]
     pub fn draw_if<const REVERSE_Z: bool>(
+        &mut self,
+        t: &Tri,
+        id: u32,
+        keep: impl FnMut(i32, i32, (i8, i8)) -> bool,
+    ) {
+        self.tested::<REVERSE_Z, false>(t, id, keep);
+    }
+
+    /// `draw_if`; `TESTS_ALL`: `keep` passes every sample (`draw`), which
+    /// lets four samples be tested side by side.
+    #[inline]
+    fn tested<const REVERSE_Z: bool, const TESTS_ALL: bool>(
         &mut self,
         t: &Tri,
         id: u32,
@@ -482,6 +545,27 @@ impl Visibility {
             return;
         }
         let pattern = self.pattern;
+        if let (true, Ok(four)) = (TESTS_ALL, <&[(i8, i8); 4]>::try_from(pattern)) {
+            // Four samples side by side: the depth test of `in_front`,
+            // lane by lane.
+            raster_samples4(t, rect, four, |px, py, mask, z| {
+                let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * 4;
+                let old = Vec4::from_slice(&depth[base..base + 4]);
+                let front = if REVERSE_Z {
+                    z.cmpgt(old)
+                } else {
+                    z.cmplt(old)
+                };
+                let pass = (z.cmpge(Vec4::ZERO) & z.cmple(Vec4::ONE) & front).bitmask() & mask;
+                for s in 0..4 {
+                    if pass & (1 << s) != 0 {
+                        depth[base + s] = z[s];
+                        ids[base + s] = id;
+                    }
+                }
+            });
+            return;
+        }
         raster_samples(t, rect, pattern, |px, py, mask, z| {
             let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * n;
             for (s, &zs) in z.iter().enumerate().take(n) {
@@ -667,6 +751,64 @@ mod tests {
                 assert!(id == NO_TRIANGLE || (lo..hi).contains(&x), "round {round}");
             }
         }
+    }
+
+    /// Four samples side by side (`draw` at four samples) test depth as
+    /// one sample at a time does (`draw_if` passing every sample): the same
+    /// ids and depth bits, over triangles crossing the near and far depths,
+    /// overlapping each other, and drawn twice.
+    #[test]
+    fn four_samples_at_once_equal_one_at_a_time() {
+        let mut rnd = crate::testing::xorshift(0x2f0b_39c1_77e4_d015);
+        const FOUR: &[(i8, i8)] = &[(-2, -6), (6, -2), (-6, 2), (2, 6)];
+        let vp = Viewport {
+            width: 96,
+            height: 64,
+            msaa: true,
+        };
+        let rect = TileRect {
+            x0: 0,
+            y0: 16,
+            x1: 96,
+            y1: 32,
+        };
+        let mut covered = 0;
+        for round in 0..120 {
+            let reverse = round % 2 == 0;
+            let mut tris = Vec::new();
+            for _ in 0..(1 + round % 7) {
+                let (cx, cy) = (rnd() * 2.0 - 1.0, rnd() - 0.5);
+                let s = [0.02, 0.2, 1.0][round % 3] * (0.5 + rnd());
+                let p = [(); 3].map(|_| (rnd() - 0.5, rnd() - 0.5, rnd() * 1.4 - 0.2));
+                let v = |(dx, dy, z): (f32, f32, f32)| ClipVertex {
+                    pos: Vec4::new(cx + dx * s, cy + dy * s, z, 1.0),
+                    bary: Vec3::ZERO,
+                };
+                tris.extend(setup([v(p[0]), v(p[1]), v(p[2])], vp, CullMode::None, 0, 0));
+            }
+            // Coplanar twins: equal depths keep the earlier triangle.
+            if let Some(t) = tris.first() {
+                tris.push(*t);
+            }
+            let (mut four, mut one) = (
+                Visibility::new(rect, reverse, FOUR),
+                Visibility::new(rect, reverse, FOUR),
+            );
+            for (i, t) in tris.iter().enumerate() {
+                if reverse {
+                    four.draw::<true>(t, i as u32);
+                    one.draw_if::<true>(t, i as u32, |_, _, _| true);
+                } else {
+                    four.draw::<false>(t, i as u32);
+                    one.draw_if::<false>(t, i as u32, |_, _, _| true);
+                }
+            }
+            assert_eq!(four.id(), one.id(), "round {round}");
+            let bits = |d: &[f32]| d.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(four.depth()), bits(one.depth()), "round {round}");
+            covered += four.id().iter().filter(|&&id| id != NO_TRIANGLE).count();
+        }
+        assert!(covered > 10_000, "{covered}");
     }
 
     #[test]

@@ -248,19 +248,19 @@ impl Words8 {
     }
 }
 
-/// Whole numbers below which `ramp4` holds (2^51).
+/// Whole numbers below which `exact4` and `ramp4` hold (2^51).
 pub const RAMP_LIMIT: i64 = 1 << 51;
 
-/// `[s, s + step, s + 2 step, s + 3 step]`, each as `v as f32` gives it
-/// (rounded once, to nearest), for values of magnitude below
-/// `RAMP_LIMIT`: each becomes an f64 exactly (its bits added to those of
-/// 2^52 + 2^51, which is then taken away), then one f32 rounding.
+/// `v[k] as f32`, lane by lane (rounded once, to nearest), for values of
+/// magnitude below `RAMP_LIMIT`: each becomes an f64 exactly (its bits
+/// added to those of 2^52 + 2^51, which is then taken away), then one f32
+/// rounding.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub fn ramp4(s: i64, step: i64) -> Vec4 {
+pub fn exact4(v: [i64; 4]) -> Vec4 {
     use std::arch::x86_64::*;
     const MAGIC: f64 = 6_755_399_441_055_744.0; // 2^52 + 2^51
-    debug_assert!([s, s + 3 * step].iter().all(|v| v.abs() < RAMP_LIMIT));
+    debug_assert!(v.iter().all(|v| v.abs() < RAMP_LIMIT));
     // SAFETY: SSE2 only (in every x86-64 target's base features); no
     // memory is touched.
     unsafe {
@@ -270,17 +270,23 @@ pub fn ramp4(s: i64, step: i64) -> Vec4 {
             let v = _mm_add_epi64(_mm_set_epi64x(b, a), mi);
             _mm_cvtpd_ps(_mm_sub_pd(_mm_castsi128_pd(v), m))
         };
-        let lo = exact(s, s + step);
-        let hi = exact(s + 2 * step, s + 3 * step);
+        let lo = exact(v[0], v[1]);
+        let hi = exact(v[2], v[3]);
         Vec4::from(_mm_movelh_ps(lo, hi))
     }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
 #[inline(always)]
+pub fn exact4(v: [i64; 4]) -> Vec4 {
+    Vec4::new(v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32)
+}
+
+/// `[s, s + step, s + 2 step, s + 3 step]`, each as `v as f32` gives it
+/// (`exact4`: magnitudes below `RAMP_LIMIT`).
+#[inline(always)]
 pub fn ramp4(s: i64, step: i64) -> Vec4 {
-    let at = |k: i64| (s + k * step) as f32;
-    Vec4::new(at(0), at(1), at(2), at(3))
+    exact4([s, s + step, s + 2 * step, s + 3 * step])
 }
 
 /// 3-vectors, one per lane of `L` (four by default), as a structure of
