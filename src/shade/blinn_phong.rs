@@ -4,8 +4,10 @@
 //!
 //! with `illum 0`: L = Kd; `illum 1`: no specular term; `illum 2` and up: all
 //! terms. All quantities are linear RGB; textures already multiplied in.
-//! The environment adds Kd E(n) / pi (times AO) plus Ks times the radiance
-//! prefiltered along the reflection with the GGX lobe that matches Ns.
+//! The environment adds Kd E(n) / pi (times AO; under `bounces = 1`, E with
+//! the light bounced off the surfaces around, without AO) plus Ks times the
+//! radiance prefiltered along the reflection with the GGX lobe that matches
+//! Ns.
 //!
 //! Written once over the lane type (`shade::lanes`); Gouraud shading sums
 //! the lights at the vertices with the same code and combines the sums per
@@ -16,6 +18,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::env::dominant_direction_lanes;
+use super::env::reflect::At;
 use super::env::sampled::{self as env_sampled, Lobes};
 use super::lanes::{Lanes, Lit};
 use super::{Fetch, ShadeContext};
@@ -208,7 +211,21 @@ impl ShadeContext<'_> {
                 env_sampled::radiance(sampled, point, v.lane(k), &lobes)
             });
         }
-        let diffuse = (c.kd * env.irradiance_lanes(n)).scale(f.ao / L::splat(PI));
+        // Under `bounces = 1` the diffuse light gathers the surfaces
+        // around, as a pbr material's does; its rays see what hides the
+        // environment, so the AO does not darken that light again.
+        let gathered = self.env_reflections.as_ref().filter(|r| r.bounce);
+        let diffuse = match gathered {
+            Some(with) => {
+                let at = At {
+                    with,
+                    position: f.position,
+                    geo_normal: &f.geo_normal[..],
+                };
+                (c.kd * at.irradiance(env.irradiance_lanes(n), n)).scale(L::splat(1.0 / PI))
+            }
+            None => (c.kd * env.irradiance_lanes(n)).scale(f.ao / L::splat(PI)),
+        };
         let ks = c.ks;
         let no_ks = ks.x.cmpeq(zero) & ks.y.cmpeq(zero) & ks.z.cmpeq(zero);
         if no_ks.all() {

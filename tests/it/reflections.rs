@@ -84,8 +84,9 @@ fn a_mirror_shows_the_wall_its_reflection_meets() {
 /// A white Lambertian floor beside a red Lambertian wall (the wall from
 /// x = 0.5 on, facing -x), under a uniform white environment, seen from
 /// straight above: the linear colour of the pixel at `x` (of 32 across
-/// [-2, 2]) on the floor's middle row.
-fn floor_by_a_wall(name: &str, bounces: u32, x: usize) -> (Vec3, Scene) {
+/// [-2, 2]) on the floor's middle row. `pbr`: metallic-roughness
+/// materials (`Pm`, `Pr`), else Blinn-Phong ones (Kd alone).
+fn floor_by_a_wall(name: &str, bounces: u32, x: usize, pbr: bool) -> (Vec3, Scene) {
     let dir = common::scratch(name);
     std::fs::write(
         dir.join("m.obj"),
@@ -96,12 +97,14 @@ fn floor_by_a_wall(name: &str, bounces: u32, x: usize) -> (Vec3, Scene) {
          usemtl wall\nf 5 6 7 8\n",
     )
     .unwrap();
-    std::fs::write(
-        dir.join("m.mtl"),
+    let mtl = if pbr {
         "newmtl floor\nKd 1 1 1\nPm 0\nPr 1\nPs 0\n\
-         newmtl wall\nKd 1 0 0\nPm 0\nPr 1\n",
-    )
-    .unwrap();
+         newmtl wall\nKd 1 0 0\nPm 0\nPr 1\n"
+    } else {
+        "newmtl floor\nKd 1 1 1\nKs 0 0 0\nillum 1\n\
+         newmtl wall\nKd 1 0 0\nKs 0 0 0\nillum 1\n"
+    };
+    std::fs::write(dir.join("m.mtl"), mtl).unwrap();
     let scene = format!(
         "[output]\nwidth = 32\nheight = 32\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
          [environment]\npreset = \"neutral\"\nemitters = 0\nbounces = {bounces}\n\
@@ -117,28 +120,32 @@ fn floor_by_a_wall(name: &str, bounces: u32, x: usize) -> (Vec3, Scene) {
 
 #[test]
 fn bounced_light_tints_a_floor_by_the_wall_beside_it() {
-    // The view spans x in [-3.5, 0.5]: pixel 31 lies against the wall,
-    // pixel 0 four units from it.
-    let (near0, _) = floor_by_a_wall("bounce_off_near", 0, 31);
-    let (near1, scene) = floor_by_a_wall("bounce_on_near", 1, 31);
-    let (far1, _) = floor_by_a_wall("bounce_on_far", 1, 0);
-    // Without the bounce, the floor sees the whole white sky: grey-white.
-    assert!(
-        (near0.x - near0.y).abs() < 0.01 && (near0.y - near0.z).abs() < 0.01,
-        "no bounce: {near0}"
-    );
-    // With it, at the foot of the wall, the wall fills half the floor's
-    // cosine-weighted hemisphere: green and blue lose half the sky, and
-    // the wall, lit as an open point (radiance: its red albedo times the
-    // sky's 1), gives red back: (1, 0.5, 0.5).
-    assert!(
-        (near1 - Vec3::new(1.0, 0.5, 0.5)).abs().max_element() < 0.05,
-        "bounce, at the wall's foot: {near1}"
-    );
-    // Far from the wall, the floor sees little of it.
-    assert!(
-        (far1 - near0).abs().max_element() < 0.1 && far1.x - far1.y < 0.1,
-        "bounce, far: {far1} against {near0}"
-    );
-    same_at_every_width(&scene, &[0], "a floor's bounced light");
+    for pbr in [true, false] {
+        let kind = if pbr { "pbr" } else { "blinn" };
+        // The view spans x in [-3.5, 0.5]: pixel 31 lies against the wall,
+        // pixel 0 four units from it.
+        let (near0, _) = floor_by_a_wall(&format!("bounce_off_near_{kind}"), 0, 31, pbr);
+        let (near1, scene) = floor_by_a_wall(&format!("bounce_on_near_{kind}"), 1, 31, pbr);
+        let (far1, _) = floor_by_a_wall(&format!("bounce_on_far_{kind}"), 1, 0, pbr);
+        // Without the bounce, the floor sees the whole white sky:
+        // grey-white.
+        assert!(
+            (near0.x - near0.y).abs() < 0.01 && (near0.y - near0.z).abs() < 0.01,
+            "{kind}, no bounce: {near0}"
+        );
+        // With it, at the foot of the wall, the wall fills half the
+        // floor's cosine-weighted hemisphere: green and blue lose half the
+        // sky, and the wall, lit as an open point (radiance: its red
+        // albedo times the sky's 1), gives red back: (1, 0.5, 0.5).
+        assert!(
+            (near1 - Vec3::new(1.0, 0.5, 0.5)).abs().max_element() < 0.05,
+            "{kind}, bounce, at the wall's foot: {near1}"
+        );
+        // Far from the wall, the floor sees little of it.
+        assert!(
+            (far1 - near0).abs().max_element() < 0.1 && far1.x - far1.y < 0.1,
+            "{kind}, bounce, far: {far1} against {near0}"
+        );
+        same_at_every_width(&scene, &[0], "a floor's bounced light");
+    }
 }
