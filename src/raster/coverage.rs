@@ -261,22 +261,35 @@ pub fn raster_samples<F: FnMut(i32, i32, u32, &[f32; MAX_SAMPLES])>(
     });
 }
 
-/// `raster_samples` for four-sample patterns, the samples side by side:
-/// `visit(px, py, mask, z)` with the four depths as lanes (bit for bit
-/// `raster_samples`' where the mask has them; the others unspecified).
+/// `raster_samples` for patterns of `G` groups of four samples (4, 8 or 16
+/// samples), four side by side: `visit(px, py, g, mask, z)` for each group `g` of four
+/// (samples 4g..4g + 4) that covers some sample, with their depths as
+/// lanes (bit for bit `raster_samples`' where the mask has them; the others
+/// unspecified).
 #[inline]
-pub fn raster_samples4<F: FnMut(i32, i32, u32, Vec4)>(
+pub fn raster_samples4<const G: usize, F: FnMut(i32, i32, usize, u32, Vec4)>(
     t: &Tri,
     rect: TileRect,
-    pattern: &[(i8, i8); 4],
+    pattern: &[(i8, i8)],
     mut visit: F,
 ) {
+    let groups = G;
+    debug_assert_eq!(groups * 4, pattern.len(), "{G} groups of four samples");
     let e = t.edges();
     debug_assert!(e.iter().all(|e| e.a % SUBPIXEL == 0 && e.b % SUBPIXEL == 0));
-    let off: [[i64; 4]; 3] = std::array::from_fn(|k| {
-        pattern.map(|(ox, oy)| (e[k].a * ox as i64 + e[k].b * oy as i64) / 16)
-    });
-    let reach = off.map(|o| o.into_iter().max().unwrap_or(0));
+    // Per group and edge, the samples' edge-function offsets from the
+    // pixel center.
+    let mut off = [[[0i64; 4]; 3]; G];
+    for (g, o) in off.iter_mut().enumerate().take(groups) {
+        for (k, ok) in o.iter_mut().enumerate() {
+            for (s, v) in ok.iter_mut().enumerate() {
+                let (ox, oy) = pattern[4 * g + s];
+                *v = (e[k].a * ox as i64 + e[k].b * oy as i64) / 16;
+            }
+        }
+    }
+    let reach: [i64; 3] =
+        std::array::from_fn(|k| off[..groups].iter().flat_map(|o| o[k]).max().unwrap_or(0));
     let plane = DepthPlane::new(t, &e);
     let (z0, dz1, dz2) = (
         Vec4::splat(plane.z0),
@@ -287,28 +300,32 @@ pub fn raster_samples4<F: FnMut(i32, i32, u32, Vec4)>(
     // most half a pixel's step) less the bias stay within `RAMP_LIMIT`.
     const CENTER_LIMIT: i64 = RAMP_LIMIT / 2;
     let (b1, b2) = (plane.bias1, plane.bias2);
-    let small = off
+    let small = off[..groups]
         .iter()
+        .flatten()
         .flatten()
         .chain(&[b1, b2])
         .all(|v| v.abs() < CENTER_LIMIT);
     walk(t, &e, rect, reach, |px, py, w| {
-        let at = |k: usize| off[k].map(|o| w[k] + o);
-        let (a, b, c) = (at(0), at(1), at(2));
-        let mut mask = 0u32;
-        for s in 0..4 {
-            mask |= (((a[s] | b[s] | c[s]) >= 0) as u32) << s;
+        let exact = small && w[1].abs() < CENTER_LIMIT && w[2].abs() < CENTER_LIMIT;
+        for (g, off) in off.iter().enumerate().take(groups) {
+            let at = |k: usize| off[k].map(|o| w[k] + o);
+            let (a, b, c) = (at(0), at(1), at(2));
+            let mut mask = 0u32;
+            for s in 0..4 {
+                mask |= (((a[s] | b[s] | c[s]) >= 0) as u32) << s;
+            }
+            if mask == 0 {
+                continue;
+            }
+            let z = if exact {
+                // `plane.at`, lane by lane, in its order.
+                z0 + exact4(b.map(|v| v - b1)) * dz1 + exact4(c.map(|v| v - b2)) * dz2
+            } else {
+                Vec4::from_array(std::array::from_fn(|s| plane.at(b[s], c[s])))
+            };
+            visit(px, py, g, mask, z);
         }
-        if mask == 0 {
-            return;
-        }
-        let z = if small && w[1].abs() < CENTER_LIMIT && w[2].abs() < CENTER_LIMIT {
-            // `plane.at`, lane by lane, in its order.
-            z0 + exact4(b.map(|v| v - b1)) * dz1 + exact4(c.map(|v| v - b2)) * dz2
-        } else {
-            Vec4::from_array(std::array::from_fn(|s| plane.at(b[s], c[s])))
-        };
-        visit(px, py, mask, z);
     });
 }
 
@@ -384,6 +401,37 @@ pub fn raster_depth_max(t: &Tri, rect: TileRect, d: &mut [f32], stride: usize) {
         row[1] += e[1].b;
         row[2] += e[2].b;
     }
+}
+
+/// The depth test of `in_front` for triangle `id` over every sample of
+/// `rect` it covers, `G` groups of four samples per pixel
+/// (`raster_samples4`), four side by side, into a tile's `(depth, ids)`.
+#[inline]
+fn test_groups<const REVERSE_Z: bool, const G: usize>(
+    t: &Tri,
+    rect: TileRect,
+    pattern: &[(i8, i8)],
+    id: u32,
+    (depth, ids): (&mut [f32], &mut [u32]),
+) {
+    let stride = rect.width();
+    raster_samples4::<G, _>(t, rect, pattern, |px, py, g, mask, z| {
+        let pixel = (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
+        let base = pixel * 4 * G + 4 * g;
+        let old = Vec4::from_slice(&depth[base..base + 4]);
+        let front = if REVERSE_Z {
+            z.cmpgt(old)
+        } else {
+            z.cmplt(old)
+        };
+        let pass = (z.cmpge(Vec4::ZERO) & z.cmple(Vec4::ONE) & front).bitmask() & mask;
+        for s in 0..4 {
+            if pass & (1 << s) != 0 {
+                depth[base + s] = z[s];
+                ids[base + s] = id;
+            }
+        }
+    });
 }
 
 pub const NO_TRIANGLE: u32 = u32::MAX;
@@ -545,26 +593,15 @@ impl Visibility {
             return;
         }
         let pattern = self.pattern;
-        if let (true, Ok(four)) = (TESTS_ALL, <&[(i8, i8); 4]>::try_from(pattern)) {
-            // Four samples side by side: the depth test of `in_front`,
-            // lane by lane.
-            raster_samples4(t, rect, four, |px, py, mask, z| {
-                let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * 4;
-                let old = Vec4::from_slice(&depth[base..base + 4]);
-                let front = if REVERSE_Z {
-                    z.cmpgt(old)
-                } else {
-                    z.cmplt(old)
-                };
-                let pass = (z.cmpge(Vec4::ZERO) & z.cmple(Vec4::ONE) & front).bitmask() & mask;
-                for s in 0..4 {
-                    if pass & (1 << s) != 0 {
-                        depth[base + s] = z[s];
-                        ids[base + s] = id;
-                    }
-                }
-            });
-            return;
+        if TESTS_ALL {
+            // Four samples side by side.
+            let buffers = (&mut depth[..], &mut ids[..]);
+            match n {
+                4 => return test_groups::<REVERSE_Z, 1>(t, rect, pattern, id, buffers),
+                8 => return test_groups::<REVERSE_Z, 2>(t, rect, pattern, id, buffers),
+                16 => return test_groups::<REVERSE_Z, 4>(t, rect, pattern, id, buffers),
+                _ => {}
+            }
         }
         raster_samples(t, rect, pattern, |px, py, mask, z| {
             let base = ((py - rect.y0) as usize * stride + (px - rect.x0) as usize) * n;
@@ -753,14 +790,13 @@ mod tests {
         }
     }
 
-    /// Four samples side by side (`draw` at four samples) test depth as
+    /// Four samples side by side (`draw` at 4, 8 and 16 samples) test depth as
     /// one sample at a time does (`draw_if` passing every sample): the same
     /// ids and depth bits, over triangles crossing the near and far depths,
     /// overlapping each other, and drawn twice.
     #[test]
     fn four_samples_at_once_equal_one_at_a_time() {
         let mut rnd = crate::testing::xorshift(0x2f0b_39c1_77e4_d015);
-        const FOUR: &[(i8, i8)] = &[(-2, -6), (6, -2), (-6, 2), (2, 6)];
         let vp = Viewport {
             width: 96,
             height: 64,
@@ -773,12 +809,13 @@ mod tests {
             y1: 32,
         };
         let mut covered = 0;
-        for round in 0..120 {
+        for round in 0..180 {
             let reverse = round % 2 == 0;
+            let pattern = sample_pattern([4, 8, 16][round % 3]).unwrap_or(&[]);
             let mut tris = Vec::new();
             for _ in 0..(1 + round % 7) {
                 let (cx, cy) = (rnd() * 2.0 - 1.0, rnd() - 0.5);
-                let s = [0.02, 0.2, 1.0][round % 3] * (0.5 + rnd());
+                let s = [0.02, 0.2, 1.0][round / 3 % 3] * (0.5 + rnd());
                 let p = [(); 3].map(|_| (rnd() - 0.5, rnd() - 0.5, rnd() * 1.4 - 0.2));
                 let v = |(dx, dy, z): (f32, f32, f32)| ClipVertex {
                     pos: Vec4::new(cx + dx * s, cy + dy * s, z, 1.0),
@@ -791,8 +828,8 @@ mod tests {
                 tris.push(*t);
             }
             let (mut four, mut one) = (
-                Visibility::new(rect, reverse, FOUR),
-                Visibility::new(rect, reverse, FOUR),
+                Visibility::new(rect, reverse, pattern),
+                Visibility::new(rect, reverse, pattern),
             );
             for (i, t) in tris.iter().enumerate() {
                 if reverse {
@@ -808,7 +845,7 @@ mod tests {
             assert_eq!(bits(four.depth()), bits(one.depth()), "round {round}");
             covered += four.id().iter().filter(|&&id| id != NO_TRIANGLE).count();
         }
-        assert!(covered > 10_000, "{covered}");
+        assert!(covered > 40_000, "{covered}");
     }
 
     #[test]
