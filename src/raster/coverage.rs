@@ -666,6 +666,21 @@ mod tests {
     use crate::raster::setup::{Viewport, setup};
     use glam::{Vec3, Vec4};
 
+    /// A viewport of `size` (multisampled or not) and the tile
+    /// `[x0, y0, x1, y1]` of it.
+    fn frame_and_tile(
+        size: (u32, u32),
+        msaa: bool,
+        [x0, y0, x1, y1]: [i32; 4],
+    ) -> (Viewport, TileRect) {
+        let vp = Viewport {
+            width: size.0,
+            height: size.1,
+            msaa,
+        };
+        (vp, TileRect { x0, y0, x1, y1 })
+    }
+
     #[test]
     fn runs_visit_the_pixels_that_tests_visit() {
         // Pseudo-random triangles of every size and slope, whole and cut
@@ -677,17 +692,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f32 / (1u64 << 53) as f32
         };
-        let vp = Viewport {
-            width: 128,
-            height: 96,
-            msaa: true,
-        };
-        let rect = TileRect {
-            x0: 16,
-            y0: 8,
-            x1: 112,
-            y1: 80,
-        };
+        let (vp, rect) = frame_and_tile((128, 96), true, [16, 8, 112, 80]);
         let mut checked = 0;
         for i in 0..3000 {
             let scale = [0.05f32, 0.3, 1.5][i % 3];
@@ -732,17 +737,7 @@ mod tests {
             .take(40)
             .enumerate()
         {
-            let vp = Viewport {
-                width: 96,
-                height: 64,
-                msaa: pattern.len() > 1,
-            };
-            let rect = TileRect {
-                x0: 0,
-                y0: 16,
-                x1: 96,
-                y1: 32,
-            };
+            let (vp, rect) = frame_and_tile((96, 64), pattern.len() > 1, [0, 16, 96, 32]);
             let reverse = round % 3 == 0;
             let mut tris = Vec::new();
             for _ in 0..(round % 5) {
@@ -797,17 +792,7 @@ mod tests {
     #[test]
     fn four_samples_at_once_equal_one_at_a_time() {
         let mut rnd = crate::testing::xorshift(0x2f0b_39c1_77e4_d015);
-        let vp = Viewport {
-            width: 96,
-            height: 64,
-            msaa: true,
-        };
-        let rect = TileRect {
-            x0: 0,
-            y0: 16,
-            x1: 96,
-            y1: 32,
-        };
+        let (vp, rect) = frame_and_tile((96, 64), true, [0, 16, 96, 32]);
         let mut covered = 0;
         for round in 0..180 {
             let reverse = round % 2 == 0;
@@ -859,17 +844,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f32 / (1u64 << 53) as f32
         };
-        let vp = Viewport {
-            width: 300,
-            height: 200,
-            msaa: false,
-        };
-        let rect = TileRect {
-            x0: 20,
-            y0: 10,
-            x1: 280,
-            y1: 150,
-        };
+        let (vp, rect) = frame_and_tile((300, 200), false, [20, 10, 280, 150]);
         let stride = rect.width();
         let start: Vec<f32> = (0..stride * rect.height()).map(|_| rnd() * 0.5).collect();
         let (mut a, mut b) = (start.clone(), start);
