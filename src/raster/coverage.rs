@@ -685,13 +685,7 @@ mod tests {
     fn runs_visit_the_pixels_that_tests_visit() {
         // Pseudo-random triangles of every size and slope, whole and cut
         // by the tile, with and without MSAA reach.
-        let mut seed = 0x2545_f491_u64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut rnd = crate::testing::xorshift(0x2545_f491);
         let (vp, rect) = frame_and_tile((128, 96), true, [16, 8, 112, 80]);
         let mut checked = 0;
         for i in 0..3000 {
@@ -837,13 +831,7 @@ mod tests {
     fn depth_max_runs_equal_texel_by_texel() {
         // Triangles of every size, some crossing the near and far
         // depths, into a map seeded with depths.
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut rnd = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
         let (vp, rect) = frame_and_tile((300, 200), false, [20, 10, 280, 150]);
         let stride = rect.width();
         let start: Vec<f32> = (0..stride * rect.height()).map(|_| rnd() * 0.5).collect();

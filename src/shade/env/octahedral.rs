@@ -126,13 +126,8 @@ mod tests {
 
     #[test]
     fn directions_round_trip_and_every_width_encodes_as_one() {
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut unit = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
+        let mut next = || unit() * 2.0 - 1.0;
         let mut dirs: Vec<Vec3> = (0..40_000)
             .map(|_| Vec3::new(next(), next(), next()))
             .collect();

@@ -139,13 +139,8 @@ fn rotation_turns_the_environment_counter_clockwise_seen_from_above() {
 /// Directions of every kind: random, on the axes and the poles, signed
 /// zeros, tiny, huge, infinite and NaN components.
 fn directions() -> Vec<Vec3> {
-    let mut s = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-    };
+    let mut unit = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
+    let mut next = || unit() * 2.0 - 1.0;
     let mut out: Vec<Vec3> = (0..20_000)
         .map(|_| Vec3::new(next(), next(), next()))
         .collect();
