@@ -87,6 +87,13 @@ impl Surfaces for FrameSurfaces<'_> {
             roughness: r.roughness,
             transmission: r.transmission,
             emitted: r.emitted,
+            lamp: r.emitted != Vec3::ZERO
+                && self
+                    .setup
+                    .scene
+                    .emitters
+                    .iter()
+                    .any(|p| p.holds(hit.mesh, hit.prim)),
         })
     }
 }

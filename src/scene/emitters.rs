@@ -50,6 +50,10 @@ pub struct Patch {
     pub area: f32,
     /// Linear radiance it emits (two-sided).
     pub radiance: Vec3,
+    /// Its triangles, as indices into the model's mesh, ascending: a
+    /// traced reflection that meets one leaves its emission to the light
+    /// (`Patch::holds`).
+    pub triangles: Vec<u32>,
 }
 
 impl Patch {
@@ -85,6 +89,11 @@ impl Patch {
         }
     }
 
+    /// Whether triangle `prim` of model `model` is part of this piece.
+    pub fn holds(&self, model: usize, prim: u32) -> bool {
+        self.model == model && self.triangles.binary_search(&prim).is_ok()
+    }
+
     fn power(&self) -> f32 {
         luminance(self.radiance) * (self.along + self.around)
     }
@@ -113,7 +122,16 @@ pub fn patches(
             let range = g.triangles.start as usize..g.triangles.end as usize;
             let tris = model.mesh.triangles.get(range).unwrap_or(&[]);
             for piece in pieces(&model.mesh, tris) {
-                all.extend(patch(&model.mesh, &piece, radiance, k));
+                let corners: Vec<[u32; 3]> = piece.iter().map(|&i| tris[i]).collect();
+                all.extend(patch(&model.mesh, &corners, radiance, k).map(|p| {
+                    Patch {
+                        triangles: piece
+                            .iter()
+                            .map(|&i| g.triangles.start + i as u32)
+                            .collect(),
+                        ..p
+                    }
+                }));
             }
         }
     }
@@ -166,12 +184,14 @@ fn patch(mesh: &Mesh, piece: &[[u32; 3]], radiance: Vec3, model: usize) -> Optio
         around,
         area,
         radiance,
+        triangles: Vec::new(),
     })
 }
 
 /// The connected pieces of `tris`: triangles sharing a vertex, or a
-/// vertex position, are one piece. In order of their first triangle.
-fn pieces(mesh: &Mesh, tris: &[[u32; 3]]) -> Vec<Vec<[u32; 3]>> {
+/// vertex position, are one piece. Each piece is its triangles' indices
+/// into `tris`, ascending; the pieces in order of their first triangle.
+fn pieces(mesh: &Mesh, tris: &[[u32; 3]]) -> Vec<Vec<usize>> {
     let mut id: HashMap<[u32; 3], usize> = HashMap::new();
     let mut parent: Vec<usize> = Vec::new();
     let mut node = |i: u32, parent: &mut Vec<usize>| {
@@ -201,14 +221,14 @@ fn pieces(mesh: &Mesh, tris: &[[u32; 3]]) -> Vec<Vec<[u32; 3]>> {
         }
     }
     let mut slot: HashMap<usize, usize> = HashMap::new();
-    let mut out: Vec<Vec<[u32; 3]>> = Vec::new();
-    for (t, n) in tris.iter().zip(&nodes) {
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for (t, n) in nodes.iter().enumerate() {
         let r = root(&mut parent, n[0]);
         let k = *slot.entry(r).or_insert_with(|| {
             out.push(Vec::new());
             out.len() - 1
         });
-        out[k].push(*t);
+        out[k].push(t);
     }
     out
 }
@@ -297,8 +317,8 @@ mod tests {
         tris.extend(other);
         let pieces = pieces(&mesh, &tris);
         // Joined by position, not by index: two pieces of two triangles.
-        assert_eq!(pieces.iter().map(Vec::len).collect::<Vec<_>>(), [2, 2]);
-        let p = patch(&mesh, &pieces[0], Vec3::splat(10.0), 0).unwrap();
+        assert_eq!(pieces, [vec![0, 1], vec![2, 3]]);
+        let p = patch(&mesh, &tris[0..2], Vec3::splat(10.0), 0).unwrap();
         assert!((p.center - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6);
         assert!((p.axis.dot(Vec3::Y).abs() - 1.0).abs() < 1e-6);
         assert!((p.area - 0.25).abs() < 1e-6);
@@ -350,8 +370,8 @@ mod tests {
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect();
         let pieces = pieces(&mesh, &tris);
-        assert_eq!(pieces.len(), 1);
-        assert!(patch(&mesh, &pieces[0], Vec3::ONE, 0).is_none());
+        assert_eq!(pieces, [(0..12).collect::<Vec<_>>()]);
+        assert!(patch(&mesh, &tris, Vec3::ONE, 0).is_none());
         // One face alone is a light.
         assert!(patch(&mesh, &tris[2..4], Vec3::ONE, 0).is_some());
     }

@@ -5,6 +5,7 @@ pub mod agx;
 pub mod ao;
 pub mod blinn_phong;
 pub mod env;
+pub mod ggx;
 pub mod gouraud;
 pub mod iridescence;
 pub mod lanes;

@@ -127,3 +127,40 @@ fn area_lights_are_the_same_at_every_lane_width() {
         crate::widths::same_at_every_width(&scene, &[0], &format!("box under a lamp, {shading}"));
     }
 }
+
+/// A glossy white metal floor (roughness 0.2) with a lamp (side 0.5,
+/// radiance 10, facing down) one up and one to the side, in a black
+/// environment, seen from where the floor mirrors the lamp: the floor's
+/// middle pixel, with `reflections` as given.
+fn lamp_in_a_glossy_floor(name: &str, reflections: bool) -> f32 {
+    let dir = common::scratch(name);
+    let obj = "mtllib m.mtl\n\
+         v -5 0 -5\nv 5 0 -5\nv 5 0 5\nv -5 0 5\n\
+         v -1.25 1 -0.25\nv -0.75 1 -0.25\nv -0.75 1 0.25\nv -1.25 1 0.25\n\
+         usemtl floor\nf 4 3 2 1\n\
+         usemtl lamp\nf 5 6 7 8\n";
+    let mtl = "newmtl floor\nKd 1 1 1\nPm 1\nPr 0.2\n\
+         newmtl lamp\nKd 0 0 0\nKe 10 10 10\nPm 0\nPr 1\n";
+    let scene = format!(
+        "[output]\nwidth = 16\nheight = 16\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
+         [environment]\npreset = \"neutral\"\nintensity = 0.0\nreflections = {reflections}\n\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\neye = [1.0, 1.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         projection = \"orthographic\"\nheight = 0.05\n"
+    );
+    let s = common::scene_in(&dir, &scene, &[("m.obj", obj), ("m.mtl", mtl)]);
+    assert_eq!(s.emitters.len(), 1);
+    let c = render_frame(&s, 0, 0).color[8 * 16 + 8];
+    (c.x + c.y + c.z) / 3.0
+}
+
+#[test]
+fn a_traced_reflection_leaves_a_lamp_to_its_area_light() {
+    // The area light's highlight shows the lamp in the floor. A traced
+    // reflection that meets the lamp must not add its emission again
+    // (it did: 18.2 against the highlight's 8.2).
+    let off = lamp_in_a_glossy_floor("lamp_floor_plain", false);
+    let on = lamp_in_a_glossy_floor("lamp_floor_traced", true);
+    assert!(off > 1.0, "the highlight: {off}");
+    assert!((on - off).abs() < 0.05 * off, "traced {on} against {off}");
+}

@@ -53,6 +53,10 @@ pub struct Bounce {
     /// The light it emits (counted only where a refracted ray sees it:
     /// `Scene::seen`).
     pub emitted: Vec3,
+    /// Its emission lights the scene as an area light already
+    /// (`environment.emitters`): a traced reflection leaves it to the
+    /// light's highlight.
+    pub lamp: bool,
 }
 
 /// The frame's surfaces, as a ray meets them.
@@ -198,6 +202,7 @@ mod tests {
                 roughness: 1.0,
                 transmission: 0.0,
                 emitted: Vec3::ZERO,
+                lamp: false,
             })
         }
     }

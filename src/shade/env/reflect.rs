@@ -40,6 +40,7 @@ use super::pattern::{point, position_hash};
 use crate::raytrace::Tracer;
 use crate::scene::light::{Light, LightKind};
 use crate::shade::ao::cosine_direction;
+use crate::shade::ggx::{MIN_ALPHA, d_vis};
 use crate::shade::light::incidence;
 use crate::simd::{Lane, V3};
 
@@ -143,6 +144,7 @@ impl Reflections<'_> {
     /// reflects (`met`); None where it leaves the scene.
     fn incoming(&self, o: Vec3, d: Vec3) -> Option<Vec3> {
         Some(match self.met(o, d)? {
+            Some(b) if b.lamp => self.lit(&b, -d, self.bounce),
             Some(b) => self.lit(&b, -d, self.bounce) + b.emitted,
             None => Vec3::ZERO,
         })
@@ -175,18 +177,20 @@ impl Reflections<'_> {
         let ndv = n.dot(wo).clamp(1e-4, 1.0);
         let o = b.position + b.geometric * self.tracer.epsilon;
         let mut diffuse_light = env.irradiance(n) / std::f32::consts::PI;
+        let mut glossy = Vec3::ZERO;
         for light in self.lights {
             if let Some(i) = incidence(light, b.position) {
                 let cos = n.dot(i.l);
                 if cos > 0.0 && (!shadowed || self.reaches(light, o, i.l)) {
                     diffuse_light += i.e * (cos / std::f32::consts::PI);
+                    glossy += i.e * cos * highlight(b, light, wo, i.l);
                 }
             }
         }
         let mirror = n * (2.0 * n.dot(wo)) - wo;
         let ab = env.brdf(ndv, b.roughness);
         let specular = env.prefiltered(mirror, b.roughness) * (b.specular * ab.x + ab.y);
-        b.diffuse * diffuse_light + specular
+        b.diffuse * diffuse_light + specular + glossy
     }
 
     /// Whether `light` reaches `o` (already off its surface) along unit
@@ -202,5 +206,87 @@ impl Reflections<'_> {
             LightKind::Directional { .. } => f32::INFINITY,
         };
         self.tracer.transmittance(o, l, t_max) > 0.5
+    }
+}
+
+/// The specular lobe's f(wo, l) of surface `b` for `light` from unit `l`:
+/// GGX with Schlick's Fresnel from its specular colour, widened by the
+/// disc the light is seen as (a light taken out of the image, an
+/// emitter's area), as the shaded points' own highlights are
+/// (`PbrColor::widened`). The prefiltered levels no longer hold the
+/// image's lamps and sky patches: without it a metal met by a reflection
+/// ray showed none of them.
+fn highlight(b: &Bounce, light: &Light, wo: Vec3, l: Vec3) -> Vec3 {
+    let alpha = (b.roughness * b.roughness).max(MIN_ALPHA);
+    let widen = match light.kind {
+        LightKind::Directional { angle, .. } => (0.5 * angle.tan()).powi(2),
+        LightKind::Area {
+            position, radius, ..
+        } => (0.5 * radius / (position - b.position).length().max(1e-6)).powi(2),
+        _ => 0.0,
+    };
+    let a2 = (alpha * alpha + widen).min(1.0);
+    let h = (l + wo).normalize_or_zero();
+    let fresnel = b.specular + (Vec3::ONE - b.specular) * (1.0 - wo.dot(h).abs()).powi(5);
+    let dv = d_vis::<f32>(b.normal.into(), wo.into(), h.into(), b.normal.dot(l), a2);
+    fresnel * dv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn white_metal(roughness: f32) -> Bounce {
+        Bounce {
+            position: Vec3::ZERO,
+            normal: Vec3::Y,
+            geometric: Vec3::Y,
+            diffuse: Vec3::ZERO,
+            specular: Vec3::ONE,
+            roughness,
+            transmission: 0.0,
+            emitted: Vec3::ZERO,
+            lamp: false,
+        }
+    }
+
+    fn sun(angle: f32) -> Light {
+        Light {
+            kind: LightKind::Directional {
+                direction: -Vec3::Y,
+                irradiance: 1.0,
+                angle,
+            },
+            color: Vec3::ONE,
+            shadows: false,
+            range: None,
+        }
+    }
+
+    #[test]
+    fn a_met_surface_shows_a_light_s_highlight_widened_by_its_disc() {
+        // Light and view along the normal: D(1) Vis = 1 / (pi a^2) / 4,
+        // times Fresnel 1 (white metal).
+        let b = white_metal(0.5);
+        let a2 = 0.5f32.powi(4);
+        let peak = highlight(&b, &sun(0.0), Vec3::Y, Vec3::Y);
+        let expect = 1.0 / (4.0 * std::f32::consts::PI * a2);
+        assert!(
+            (peak - Vec3::splat(expect)).abs().max_element() < 1e-4 * expect,
+            "{peak}"
+        );
+        // A light seen as a disc (one taken out of the image) widens the
+        // lobe: a lower peak, alpha^2 + (tan(angle) / 2)^2.
+        let angle = 0.3f32;
+        let wide = highlight(&b, &sun(angle), Vec3::Y, Vec3::Y);
+        let a2w = a2 + (0.5 * angle.tan()).powi(2);
+        let expect = 1.0 / (4.0 * std::f32::consts::PI * a2w);
+        assert!(
+            (wide - Vec3::splat(expect)).abs().max_element() < 1e-4 * expect,
+            "{wide}"
+        );
+        // Away from the mirror direction it falls off.
+        let aside = Vec3::new(0.6, 0.8, 0.0);
+        assert!(highlight(&b, &sun(0.0), aside, Vec3::Y).x < 0.2 * peak.x);
     }
 }

@@ -62,15 +62,12 @@ use glam::Vec3;
 
 use super::env::reflect::At;
 use super::env::{EnvLight, dominant_direction_lanes};
+pub use super::ggx::{MIN_ALPHA, d_vis};
 pub use super::sheen::Sheen;
 use crate::simd::{Lane, MAX_WIDTH, Mask, V3, clamp01};
 
 /// The coat's reflectance at normal incidence (ior 1.5).
 pub const COAT_F0: f32 = 0.04;
-
-/// Smallest alpha: a perfect mirror would make D a delta that point lights
-/// never hit; this keeps a tiny, finite highlight.
-pub const MIN_ALPHA: f32 = 2e-3;
 
 /// Specular anti-aliasing (`PbrColor::widen`): the variance of the pixel
 /// filter (sigma^2) and the most the kernel adds to alpha^2 (kappa).
@@ -467,21 +464,6 @@ pub fn f_cos<L: Lane>(n: V3<L>, v: V3<L>, l: V3<L>, ndl: L, c: &PbrColor<L>) -> 
         Some(coat) => base.scale(L::splat(1.0) - coat.weight(v)) + splat3(coat.f_cos(v, l)),
         None => base,
     }
-}
-
-/// GGX's D times the separable Smith visibility for n.l = `ndl` > 0 and
-/// half vector `h`, per lane.
-#[inline(always)]
-pub fn d_vis<L: Lane>(n: V3<L>, v: V3<L>, h: V3<L>, ndl: L, a2: L) -> L {
-    let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let ndv = n.dot(v).abs().max(L::splat(1e-4));
-    let ndh = n.dot(h);
-    let t = ndh * ndh * (a2 - one) + one;
-    let d = L::select(ndh.cmpgt(zero), a2 / (L::splat(PI) * t * t), zero);
-    let vis = one
-        / ((ndl + (a2 + (one - a2) * ndl * ndl).sqrt())
-            * (ndv + (a2 + (one - a2) * ndv * ndv).sqrt()));
-    d * vis
 }
 
 /// Specular albedo under uniform light for reflectance `f0`, from the

@@ -28,20 +28,27 @@ const FAST_TURN: f32 = 64.0;
 /// The least alpha^2 `FAST_TURN` compares with.
 const MIN_LOBE: f32 = 1e-4;
 
-/// `one` in the lanes `fast` leaves clear; in the others, the mean of
+/// `one()` in the lanes `fast` leaves clear; in the others, the mean of
 /// `shade` over the pixel's four normals `ns`. `four`: `(ns, fast)`, or
-/// None for `one` everywhere.
+/// None for `one()` everywhere. Where every lane is fast, `one` is not
+/// shaded at all.
 #[inline(always)]
 fn over_pixel<L: Lane>(
     four: Option<([V3<L>; 4], L::Mask)>,
-    one: V3<L>,
+    one: impl FnOnce() -> V3<L>,
     mut shade: impl FnMut(V3<L>) -> V3<L>,
 ) -> V3<L> {
     let Some((ns, fast)) = four else {
-        return one;
+        return one();
     };
-    let sum = ns.iter().fold(V3::zero(), |sum, &n| sum + shade(n));
-    V3::select(fast, sum.scale(L::splat(0.25)), one)
+    let mean = ns
+        .iter()
+        .fold(V3::zero(), |sum, &n| sum + shade(n))
+        .scale(L::splat(0.25));
+    if fast.all() {
+        return mean;
+    }
+    V3::select(fast, mean, one())
 }
 
 impl<L: Lane> PbrColor<L> {
@@ -399,9 +406,11 @@ impl ShadeContext<'_> {
         let four = spread_normals
             .zip(fast)
             .filter(|_| self.env_sampled.is_none());
-        let direct = over_pixel(four, self.direct(f, [n, v], &c), |n| {
-            self.direct(f, [n, v], &plain)
-        });
+        let direct = over_pixel(
+            four,
+            || self.direct(f, [n, v], &c),
+            |n| self.direct(f, [n, v], &plain),
+        );
         if let Some(sampled) = &self.env_sampled {
             let l = V3::from_fn(|k| match &spread_normals {
                 Some(ns) => {
@@ -423,7 +432,7 @@ impl ShadeContext<'_> {
                     position: f.position,
                     geo_normal: &f.geo_normal[..],
                 });
-                let light = environment(env, [n, v], &c, f.ao, traced.as_ref());
+                let light = || environment(env, [n, v], &c, f.ao, traced.as_ref());
                 direct
                     + over_pixel(four, light, |n| {
                         environment(env, [n, v], &plain, f.ao, traced.as_ref())
