@@ -21,10 +21,12 @@
 //! A surface met is lit as the prefiltered method lights an open point:
 //! its Lambertian colour times the irradiance E(n) / pi and the scene's
 //! lights (the lights taken out of the image among them), its specular
-//! colour times the split sum along its own mirror direction, and (for
-//! the reflections) its emission. With the bounce on, the lights are
-//! tested for shadow at the point met (the CornellBox in the studio
-//! against Cycles, eight rays: 0.121 unshadowed, 0.106 shadowed); without
+//! colour times the split sum along its own mirror direction plus each
+//! light's highlight (`highlight`), and (for the reflections) its
+//! emission, unless it is one of the emitters, whose area light's
+//! highlight shows it already (`Bounce::lamp`). With the bounce on, the
+//! lights are tested for shadow at the point met (the CornellBox in the
+//! studio against Cycles, eight rays: 0.121 unshadowed, 0.106 shadowed); without
 //! it the reflections light their surfaces unshadowed, which measured
 //! closer to Cycles where nothing else brings the walls' light (the
 //! CornellBox 0.180 against 0.183). The bounce leaves out the emission
