@@ -29,6 +29,7 @@ mod aovs;
 mod backdrop;
 mod band;
 mod bounce;
+mod bounce_pass;
 pub mod display;
 mod draw_list;
 mod emitters;
@@ -571,6 +572,8 @@ impl<'s> Renderer<'s> {
                     light: env,
                 });
         let (mirror, bounce) = self.traced_env();
+        // The bounce pass's result, once it ran (`bands`).
+        let screen = std::sync::OnceLock::new();
         ctx.env_reflections = match (env, tracer.as_ref()) {
             (Some(light), Some(tracer)) if mirror || bounce => Some(Reflections {
                 tracer,
@@ -579,6 +582,7 @@ impl<'s> Renderer<'s> {
                 lights: &setup.lights,
                 mirror,
                 bounce,
+                screen: bounce.then_some(&screen),
             }),
             _ => None,
         };
@@ -684,7 +688,9 @@ impl<'s> Renderer<'s> {
             show(color, plain, bytes);
             None
         };
-        let later: Vec<_> = if data.setup.scene.settings.ao.method == AoMethod::Off {
+        let ao_on = data.setup.scene.settings.ao.method != AoMethod::Off;
+        let bounce_pass = data.ctx.env_reflections.is_some_and(|r| r.screen.is_some());
+        let later: Vec<_> = if !ao_on && !bounce_pass {
             out.ao.clear();
             let chunks = aov_chunks(&mut out.aov, band, bands);
             out.color
@@ -703,8 +709,9 @@ impl<'s> Renderer<'s> {
                 })
                 .collect()
         } else {
-            // With ambient occlusion: visibility and the geometry buffer
-            // of every band, the AO of the whole frame, then shading.
+            // With ambient occlusion or the bounce pass: visibility and
+            // the geometry buffer of every band, the AO and the bounce of
+            // the whole frame, then shading.
             let mut gbuf = vec![GPixel::EMPTY; out.color.len()];
             let visible: Vec<_> = gbuf
                 .par_chunks_mut(band)
@@ -715,12 +722,17 @@ impl<'s> Renderer<'s> {
                     (vis, blended)
                 })
                 .collect();
-            out.ao = ao_pass::occlusion(data.setup, &gbuf, out.width, out.height, tracer);
+            whole_frame_passes(data, &gbuf, tracer, out);
+            let ao_chunks: Vec<Option<&[f32]>> = if ao_on {
+                out.ao.chunks(band).map(Some).collect()
+            } else {
+                vec![None; bands]
+            };
             let chunks = aov_chunks(&mut out.aov, band, bands);
             out.color
                 .par_chunks_mut(band)
                 .zip(out.depth.par_chunks_mut(band))
-                .zip(out.ao.par_chunks(band))
+                .zip(ao_chunks)
                 .zip(visible)
                 .zip(chunks)
                 .zip(bytes.par_iter_mut())
@@ -729,7 +741,7 @@ impl<'s> Renderer<'s> {
                     if !aov.is_empty() {
                         data.aovs(&visible.0, aov);
                     }
-                    first(visible, Some(ao), known, (color, depth), bytes)
+                    first(visible, ao, known, (color, depth), bytes)
                 })
                 .collect()
         };
@@ -790,6 +802,33 @@ impl<'s> Renderer<'s> {
 /// A mesh's object-space BVH and bounds.
 fn bvh_of(m: &Mesh) -> (Bvh, (Vec3, Vec3)) {
     (Bvh::build(&m.positions, &m.triangles), m.bounds())
+}
+
+/// The passes over the whole frame's geometry buffer `gbuf` before
+/// shading: its AO into `out.ao` (empty without AO), and the bounce into
+/// the slot the shading reads it from (`bounce_pass`).
+fn whole_frame_passes(
+    data: &fragment::BandInputs,
+    gbuf: &[GPixel],
+    tracer: Option<&Tracer>,
+    out: &mut Frame,
+) {
+    if data.setup.scene.settings.ao.method != AoMethod::Off {
+        out.ao = ao_pass::occlusion(data.setup, gbuf, out.width, out.height, tracer);
+    } else {
+        out.ao.clear();
+    }
+    let screen = data
+        .ctx
+        .env_reflections
+        .as_ref()
+        .and_then(|r| r.screen.map(|s| (r, s)));
+    if let Some((with, slot)) = screen {
+        let size = (out.width, out.height);
+        let camera = (data.ctx.eye, data.ctx.forward);
+        // One `bands` call per frame's inputs: set here only.
+        let _ = slot.set(bounce_pass::bounce(data.setup, with, gbuf, size, camera));
+    }
 }
 
 /// The data-pass buffer in band-sized chunks, or an empty chunk per band

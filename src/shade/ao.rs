@@ -355,9 +355,37 @@ pub fn gtao_raw(g: &[GPixel], view: &AoView, radius: f32, samples: u32) -> Vec<f
 /// 1/(1+p^2)^2 with p the neighbor's distance from the pixel's tangent plane
 /// in pixel footprints, times the squared cosine between the normals.
 fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
-    const TENT: [f32; 5] = [1.0, 2.0, 2.0, 2.0, 1.0];
+    edge_aware_blur(g, view, raw, (&[1.0, 2.0, 2.0, 2.0, 1.0], 1), None, 1.0)
+}
+
+/// `raw` (a value per pixel of `g`) averaged over the square `tent` (its
+/// weights along one axis, an odd count) whose taps lie `step` pixels
+/// apart, weighted by how near each tap lies to the
+/// centre's tangent plane (in footprints of `step` pixels) and how well
+/// their normals agree: it does not cross depth edges or creases. With
+/// `reach` (per pixel, a world distance), a tap also counts less the
+/// farther it lies from the centre beyond the centre's reach. Pixels where
+/// nothing was drawn take `empty` and are not read.
+pub fn edge_aware_blur<T>(
+    g: &[GPixel],
+    view: &AoView,
+    raw: &[T],
+    (tent, step): (&[f32], i32),
+    reach: Option<&[f32]>,
+    empty: T,
+) -> Vec<T>
+where
+    T: Copy
+        + Default
+        + Send
+        + Sync
+        + std::ops::Add<Output = T>
+        + std::ops::Mul<f32, Output = T>
+        + std::ops::Div<f32, Output = T>,
+{
     let (w, h) = (view.width as i32, view.height as i32);
-    let mut out = vec![1.0f32; raw.len()];
+    let half = (tent.len() / 2) as i32;
+    let mut out = vec![empty; raw.len()];
     out.par_chunks_mut(w as usize)
         .enumerate()
         .for_each(|(y, row)| {
@@ -368,16 +396,17 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
                 if !c.depth.is_finite() {
                     continue;
                 }
-                let px = view.pixel_size(c.depth);
-                let mut sum = 0.0;
+                let px = view.pixel_size(c.depth) * step as f32;
+                let inv_reach = reach.map_or(0.0, |r| 1.0 / r[(y * w + x) as usize]);
+                let mut sum = T::default();
                 let mut wsum = 0.0;
-                for (j, wy) in TENT.iter().enumerate() {
-                    let sy = y + j as i32 - 2;
+                for (j, wy) in tent.iter().enumerate() {
+                    let sy = y + (j as i32 - half) * step;
                     if sy < 0 || sy >= h {
                         continue;
                     }
-                    for (i, wx) in TENT.iter().enumerate() {
-                        let sx = x + i as i32 - 2;
+                    for (i, wx) in tent.iter().enumerate() {
+                        let sx = x + (i as i32 - half) * step;
                         if sx < 0 || sx >= w {
                             continue;
                         }
@@ -391,8 +420,12 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
                         let plane = c.normal.dot(s.position - c.position).abs() / px;
                         let agree = c.normal.dot(s.normal).max(0.0);
                         let fall = 1.0 / (1.0 + plane * plane);
-                        let wt = wx * wy * fall * fall * agree * agree;
-                        sum += wt * raw[k];
+                        let mut wt = wx * wy * fall * fall * agree * agree;
+                        if reach.is_some() {
+                            let far = (s.position - c.position).length() * inv_reach;
+                            wt /= 1.0 + far * far;
+                        }
+                        sum = sum + raw[k] * wt;
                         wsum += wt;
                     }
                 }

@@ -16,7 +16,10 @@
 //! - **Bounced light.** `GATHER_RAYS` cosine-weighted rays per point; the
 //!   irradiance is the environment's E(n), less what the rays that meet a
 //!   surface would have brought from it (E along the ray, a smooth
-//!   stand-in for its radiance), plus what those surfaces send back.
+//!   stand-in for its radiance), plus what those surfaces send back. The
+//!   frame casts them once per pixel before shading and filters what they
+//!   change (`BounceScreen`, from `render::bounce_pass`); a point off its
+//!   pixel's surface casts its own.
 //!
 //! A surface met is lit as the prefiltered method lights an open point:
 //! its Lambertian colour times the irradiance E(n) / pi and the scene's
@@ -34,7 +37,9 @@
 //! a surface sends to `bounce::INDIRECT_CLAMP`, as the sampled bounce
 //! does.
 
-use glam::Vec3;
+use std::sync::OnceLock;
+
+use glam::{Mat4, Vec3};
 
 use super::EnvLight;
 use super::bounce::{Bounce, Surfaces, clamped};
@@ -64,6 +69,65 @@ pub struct Reflections<'a> {
     pub mirror: bool,
     /// Gather light bounced once.
     pub bounce: bool,
+    /// Where the frame gathers the bounce per pixel before shading (the
+    /// bounce pass, `render::bounce_pass`), filled once the pass ran;
+    /// the points it shows read it, the others gather their own.
+    pub screen: Option<&'a OnceLock<BounceScreen>>,
+}
+
+/// The light bounced once, gathered at every pixel's surface and
+/// filtered across the surface (`ao::edge_aware_blur`): four rays a point
+/// are grain, which a path tracer's denoiser removes and one pixel's own
+/// rays cannot.
+pub struct BounceScreen {
+    pub width: usize,
+    pub height: usize,
+    /// Per pixel: the filtered irradiance change (what the gathering rays
+    /// bring, less the environment's irradiance they stand in for).
+    pub delta: Vec<Vec3>,
+    /// Per pixel: its surface's view depth (+inf: nothing) and unit
+    /// geometric normal, facing the camera.
+    pub depth: Vec<f32>,
+    pub geo_normal: Vec<Vec3>,
+    pub clip_from_world: Mat4,
+    pub eye: Vec3,
+    pub forward: Vec3,
+}
+
+/// What the gathering rays at a point found.
+struct Gathered {
+    /// What the surfaces they meet send back, times pi / `GATHER_RAYS`.
+    met: Vec3,
+    /// The environment's irradiance E along those that meet a surface,
+    /// over `GATHER_RAYS`.
+    hidden: Vec3,
+    /// The summed distance to the surfaces met that could be read, and
+    /// their count.
+    distance: f32,
+    hits: u32,
+}
+
+impl BounceScreen {
+    /// The change at world point `p` with unit geometric normal `ng`
+    /// (either side), where `p` lies on the surface its pixel shows (its
+    /// view depth within 1%, the triangles' planes within 37 degrees);
+    /// None elsewhere.
+    pub fn at(&self, p: Vec3, ng: Vec3) -> Option<Vec3> {
+        let clip = self.clip_from_world * p.extend(1.0);
+        if clip.w <= 1e-6 {
+            return None;
+        }
+        let (nx, ny) = (clip.x / clip.w, clip.y / clip.w);
+        let x = (nx * 0.5 + 0.5) * self.width as f32;
+        let y = (0.5 - ny * 0.5) * self.height as f32;
+        if !(x >= 0.0 && y >= 0.0 && x < self.width as f32 && y < self.height as f32) {
+            return None;
+        }
+        let i = y as usize * self.width + x as usize;
+        let depth = (p - self.eye).dot(self.forward);
+        let near = (depth - self.depth[i]).abs() <= 0.01 * self.depth[i];
+        (near && ng.dot(self.geo_normal[i]).abs() > 0.8).then(|| self.delta[i])
+    }
 }
 
 /// The traced light at a group of points: their positions and geometric
@@ -94,7 +158,14 @@ impl<L: Lane> At<'_, L> {
         if !self.with.bounce {
             return e;
         }
-        self.with.gather(self.position, self.geo_normal, n, e)
+        let screen = self.with.screen.and_then(OnceLock::get);
+        V3::from_fn(|k| {
+            let (p, nk, ek) = (self.position.lane(k), n.lane(k), e.lane(k));
+            match screen.and_then(|s| s.at(p, self.geo_normal[k])) {
+                Some(delta) => (ek + delta).max(Vec3::ZERO),
+                None => self.with.gather(p, self.geo_normal[k], nk, ek),
+            }
+        })
     }
 }
 
@@ -112,34 +183,58 @@ impl Reflections<'_> {
         })
     }
 
-    /// Per lane: irradiance `e` at `p` about unit `n`, less E along each
-    /// gathering ray that meets a surface, plus pi / `GATHER_RAYS` times
-    /// what that surface sends back.
-    pub fn gather<L: Lane>(&self, p: V3<L>, ng: &[Vec3], n: V3<L>, e: V3<L>) -> V3<L> {
-        V3::from_fn(|k| {
-            let (pk, nk) = (p.lane(k), n.lane(k));
-            let g = ng[k];
-            let off = if g.dot(nk) < 0.0 { -g } else { g };
-            let o = pk + off * self.tracer.epsilon;
-            let (shift, pair) = (position_hash(pk), nk.any_orthonormal_pair());
-            let (mut met, mut hidden) = (Vec3::ZERO, Vec3::ZERO);
-            for i in 0..GATHER_RAYS {
-                let xi = point(i, GATHER_RAYS, shift);
-                let d = cosine_direction(nk, pair, (xi.x, xi.y));
-                if d.dot(off) <= 0.0 {
-                    continue;
-                }
-                let Some(b) = self.met(o, d) else {
-                    continue;
-                };
-                hidden += self.light.irradiance(d);
-                if let Some(b) = b {
-                    met += clamped(self.lit(&b, -d, true));
-                }
+    /// Irradiance `e` at `p` about unit `n` (`ng`: the geometric normal),
+    /// less E along each gathering ray that meets a surface, plus pi /
+    /// `GATHER_RAYS` times what that surface sends back.
+    pub fn gather(&self, p: Vec3, ng: Vec3, n: Vec3, e: Vec3) -> Vec3 {
+        let g = self.gathered(p, ng, n);
+        (e - g.hidden).max(Vec3::ZERO) + g.met
+    }
+
+    /// What `gather` changes at `p` (what the rays bring less the
+    /// environment's irradiance they stand in for, before the clamp at
+    /// zero), and the mean distance to the surfaces they meet (+inf where
+    /// they meet none): the change varies over about that distance.
+    pub fn gathered_change(&self, p: Vec3, ng: Vec3, n: Vec3) -> (Vec3, f32) {
+        let g = self.gathered(p, ng, n);
+        let reach = if g.hits > 0 {
+            g.distance / g.hits as f32
+        } else {
+            f32::INFINITY
+        };
+        (g.met - g.hidden, reach)
+    }
+
+    /// The gathering rays at `p` about unit `n`.
+    fn gathered(&self, p: Vec3, ng: Vec3, n: Vec3) -> Gathered {
+        let off = if ng.dot(n) < 0.0 { -ng } else { ng };
+        let o = p + off * self.tracer.epsilon;
+        let (shift, pair) = (position_hash(p), n.any_orthonormal_pair());
+        let (mut met, mut hidden) = (Vec3::ZERO, Vec3::ZERO);
+        let (mut distance, mut hits) = (0.0, 0);
+        for i in 0..GATHER_RAYS {
+            let xi = point(i, GATHER_RAYS, shift);
+            let d = cosine_direction(n, pair, (xi.x, xi.y));
+            if d.dot(off) <= 0.0 {
+                continue;
             }
-            let rays = GATHER_RAYS as f32;
-            (e.lane(k) - hidden / rays).max(Vec3::ZERO) + met * (std::f32::consts::PI / rays)
-        })
+            let Some(b) = self.met(o, d) else {
+                continue;
+            };
+            hidden += self.light.irradiance(d);
+            if let Some(b) = b {
+                met += clamped(self.lit(&b, -d, true));
+                distance += (b.position - o).length();
+                hits += 1;
+            }
+        }
+        let rays = GATHER_RAYS as f32;
+        Gathered {
+            met: met * (std::f32::consts::PI / rays),
+            hidden: hidden / rays,
+            distance,
+            hits,
+        }
     }
 
     /// The radiance along the ray `o + t d` from the first surface that

@@ -279,3 +279,56 @@ fn a_phong_level_reads_as_the_two_levels_it_blends() {
         );
     }
 }
+
+/// The lobe-weighted mean the prefilter estimates (weight (n.l) D(h),
+/// n = v = `axis`), by quadrature about the axis: of a sky of radiance 1
+/// with a dark cap of half-angle `cap` around the axis.
+fn dark_cap_truth(roughness: f32, cap: f32) -> f32 {
+    let a2 = (roughness * roughness).powi(2) as f64;
+    let (mut lit, mut all) = (0.0f64, 0.0f64);
+    let m = 20_000;
+    for i in 0..m {
+        // l at angle t from the axis; h halfway, at t / 2.
+        let t = (i as f64 + 0.5) / m as f64 * std::f64::consts::FRAC_PI_2;
+        let c = (t / 2.0).cos();
+        let q = c * c * (a2 - 1.0) + 1.0;
+        let w = t.cos() * a2 / (q * q) * t.sin();
+        all += w;
+        if t > f64::from(cap) {
+            lit += w;
+        }
+    }
+    (lit / all) as f32
+}
+
+#[test]
+fn the_prefiltered_levels_do_not_bleed_a_bright_sky_into_a_dark_cap() {
+    // Filtered importance sampling with its customary one level of extra
+    // blur read 0.138 here at roughness 0.2 against 0.074, 0.451 at 0.35
+    // against 0.416; without it 0.094 and 0.429.
+    let (w, h) = (512u32, 256u32);
+    let axis = -Vec3::Z;
+    let cap = 15f32.to_radians();
+    let texels = (0..w * h)
+        .map(|i| {
+            let uv = Vec2::new(
+                ((i % w) as f32 + 0.5) / w as f32,
+                ((i / w) as f32 + 0.5) / h as f32,
+            );
+            if uv_to_direction(uv).dot(axis) > cap.cos() {
+                Vec3::ZERO
+            } else {
+                Vec3::ONE
+            }
+        })
+        .collect();
+    let env = EnvLight::new(&EnvImage::new(w, h, texels).unwrap(), 1.0, 0.0);
+    for (rough, most) in [(0.2, 0.03), (0.35, 0.02), (0.5, 0.01)] {
+        let truth = dark_cap_truth(rough, cap);
+        let got = env.prefiltered(axis, rough).x;
+        assert!(
+            (got - truth).abs() < most,
+            "roughness {rough}: {got} against {truth}"
+        );
+    }
+}
