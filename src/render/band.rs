@@ -144,7 +144,23 @@ impl<'a> BandInputs<'a> {
                 position: p.position,
                 normal: p.normal,
                 geo_normal: p.geo_normal,
+                roughness: self.roughness_factor(t.draw as usize),
             };
+        }
+    }
+
+    /// The perceptual roughness of draw `draw`'s material where it is one
+    /// factor for the whole surface (shaded as metallic-roughness, no
+    /// roughness map); -1 otherwise.
+    fn roughness_factor(&self, draw: usize) -> f32 {
+        let d = self.draws[draw];
+        let m = &self.setup.scene.models[d.model].materials[d.material];
+        let p = &m.pbr;
+        let mapped = p.metallic_roughness_map.is_some() || p.roughness_map.is_some();
+        if self.ctx.shades_pbr(m) && !mapped {
+            p.roughness.clamp(0.0, 1.0)
+        } else {
+            -1.0
         }
     }
 

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 use super::draw_list::DrawList;
 use crate::shade::ao::{AoView, GPixel, edge_aware_blur};
-use crate::shade::env::reflect::{BounceScreen, Reflections};
+use crate::shade::env::reflect::{BounceScreen, GLOSSY_FROM, Reflections};
 
 /// The filter's weights along each axis, and the steps of its passes in
 /// pixels: 36 taps a pixel, 31 pixels wide (the CornellBox under the
@@ -33,30 +33,94 @@ pub(super) fn bounce(
     setup: &DrawList,
     with: &Reflections,
     gbuf: &[GPixel],
-    (width, height): (u32, u32),
-    (eye, forward): (Vec3, Vec3),
+    size: (u32, u32),
+    camera: (Vec3, Vec3),
 ) -> BounceScreen {
+    let raw = per_pixel(gbuf, size.0, |g| {
+        with.gathered_change(g.position, g.geo_normal, g.normal)
+    });
+    filtered(setup, gbuf, size, camera, raw)
+}
+
+/// The rough reflections' pass: at every other pixel of `gbuf` (`width`
+/// x `height`) in each direction whose material has one roughness factor
+/// of at least `GLOSSY_FROM`, what `GLOSSY_RAYS` rays over its lobe
+/// change in the prefiltered light (`Reflections::reflected_change`),
+/// filtered across the surface as the bounce is, on the half-size grid
+/// (a rough lobe's reflection changes slowly across the surface; at full
+/// size the filter cost three times the CornellBox's rays); `view`: the
+/// unit vector from a point towards the eye. The other pixels are left
+/// out of the filter and show nothing.
+pub(super) fn glossy(
+    setup: &DrawList,
+    with: &Reflections,
+    gbuf: &[GPixel],
+    (width, height): (u32, u32),
+    (camera, view): ((Vec3, Vec3), &(dyn Fn(Vec3) -> Vec3 + Sync)),
+) -> BounceScreen {
+    let (w, h) = (width as usize, height as usize);
+    let half = (w.div_ceil(2), h.div_ceil(2));
+    let rough: Vec<GPixel> = (0..half.0 * half.1)
+        .map(|i| {
+            let g = &gbuf[(i / half.0) * 2 * w + (i % half.0) * 2];
+            if g.roughness >= GLOSSY_FROM {
+                *g
+            } else {
+                GPixel::EMPTY
+            }
+        })
+        .collect();
+    let raw = per_pixel(&rough, half.0 as u32, |g| {
+        let normals = [g.geo_normal, g.normal, view(g.position)];
+        with.reflected_change(g.position, normals, g.roughness)
+    });
+    let size = (half.0 as u32, half.1 as u32);
+    let mut screen = filtered(setup, &rough, size, camera, raw);
+    screen.position = rough.iter().map(|g| g.position).collect();
+    screen
+}
+
+/// `f` of every drawn pixel of `gbuf` (rows of `width`); (0, +inf)
+/// elsewhere.
+fn per_pixel(
+    gbuf: &[GPixel],
+    width: u32,
+    f: impl Fn(&GPixel) -> (Vec3, f32) + Sync,
+) -> Vec<(Vec3, f32)> {
     let w = width as usize;
     let mut raw = vec![(Vec3::ZERO, f32::INFINITY); gbuf.len()];
     raw.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
             let g = &gbuf[y * w + x];
             if g.depth.is_finite() {
-                *o = with.gathered_change(g.position, g.geo_normal, g.normal);
+                *o = f(g);
             }
         }
     });
+    raw
+}
+
+/// The changes and reaches `raw` of the pixels of `gbuf`, filtered
+/// (`TENT` at `STEPS`), as the screen shading reads them.
+fn filtered(
+    setup: &DrawList,
+    gbuf: &[GPixel],
+    (width, height): (u32, u32),
+    (eye, forward): (Vec3, Vec3),
+    raw: Vec<(Vec3, f32)>,
+) -> BounceScreen {
     let (delta, reach): (Vec<Vec3>, Vec<f32>) = raw.into_iter().unzip();
     let view = AoView::new(&setup.camera, width, height);
     let delta = STEPS.iter().fold(delta, |d, &step| {
         edge_aware_blur(gbuf, &view, &d, (&TENT, step), Some(&reach), Vec3::ZERO)
     });
     BounceScreen {
-        width: w,
+        width: width as usize,
         height: height as usize,
         delta,
         depth: gbuf.iter().map(|g| g.depth).collect(),
         geo_normal: gbuf.iter().map(|g| g.geo_normal).collect(),
+        position: Vec::new(),
         clip_from_world: setup.clip_from_world,
         eye,
         forward,

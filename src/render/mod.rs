@@ -74,7 +74,7 @@ use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
 use crate::shade::env::bounce::Surfaces;
 use crate::shade::env::emitters::Emitters;
-use crate::shade::env::reflect::Reflections;
+use crate::shade::env::reflect::{GLOSSY_FROM, Reflections};
 use crate::shade::env::sampled::{EnvSampler, Sampled};
 use crate::shade::refraction::{self, OpaqueFrame};
 use crate::shade::shadow::Shadows;
@@ -433,6 +433,24 @@ impl<'s> Renderer<'s> {
             .map_or((false, false), |e| (e.reflections, e.bounce))
     }
 
+    /// Whether some material is shaded as metallic-roughness with one
+    /// roughness factor of at least `GLOSSY_FROM` (no roughness map): the
+    /// rough reflections' pass has pixels to trace.
+    fn has_rough_factor_materials(&self) -> bool {
+        let mode = self.scene.settings.shading;
+        self.scene
+            .models
+            .iter()
+            .flat_map(|m| &m.materials)
+            .any(|m| {
+                let p = &m.pbr;
+                crate::shade::shades_pbr(mode, m)
+                    && p.metallic_roughness_map.is_none()
+                    && p.roughness_map.is_none()
+                    && p.roughness >= GLOSSY_FROM
+            })
+    }
+
     fn traces_rays(&self, lights: &[Light]) -> bool {
         let s = &self.scene.settings;
         (s.shadows == ShadowMethod::Raytraced && lights.iter().any(|l| l.shadows))
@@ -572,8 +590,11 @@ impl<'s> Renderer<'s> {
                     light: env,
                 });
         let (mirror, bounce) = self.traced_env();
-        // The bounce pass's result, once it ran (`bands`).
+        // The bounce pass's and the rough reflections' pass's results,
+        // once they ran (`bands`).
         let screen = std::sync::OnceLock::new();
+        let glossy_screen = std::sync::OnceLock::new();
+        let glossy = mirror && self.has_rough_factor_materials();
         ctx.env_reflections = match (env, tracer.as_ref()) {
             (Some(light), Some(tracer)) if mirror || bounce => Some(Reflections {
                 tracer,
@@ -583,6 +604,7 @@ impl<'s> Renderer<'s> {
                 mirror,
                 bounce,
                 screen: bounce.then_some(&screen),
+                glossy: glossy.then_some(&glossy_screen),
             }),
             _ => None,
         };
@@ -689,7 +711,7 @@ impl<'s> Renderer<'s> {
             None
         };
         let ao_on = data.setup.scene.settings.ao.method != AoMethod::Off;
-        let bounce_pass = data.ctx.env_reflections.is_some_and(|r| r.screen.is_some());
+        let bounce_pass = data.ctx.env_reflections.is_some_and(|r| r.has_passes());
         let later: Vec<_> = if !ao_on && !bounce_pass {
             out.ao.clear();
             let chunks = aov_chunks(&mut out.aov, band, bands);
@@ -823,11 +845,21 @@ fn whole_frame_passes(
         .env_reflections
         .as_ref()
         .and_then(|r| r.screen.map(|s| (r, s)));
+    let size = (out.width, out.height);
+    let camera = (data.ctx.eye, data.ctx.forward);
     if let Some((with, slot)) = screen {
-        let size = (out.width, out.height);
-        let camera = (data.ctx.eye, data.ctx.forward);
         // One `bands` call per frame's inputs: set here only.
         let _ = slot.set(bounce_pass::bounce(data.setup, with, gbuf, size, camera));
+    }
+    let glossy = data
+        .ctx
+        .env_reflections
+        .as_ref()
+        .and_then(|r| r.glossy.map(|s| (r, s)));
+    if let Some((with, slot)) = glossy {
+        let view = |p: Vec3| data.ctx.view_vector(p);
+        let pass = bounce_pass::glossy(data.setup, with, gbuf, size, (camera, &view));
+        let _ = slot.set(pass);
     }
 }
 

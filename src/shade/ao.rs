@@ -36,6 +36,10 @@ pub struct GPixel {
     pub normal: Vec3,
     /// Unit normal of the triangle's plane, facing the camera.
     pub geo_normal: Vec3,
+    /// The specular lobe's perceptual roughness where the material's is
+    /// one factor (metallic-roughness without a roughness map); -1 where
+    /// it is not known here.
+    pub roughness: f32,
 }
 
 impl GPixel {
@@ -44,6 +48,7 @@ impl GPixel {
         position: Vec3::ZERO,
         normal: Vec3::Z,
         geo_normal: Vec3::Z,
+        roughness: -1.0,
     };
 }
 
@@ -503,6 +508,7 @@ mod tests {
                     position: world,
                     normal: Vec3::Y,
                     geo_normal: Vec3::Y,
+                    roughness: -1.0,
                 };
             }
         }

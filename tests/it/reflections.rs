@@ -1,8 +1,9 @@
 //! Traced reflections under the prefiltered environment
 //! (`environment.reflections`): a mirror shows the surface its dominant
 //! direction meets, not the environment behind it, whatever its
-//! roughness; a lobe whose dominant direction misses the wall keeps the
-//! environment; light bounced once (`environment.bounces = 1`) tints a
+//! roughness below `GLOSSY_FROM`; a rougher lobe shows the wall over the
+//! share of the lobe it fills, and the edge of what it meets as a
+//! gradient (the rough reflections' pass); light bounced once (`environment.bounces = 1`) tints a
 //! floor by the wall beside it; every lane width gives the same bytes.
 
 use glam::Vec3;
@@ -66,19 +67,84 @@ fn a_mirror_shows_the_wall_its_reflection_meets() {
     // same picture.
     let (no, _) = mirror_floor("reflect_no", 0.0, "reflections = false\n");
     assert_eq!(no, off);
-    // A lobe of roughness 1 reads along the normal (the dominant
-    // direction), which misses the wall: the environment.
+    // A rough lobe (from `GLOSSY_FROM`, 0.3) is traced over its width by
+    // the rough reflections' pass: the part of it the wall fills shows
+    // the wall's red, the rest the white environment. At roughness 1 the
+    // lobe spreads over the hemisphere, about half of which (the half
+    // behind the point) the tall, wide wall fills.
     let (rough_on, _) = mirror_floor("reflect_rough_on", 1.0, "reflections = true\n");
     let (rough_off, _) = mirror_floor("reflect_rough_off", 1.0, "");
-    assert_eq!(rough_on, rough_off);
-    // Half way, the dominant direction still meets the wall: its red
-    // replaces the environment, times the lobe's (lower) albedo.
-    let (half, _) = mirror_floor("reflect_half", 0.5, "reflections = true\n");
+    let kept = rough_on.y / rough_off.y;
     assert!(
-        half.x > 1.0 && half.x < on.x && half.y < 0.03,
-        "roughness 0.5: {half}"
+        rough_on.x > rough_off.x && kept > 0.3 && kept < 0.7,
+        "roughness 1: {rough_on} against {rough_off} untraced"
+    );
+    // Half way, the wall fills most of the lobe: mostly its red, some
+    // of the environment's white, times the lobe's (lower) albedo.
+    let (half, _) = mirror_floor("reflect_half", 0.5, "reflections = true\n");
+    let (half_off, _) = mirror_floor("reflect_half_off", 0.5, "");
+    assert!(
+        half.x > 1.0 && half.x < on.x && half.y < 0.5 * half_off.y,
+        "roughness 0.5: {half} against {half_off} untraced"
     );
     same_at_every_width(&scene, &[0], "a mirror floor's traced reflection");
+}
+
+/// A metal floor (white, roughness 0.5) seen in perspective, with a low
+/// wall (1 high, black, emitting nothing) across it behind the point
+/// looked at, under a uniform white environment: the green of the
+/// middle column of 48 pixels, from the top.
+fn rough_floor_by_a_low_wall(name: &str) -> (Vec<f32>, Scene) {
+    let dir = common::scratch(name);
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\n\
+         v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\n\
+         v -4 0 -1\nv 4 0 -1\nv 4 1 -1\nv -4 1 -1\n\
+         usemtl floor\nf 4 3 2 1\n\
+         usemtl wall\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl floor\nKd 1 1 1\nPm 1\nPr 0.5\n\
+         newmtl wall\nKd 0 0 0\nKs 0 0 0\nPm 0\nPr 1\n",
+    )
+    .unwrap();
+    let scene = "[output]\nwidth = 48\nheight = 48\n[render]\ntonemap = \"clamp\"\n\
+         exposure = 0.0\n[environment]\npreset = \"neutral\"\nemitters = 0\nreflections = true\n\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\neye = [0.0, 1.2, 2.5]\ntarget = [0.0, 0.0, 0.0]\nfov = 40.0\n";
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    let s = Scene::load(&dir.join("s.toml"), &Default::default()).unwrap();
+    let frame = render_frame(&s, 0, 0);
+    let column = (0..48).map(|y| frame.color[y * 48 + 24].y).collect();
+    (column, s)
+}
+
+#[test]
+fn a_rough_floor_reflects_a_wall_s_edge_as_a_gradient() {
+    // Down the floor towards the camera, the wall fills less and less of
+    // the lobe of roughness 0.5: the reflection brightens from the
+    // wall's black to the environment's white. One ray along the
+    // dominant direction drew that as a step of one pixel (the first
+    // pixel whose ray clears the wall's top); the lobe's rays, filtered,
+    // spread it over many.
+    let (column, scene) = rough_floor_by_a_low_wall("reflect_rough_edge");
+    // The floor's rows below the wall's foot.
+    let floor: Vec<f32> = column.into_iter().filter(|g| g.is_finite()).collect();
+    let lo = floor.iter().copied().fold(f32::MAX, f32::min);
+    let hi = floor.iter().copied().fold(f32::MIN, f32::max);
+    let step = floor
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f32::max);
+    assert!(hi - lo > 0.1, "the wall shows in the floor: {floor:?}");
+    assert!(
+        step < 0.25 * (hi - lo),
+        "largest step {step} of a range {lo}..{hi}: {floor:?}"
+    );
+    same_at_every_width(&scene, &[0], "a rough floor's reflection pass");
 }
 
 /// A white Lambertian floor beside a red Lambertian wall (the wall from

@@ -49,12 +49,25 @@ use crate::scene::light::{Light, LightKind};
 use crate::shade::ao::cosine_direction;
 use crate::shade::ggx::{MIN_ALPHA, d_vis};
 use crate::shade::light::incidence;
-use crate::simd::{Lane, V3};
+use crate::simd::{Lane, Mask, V3};
 
 /// Rays per shaded point of the bounced light (the CornellBox under the
 /// studio HDRI against Cycles: 1: 0.121, 2: 0.113, 4: 0.109, 8: 0.108,
 /// 16: 0.107).
 pub const GATHER_RAYS: u32 = 4;
+
+/// Rays per pixel of the rough reflections' pass (`reflected_change`),
+/// drawn over the lobe.
+pub const GLOSSY_RAYS: u32 = 8;
+
+/// The perceptual roughness from which a point of a material with one
+/// roughness factor reads its reflection from the rough reflections'
+/// pass (`Reflections::glossy`) instead of one ray along the lobe's
+/// dominant direction: one ray draws the edge of what it meets as a hard
+/// line across a lobe that is wide. On the Cycles set (`docs/cycles.md`)
+/// lobes of 0.15 and 0.25 (the iridescent and the specular-ior spheres,
+/// which mirror each other) came out closer with their one ray.
+pub const GLOSSY_FROM: f32 = 0.3;
 
 /// What the traced light reads: the frame's rays and surfaces, the
 /// prefiltered environment and the scene's lights, and which of the two
@@ -73,6 +86,12 @@ pub struct Reflections<'a> {
     /// bounce pass, `render::bounce_pass`), filled once the pass ran;
     /// the points it shows read it, the others gather their own.
     pub screen: Option<&'a OnceLock<BounceScreen>>,
+    /// Where the frame traces the rough lobes' reflections per pixel
+    /// before shading (`render::bounce_pass::glossy`), filled once the
+    /// pass ran: what they change in the prefiltered light, filtered
+    /// across the surface, for the points it shows whose roughness is
+    /// at least `GLOSSY_FROM`; the others trace their one ray.
+    pub glossy: Option<&'a OnceLock<BounceScreen>>,
 }
 
 /// The light bounced once, gathered at every pixel's surface and
@@ -89,6 +108,11 @@ pub struct BounceScreen {
     /// geometric normal, facing the camera.
     pub depth: Vec<f32>,
     pub geo_normal: Vec<Vec3>,
+    /// Per pixel of a grid coarser than the frame's (the rough
+    /// reflections' pass): its sample's position, whose tangent plane a
+    /// point must lie on; empty on the frame's own grid, where the view
+    /// depth is checked.
+    pub position: Vec<Vec3>,
     pub clip_from_world: Mat4,
     pub eye: Vec3,
     pub forward: Vec3,
@@ -123,10 +147,30 @@ impl BounceScreen {
         if !(x >= 0.0 && y >= 0.0 && x < self.width as f32 && y < self.height as f32) {
             return None;
         }
-        let i = y as usize * self.width + x as usize;
+        let (x, y) = (x as usize, y as usize);
         let depth = (p - self.eye).dot(self.forward);
-        let near = (depth - self.depth[i]).abs() <= 0.01 * self.depth[i];
-        (near && ng.dot(self.geo_normal[i]).abs() > 0.8).then(|| self.delta[i])
+        let on = |i: usize| {
+            let d = self.depth[i];
+            let near = if self.position.is_empty() {
+                (depth - d).abs() <= 0.01 * d
+            } else {
+                d.is_finite() && (p - self.position[i]).dot(self.geo_normal[i]).abs() <= 0.01 * d
+            };
+            near && ng.dot(self.geo_normal[i]).abs() > 0.8
+        };
+        if self.position.is_empty() {
+            let i = y * self.width + x;
+            return on(i).then(|| self.delta[i]);
+        }
+        // On the coarser grid a point lies between the samples of its
+        // cell and of the cells after it: the first on its surface.
+        [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .into_iter()
+            .map(|(dx, dy)| (x + dx, y + dy))
+            .filter(|&(x, y)| x < self.width && y < self.height)
+            .map(|(x, y)| y * self.width + x)
+            .find(|&i| on(i))
+            .map(|i| self.delta[i])
     }
 }
 
@@ -140,14 +184,37 @@ pub struct At<'a, L: Lane> {
 }
 
 impl<L: Lane> At<'_, L> {
-    /// `light` (the prefiltered environment along `r`), replaced by what
-    /// a ray along `r` meets where it meets a surface.
+    /// `light` (the prefiltered environment along `r`, for lobes of
+    /// perceptual `roughness`), replaced by what a ray along `r` meets
+    /// where it meets a surface; a lobe at least `GLOSSY_FROM` rough, at a
+    /// point the rough reflections' pass shows, takes the pass's filtered
+    /// change instead.
     #[inline]
-    pub fn blend(&self, light: V3<L>, r: V3<L>) -> V3<L> {
+    pub fn blend(&self, light: V3<L>, r: V3<L>, roughness: L) -> V3<L> {
         if !self.with.mirror {
             return light;
         }
-        self.with.along(self.position, self.geo_normal, r, light)
+        let glossy = self.with.glossy.and_then(OnceLock::get);
+        let rough = roughness.cmpge(L::splat(GLOSSY_FROM));
+        let Some(screen) = glossy.filter(|_| rough.any()) else {
+            return self.with.along(self.position, self.geo_normal, r, light);
+        };
+        let mut out = light;
+        let mut own = false;
+        let mut changed = [None; crate::simd::MAX_WIDTH];
+        for (k, c) in changed.iter_mut().enumerate().take(L::WIDTH) {
+            if roughness.lane(k) >= GLOSSY_FROM {
+                *c = screen.at(self.position.lane(k), self.geo_normal[k]);
+            }
+            own |= c.is_none();
+        }
+        if own {
+            out = self.with.along(self.position, self.geo_normal, r, light);
+        }
+        V3::from_fn(|k| match changed[k] {
+            Some(delta) => (light.lane(k) + delta).max(Vec3::ZERO),
+            None => out.lane(k),
+        })
     }
 
     /// The irradiance `e` (the environment's, about unit normals `n`)
@@ -170,6 +237,12 @@ impl<L: Lane> At<'_, L> {
 }
 
 impl Reflections<'_> {
+    /// Whether the frame runs a pass over its geometry buffer for them
+    /// (the bounce, the rough reflections) before shading.
+    pub fn has_passes(&self) -> bool {
+        self.screen.is_some() || self.glossy.is_some()
+    }
+
     /// Per lane: the radiance arriving at `p` along unit `r` from the
     /// surface the ray meets, or `open` where it meets nothing. `ng`: the
     /// geometric normals, toward the viewer (the rays' offset).
@@ -203,6 +276,59 @@ impl Reflections<'_> {
             f32::INFINITY
         };
         (g.met - g.hidden, reach)
+    }
+
+    /// What `GLOSSY_RAYS` rays over the GGX lobe of perceptual
+    /// `roughness` about unit `n`, seen from unit `v` (towards the
+    /// viewer), change at `p` in the prefiltered environment's light: per
+    /// ray that meets a surface, its radiance less the environment's
+    /// along it (prefiltered at `roughness`), weighted by n.l, over the
+    /// rays' weights; and the mean distance to the surfaces they meet
+    /// (+inf where they meet none). `ng`: the geometric normal.
+    pub fn reflected_change(&self, p: Vec3, [ng, n, v]: [Vec3; 3], roughness: f32) -> (Vec3, f32) {
+        let off = if ng.dot(v) < 0.0 { -ng } else { ng };
+        let o = p + off * self.tracer.epsilon;
+        let a2 = (roughness * roughness).max(MIN_ALPHA).powi(2);
+        let (shift, (tx, ty)) = (position_hash(p), n.any_orthonormal_pair());
+        let (mut change, mut weight) = (Vec3::ZERO, 0.0);
+        let (mut distance, mut hits) = (0.0, 0);
+        for i in 0..GLOSSY_RAYS {
+            let xi = point(i, GLOSSY_RAYS, shift);
+            // A GGX half vector: cos^2 = (1 - u) / (1 + (a^2 - 1) u).
+            let cos2 = (1.0 - xi.x) / (1.0 + (a2 - 1.0) * xi.x);
+            let (cos, sin) = (cos2.sqrt(), (1.0 - cos2).max(0.0).sqrt());
+            let phi = std::f32::consts::TAU * xi.y;
+            let h = tx * (sin * phi.cos()) + ty * (sin * phi.sin()) + n * cos;
+            let l = h * (2.0 * v.dot(h)) - v;
+            let ndl = n.dot(l);
+            if ndl <= 0.0 || l.dot(off) <= 0.0 {
+                continue;
+            }
+            weight += ndl;
+            let Some(b) = self.met(o, l) else {
+                continue;
+            };
+            let open = self.light.prefiltered(l, roughness);
+            let sent = match b {
+                Some(b) => {
+                    distance += (b.position - o).length();
+                    hits += 1;
+                    let lit = self.lit(&b, -l, self.bounce);
+                    if b.lamp { lit } else { lit + b.emitted }
+                }
+                None => Vec3::ZERO,
+            };
+            change += (sent - open) * ndl;
+        }
+        if weight <= 0.0 {
+            return (Vec3::ZERO, f32::INFINITY);
+        }
+        let reach = if hits > 0 {
+            distance / hits as f32
+        } else {
+            f32::INFINITY
+        };
+        (change / weight, reach)
     }
 
     /// The gathering rays at `p` about unit `n`.

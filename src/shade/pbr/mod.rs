@@ -545,7 +545,9 @@ pub fn environment<L: Lane>(
         V3::from_fn(|k| env.prefiltered(r.lane(k), rough.lane(k)))
     };
     if let Some(t) = traced {
-        light = t.blend(light, r);
+        // The coat's one ray (the rough reflections' pass traces the
+        // base's lobe).
+        light = t.blend(light, r, L::splat(0.0));
     }
     let layer = light.scale((L::splat(COAT_F0) * a + b) * so);
     base.scale(L::splat(1.0) - coat.weight(v)) + layer.scale(coat.factor * c.occlusion)
@@ -586,7 +588,7 @@ fn base_environment<L: Lane>(
     let r = dominant_direction_lanes(nr, r, c.roughness);
     let mut light = V3::from_fn(|k| env.prefiltered(r.lane(k), c.roughness.lane(k)));
     if let Some(t) = traced {
-        light = t.blend(light, r);
+        light = t.blend(light, r, c.roughness);
     }
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
     let specular = (light * spec).scale(so);
