@@ -155,13 +155,7 @@ impl<'a> BandInputs<'a> {
     fn roughness_factor(&self, draw: usize) -> f32 {
         let d = self.draws[draw];
         let m = &self.setup.scene.models[d.model].materials[d.material];
-        let p = &m.pbr;
-        let mapped = p.metallic_roughness_map.is_some() || p.roughness_map.is_some();
-        if self.ctx.shades_pbr(m) && !mapped {
-            p.roughness.clamp(0.0, 1.0)
-        } else {
-            -1.0
-        }
+        crate::shade::env::reflect::pass_roughness(self.ctx.mode, m).unwrap_or(-1.0)
     }
 
     #[inline]

@@ -74,7 +74,7 @@ use crate::shade::ao::GPixel;
 use crate::shade::env::EnvLight;
 use crate::shade::env::bounce::Surfaces;
 use crate::shade::env::emitters::Emitters;
-use crate::shade::env::reflect::{GLOSSY_FROM, Reflections};
+use crate::shade::env::reflect::{GLOSSY_FROM, Reflections, pass_roughness};
 use crate::shade::env::sampled::{EnvSampler, Sampled};
 use crate::shade::refraction::{self, OpaqueFrame};
 use crate::shade::shadow::Shadows;
@@ -442,13 +442,7 @@ impl<'s> Renderer<'s> {
             .models
             .iter()
             .flat_map(|m| &m.materials)
-            .any(|m| {
-                let p = &m.pbr;
-                crate::shade::shades_pbr(mode, m)
-                    && p.metallic_roughness_map.is_none()
-                    && p.roughness_map.is_none()
-                    && p.roughness >= GLOSSY_FROM
-            })
+            .any(|m| pass_roughness(mode, m).is_some_and(|r| r >= GLOSSY_FROM))
     }
 
     fn traces_rays(&self, lights: &[Light]) -> bool {

@@ -69,6 +69,19 @@ pub const GLOSSY_RAYS: u32 = 8;
 /// which mirror each other) came out closer with their one ray.
 pub const GLOSSY_FROM: f32 = 0.3;
 
+/// The roughness the rough reflections' pass traces for material `m`
+/// (shaded in `mode`): its perceptual roughness factor, clamped to 0..1,
+/// where it is shaded as metallic-roughness without a roughness map;
+/// None elsewhere (the pass reads no textures).
+pub fn pass_roughness(
+    mode: crate::scene::settings::ShadingMode,
+    m: &crate::scene::Material,
+) -> Option<f32> {
+    let p = &m.pbr;
+    let mapped = p.metallic_roughness_map.is_some() || p.roughness_map.is_some();
+    (crate::shade::shades_pbr(mode, m) && !mapped).then(|| p.roughness.clamp(0.0, 1.0))
+}
+
 /// What the traced light reads: the frame's rays and surfaces, the
 /// prefiltered environment and the scene's lights, and which of the two
 /// it traces.
