@@ -16,7 +16,11 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::draw_list::DrawList;
-use crate::shade::ao::{AoView, GPixel, edge_aware_blur};
+use super::rays::CameraRays;
+use crate::raytrace::Tracer;
+use crate::shade::ao::{AoView, GPixel, cosine_direction, edge_aware_blur};
+use crate::shade::env::bounce::Surfaces;
+use crate::shade::env::pattern::{point, position_hash};
 use crate::shade::env::reflect::{BounceScreen, GLOSSY_FROM, Reflections};
 
 /// The filter's weights along each axis, and the steps of its passes in
@@ -26,9 +30,10 @@ use crate::shade::env::reflect::{BounceScreen, GLOSSY_FROM, Reflections};
 const TENT: [f32; 3] = [1.0, 2.0, 1.0];
 const STEPS: [i32; 4] = [1, 2, 4, 8];
 
-/// The bounce of every pixel of `gbuf` (`width` x `height`), gathered by
-/// `with` and filtered; `(eye, forward)`: the camera's position and unit
-/// view axis.
+/// The bounce at the pixels of `gbuf` (`width` x `height`; every other
+/// one in each direction where the frame's shorter side has at least
+/// twice `HALF_FROM` pixels), gathered by `with` and filtered;
+/// `(eye, forward)`: the camera's position and unit view axis.
 pub(super) fn bounce(
     setup: &DrawList,
     with: &Reflections,
@@ -36,24 +41,50 @@ pub(super) fn bounce(
     size: (u32, u32),
     camera: (Vec3, Vec3),
 ) -> BounceScreen {
-    let raw = per_pixel(gbuf, size.0, |g| {
+    let (points, grid, coarse) = samples(gbuf, size, |_| true);
+    let raw = per_pixel(&points, grid.0, |g| {
         with.gathered_change(g.position, g.geo_normal, g.normal)
     });
-    filtered(setup, gbuf, size, camera, raw)
+    let mut screen = filtered(setup, &points, grid, camera, raw);
+    if coarse {
+        screen.position = points.iter().map(|g| g.position).collect();
+    }
+    screen
 }
 
-/// The shorter side, in samples, from which the rough reflections' pass
-/// takes every other pixel: a frame of 160x120 on a grid of 80x60 lost
-/// the lower discs' gradients (the anisotropy discs against Cycles,
-/// 0.123 -> 0.137 FLIP), while at 700x700 the full grid's filter
-/// doubled the CornellBox's frame.
-const GLOSSY_HALF_FROM: usize = 240;
+/// The shorter side, in samples, from which the passes take every other
+/// pixel. The rough reflections' pass on a frame of 160x120, on a grid
+/// of 80x60, lost the lower discs' gradients (the anisotropy discs
+/// against Cycles, 0.123 -> 0.137 FLIP), while at 700x700 the full
+/// grid's filter doubled the CornellBox's frame; the bounce at 700x700
+/// took 0.6 s a frame on every pixel, TODO on every other one.
+const HALF_FROM: usize = 240;
+
+/// The pixels of `gbuf` (`width` x `height`) a pass samples: every one,
+/// or every other one in each direction where the shorter side has at
+/// least twice `HALF_FROM`; those `keep` refuses are left empty. With the
+/// grid's size, and whether it is the coarser one.
+fn samples(
+    gbuf: &[GPixel],
+    (width, height): (u32, u32),
+    keep: impl Fn(&GPixel) -> bool,
+) -> (Vec<GPixel>, (u32, u32), bool) {
+    let (w, h) = (width as usize, height as usize);
+    let step = if w.min(h) >= 2 * HALF_FROM { 2 } else { 1 };
+    let grid = (w.div_ceil(step), h.div_ceil(step));
+    let points = (0..grid.0 * grid.1)
+        .map(|i| {
+            let g = &gbuf[(i / grid.0) * step * w + (i % grid.0) * step];
+            if keep(g) { *g } else { GPixel::EMPTY }
+        })
+        .collect();
+    (points, (grid.0 as u32, grid.1 as u32), step > 1)
+}
 
 /// The rough reflections' pass: at the pixels of `gbuf` (`width` x
-/// `height`) whose material has one roughness factor of at least
-/// `GLOSSY_FROM` (every other one in each direction where the frame's
-/// shorter side has at least twice `GLOSSY_HALF_FROM` pixels), what
-/// `GLOSSY_RAYS` rays over its lobe change in the prefiltered light
+/// `height`, sampled as `samples` does) whose material has one roughness
+/// factor of at least `GLOSSY_FROM`, what `GLOSSY_RAYS` rays over its
+/// lobe change in the prefiltered light
 /// (`Reflections::reflected_change`), filtered across the surface as
 /// the bounce is (a rough lobe's reflection changes slowly across the
 /// surface); `view`: the unit vector from a point towards the eye. The
@@ -62,32 +93,15 @@ pub(super) fn glossy(
     setup: &DrawList,
     with: &Reflections,
     gbuf: &[GPixel],
-    (width, height): (u32, u32),
+    size: (u32, u32),
     (camera, view): ((Vec3, Vec3), &(dyn Fn(Vec3) -> Vec3 + Sync)),
 ) -> BounceScreen {
-    let (w, h) = (width as usize, height as usize);
-    let step = if w.min(h) >= 2 * GLOSSY_HALF_FROM {
-        2
-    } else {
-        1
-    };
-    let half = (w.div_ceil(step), h.div_ceil(step));
-    let rough: Vec<GPixel> = (0..half.0 * half.1)
-        .map(|i| {
-            let g = &gbuf[(i / half.0) * step * w + (i % half.0) * step];
-            if g.roughness >= GLOSSY_FROM {
-                *g
-            } else {
-                GPixel::EMPTY
-            }
-        })
-        .collect();
-    let raw = per_pixel(&rough, half.0 as u32, |g| {
+    let (rough, grid, _) = samples(gbuf, size, |g| g.roughness >= GLOSSY_FROM);
+    let raw = per_pixel(&rough, grid.0, |g| {
         let normals = [g.geo_normal, g.normal, view(g.position)];
         with.reflected_change(g.position, normals, g.roughness)
     });
-    let size = (half.0 as u32, half.1 as u32);
-    let mut screen = filtered(setup, &rough, size, camera, raw);
+    let mut screen = filtered(setup, &rough, grid, camera, raw);
     screen.position = rough.iter().map(|g| g.position).collect();
     screen
 }
@@ -136,5 +150,60 @@ fn filtered(
         clip_from_world: setup.clip_from_world,
         eye,
         forward,
+    }
+}
+
+/// The `enclosed_share` from which a frame gathers bounced light where
+/// the scene leaves `environment.bounces` unset: the Cornell box seen
+/// through its open side measures 0.73; the Cycles set's objects in the
+/// open 0 to 0.21 (FlightHelmet), the showcase 0.23.
+pub(super) const ENCLOSED_FROM: f32 = 0.5;
+
+/// Camera rays per side of the grid `enclosed_share` casts (its shorter
+/// side; the longer one in proportion).
+const PROBE_GRID: u32 = 24;
+/// Rays `enclosed_share` casts from each point a camera ray meets.
+const PROBE_RAYS: u32 = 8;
+
+/// How much of the environment the surfaces the camera sees are hidden
+/// from by the scene: over a grid of camera rays, the share of
+/// cosine-weighted rays from the points they meet (off the side facing
+/// the camera) that meet a surface. 0 where the camera sees nothing.
+pub(super) fn enclosed_share(rays: &CameraRays, tracer: &Tracer, surfaces: &dyn Surfaces) -> f32 {
+    let (w, h) = rays.size();
+    let (gw, gh) = if w >= h {
+        ((PROBE_GRID * w).div_ceil(h), PROBE_GRID)
+    } else {
+        (PROBE_GRID, (PROBE_GRID * h).div_ceil(w))
+    };
+    let (mut hidden, mut cast) = (0u32, 0u32);
+    for gy in 0..gh {
+        for gx in 0..gw {
+            let px = ((gx * 2 + 1) * w / (2 * gw)) as i32;
+            let py = ((gy * 2 + 1) * h / (2 * gh)) as i32;
+            let (o, d) = rays.ray(px, py);
+            let Some(b) = tracer
+                .nearest(o, d, f32::INFINITY)
+                .and_then(|hit| surfaces.at(hit, o, d))
+            else {
+                continue;
+            };
+            let q = b.position + b.geometric * tracer.epsilon;
+            let (shift, pair) = (
+                position_hash(b.position),
+                b.geometric.any_orthonormal_pair(),
+            );
+            for i in 0..PROBE_RAYS {
+                let xi = point(i, PROBE_RAYS, shift);
+                let l = cosine_direction(b.geometric, pair, (xi.x, xi.y));
+                cast += 1;
+                hidden += u32::from(tracer.occluded(q, l, f32::INFINITY));
+            }
+        }
+    }
+    if cast == 0 {
+        0.0
+    } else {
+        hidden as f32 / cast as f32
     }
 }

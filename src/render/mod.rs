@@ -66,7 +66,7 @@ use crate::raster::setup::Viewport;
 use crate::raytrace::bvh::Bvh;
 use crate::raytrace::{Cutout, Placed, Tracer};
 use crate::scene::camera::Projection;
-use crate::scene::environment::EnvMethod;
+use crate::scene::environment::{Bounces, EnvMethod};
 use crate::scene::material::{Native, roughness_from_ns};
 use crate::scene::settings::{AoMethod, Background, ShadingMode, ShadowMethod, TextureFilter};
 use crate::scene::{Light, Scene};
@@ -426,11 +426,11 @@ impl<'s> Renderer<'s> {
     /// (`environment.reflections`).
     /// Whether the prefiltered environment traces reflections and
     /// gathers bounced light (`shade::env::reflect`).
-    fn traced_env(&self) -> (bool, bool) {
+    fn traced_env(&self) -> (bool, Bounces) {
         self.scene
             .environment
             .as_ref()
-            .map_or((false, false), |e| (e.reflections, e.bounce))
+            .map_or((false, Bounces::Off), |e| (e.reflections, e.bounce))
     }
 
     /// Whether some material is shaded as metallic-roughness with one
@@ -451,7 +451,7 @@ impl<'s> Renderer<'s> {
             || s.ao.method == AoMethod::Raytraced
             || self.env_sampler().is_some()
             || self.scene.ground.is_some()
-            || self.traced_env() != (false, false)
+            || self.traced_env() != (false, Bounces::Off)
     }
 
     /// The frame's meshes as placed, for rays. `posed`: the BVHs of this
@@ -583,7 +583,15 @@ impl<'s> Renderer<'s> {
                     surfaces: bounces.then_some(&surfaces as &dyn Surfaces),
                     light: env,
                 });
-        let (mirror, bounce) = self.traced_env();
+        let (mirror, bounces) = self.traced_env();
+        let bounce = match (bounces, tracer.as_ref()) {
+            (Bounces::On, _) => true,
+            (Bounces::WhereEnclosed, Some(t)) => {
+                let rays = rays::CameraRays::new(&setup.camera, width, height);
+                bounce_pass::enclosed_share(&rays, t, &surfaces) >= bounce_pass::ENCLOSED_FROM
+            }
+            _ => false,
+        };
         // The bounce pass's and the rough reflections' pass's results,
         // once they ran (`bands`).
         let screen = std::sync::OnceLock::new();

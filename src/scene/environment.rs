@@ -47,10 +47,22 @@ pub struct Environment {
     /// Prefiltered: whether the specular lobes' dominant directions are
     /// traced against the models (`shade::env::reflect`); sampled: false.
     pub reflections: bool,
-    /// Prefiltered: whether light bounced once between surfaces is
-    /// gathered (`environment.bounces = 1`, `shade::env::reflect`);
-    /// sampled: false (`EnvMethod::Sampled::bounces`).
-    pub bounce: bool,
+    /// Prefiltered: when light bounced once between surfaces is gathered
+    /// (`environment.bounces`, `shade::env::reflect`); sampled: `Off`
+    /// (`EnvMethod::Sampled::bounces`).
+    pub bounce: Bounces,
+}
+
+/// When the prefiltered environment gathers light bounced once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bounces {
+    /// Never (`environment.bounces = 0`; the presets).
+    Off,
+    /// In every frame (`environment.bounces = 1`).
+    On,
+    /// In frames whose camera looks into an enclosure: a room, a box
+    /// (the default for an image's light, `environment.bounces` unset).
+    WhereEnclosed,
 }
 
 impl Environment {
@@ -67,7 +79,7 @@ impl Environment {
             prefilter_size: DEFAULT_PREFILTER_SIZE,
             emitters: DEFAULT_EMITTERS as u32,
             reflections: false,
-            bounce: false,
+            bounce: Bounces::Off,
         }
     }
 }

@@ -4,7 +4,9 @@
 //! roughness below `GLOSSY_FROM`; a rougher lobe shows the wall over the
 //! share of the lobe it fills, and the edge of what it meets as a
 //! gradient (the rough reflections' pass); light bounced once (`environment.bounces = 1`) tints a
-//! floor by the wall beside it; every lane width gives the same bytes.
+//! floor by the wall beside it, and bounces unasked where the camera
+//! looks into a box under an image's light; every lane width gives the
+//! same bytes.
 
 use glam::Vec3;
 use softraster::scene::Scene;
@@ -229,4 +231,79 @@ fn bounced_light_tints_a_floor_by_the_wall_beside_it() {
         );
         same_at_every_width(&scene, &[0], "a floor's bounced light");
     }
+}
+
+/// A uniform white Radiance image of 16 x 8 (flat scanlines of RGBE
+/// (128, 128, 128, 129): radiance 1).
+fn white_sky() -> Vec<u8> {
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n".to_vec();
+    hdr.extend([128u8, 128, 128, 129].repeat(16 * 8));
+    hdr
+}
+
+/// A scene under a white image (`environment.bounces` as `bounces`
+/// gives it, or unset), seen through the open side of a box (floor,
+/// ceiling, back and two side walls, 2 units a side, the left wall red)
+/// when `inside`, else from above a floor with a low red wall on one
+/// side: its frame.
+fn box_or_floor(name: &str, inside: bool, bounces: Option<u32>) -> Vec<glam::Vec4> {
+    let dir = common::scratch(name);
+    std::fs::write(dir.join("sky.hdr"), white_sky()).unwrap();
+    let obj = if inside {
+        "mtllib m.mtl\n\
+         v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n\
+         v -1 2 -1\nv 1 2 -1\nv 1 2 1\nv -1 2 1\n\
+         usemtl grey\nf 4 3 2 1\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\n\
+         usemtl red\nf 4 1 5 8\n"
+    } else {
+        "mtllib m.mtl\n\
+         v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv 1 1 -1\nv 1 1 1\n\
+         usemtl grey\nf 4 3 2 1\nusemtl red\nf 2 3 6 5\n"
+    };
+    let camera = if inside {
+        "eye = [0.0, 1.0, 3.5]\ntarget = [0.0, 1.0, 0.0]"
+    } else {
+        "eye = [0.0, 4.0, 0.5]\ntarget = [0.0, 0.0, 0.0]"
+    };
+    let bounces = bounces.map_or(String::new(), |b| format!("bounces = {b}\n"));
+    let scene = format!(
+        "[output]\nwidth = 48\nheight = 48\n[render]\ntonemap = \"clamp\"\nexposure = 0.0\n\
+         [environment]\npath = \"sky.hdr\"\nemitters = 0\nlights = 0\n{bounces}\
+         [[model]]\npath = \"m.obj\"\n\
+         [[camera]]\n{camera}\nfov = 45.0\n"
+    );
+    let mtl = "newmtl grey\nKd 0.8 0.8 0.8\nPm 0\nPr 1\nnewmtl red\nKd 0.8 0.1 0.1\nPm 0\nPr 1\n";
+    let s = common::scene_in(&dir, &scene, &[("m.obj", obj), ("m.mtl", mtl)]);
+    render_frame(&s, 0, 0).color
+}
+
+#[test]
+fn an_image_s_light_bounces_where_the_camera_looks_into_a_box() {
+    // Into a box, with `bounces` unset: as with the bounce, not as without.
+    let auto = box_or_floor("enclosed_auto", true, None);
+    let on = box_or_floor("enclosed_on", true, Some(1));
+    let off = box_or_floor("enclosed_off", true, Some(0));
+    assert!(
+        auto == on,
+        "into a box, bounces unset: not the bounce's frame"
+    );
+    // The bounce's own effect there: the box's floor loses the sky its
+    // ceiling hides (to the grey surfaces' 0.8 and the red wall's 0.1 in
+    // green), and the red wall tints the floor beside it (measured: green
+    // 0.78 of the unbounced, red 0.08 above green).
+    let floor_left = 40 * 48 + 12;
+    let (a, o) = (auto[floor_left], off[floor_left]);
+    assert!(
+        a.y < 0.9 * o.y,
+        "the floor by the red wall: {a} against {o} without"
+    );
+    assert!(a.x > a.y + 0.04, "the floor by the red wall, not red: {a}");
+    // A floor in the open by a low wall: as without the bounce (with it,
+    // the wall would tint the floor at its foot).
+    let open = box_or_floor("open_auto", false, None);
+    let open_off = box_or_floor("open_off", false, Some(0));
+    assert!(
+        open == open_off,
+        "a floor in the open, bounces unset: not the frame without"
+    );
 }

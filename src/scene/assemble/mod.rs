@@ -19,7 +19,7 @@ use super::Scene;
 use super::animation::{Animation, Turntable, TurntableTarget};
 use super::desc::{self, Ctx, SceneDesc, Spanned};
 use super::environment::{
-    DEFAULT_EMITTERS, DEFAULT_ENV_LIGHTS, DEFAULT_PREFILTER_SIZE, EnvMethod, Environment,
+    Bounces, DEFAULT_EMITTERS, DEFAULT_ENV_LIGHTS, DEFAULT_PREFILTER_SIZE, EnvMethod, Environment,
 };
 use super::overrides::{self, SetOverride};
 use crate::assets::environment::{EnvImage, TakenLight};
@@ -536,9 +536,17 @@ fn environment(
             // An image's reflections by default; the presets' soft panels
             // (the default look) keep their speed.
             reflections: !sampled && get(&e.reflections, e.path.is_some()),
-            // Prefiltered: bounced light where the scene asks for it (it
-            // doubles a frame's time); sampled bounces in its own rays.
-            bounce: !sampled && get(&e.bounces, 0) > 0,
+            // Prefiltered: bounced light where the scene asks for it, and
+            // under an image's light where the camera looks into an
+            // enclosure (it doubles a frame's time); sampled bounces in
+            // its own rays.
+            bounce: match e.bounces.as_ref().map(|b| *b.get_ref()) {
+                _ if sampled => Bounces::Off,
+                Some(b) if b > 0 => Bounces::On,
+                Some(_) => Bounces::Off,
+                None if e.path.is_some() => Bounces::WhereEnclosed,
+                None => Bounces::Off,
+            },
         },
         sun,
         lights,

@@ -31,7 +31,7 @@ mod discs;
 pub mod emitters;
 mod image_sampler;
 mod octahedral;
-mod pattern;
+pub(crate) mod pattern;
 pub mod reflect;
 pub mod sampled;
 
