@@ -433,6 +433,27 @@ impl<'s> Renderer<'s> {
             .map_or((false, Bounces::Off), |e| (e.reflections, e.bounce))
     }
 
+    /// Whether a frame of `setup` at `size` gathers bounced light under
+    /// the prefiltered environment: where the scene asks for it, or
+    /// leaves it unset under an image and the camera looks into an
+    /// enclosure (`bounce_pass::enclosed_share`).
+    fn gathers_bounce(
+        &self,
+        setup: &DrawList,
+        (width, height): (u32, u32),
+        tracer: Option<&Tracer>,
+        surfaces: &dyn Surfaces,
+    ) -> bool {
+        match (self.traced_env().1, tracer) {
+            (Bounces::On, _) => true,
+            (Bounces::WhereEnclosed, Some(t)) => {
+                let rays = rays::CameraRays::new(&setup.camera, width, height);
+                bounce_pass::enclosed_share(&rays, t, surfaces) >= bounce_pass::ENCLOSED_FROM
+            }
+            _ => false,
+        }
+    }
+
     /// Whether some material is shaded as metallic-roughness with one
     /// roughness factor of at least `GLOSSY_FROM` (no roughness map): the
     /// rough reflections' pass has pixels to trace.
@@ -583,15 +604,8 @@ impl<'s> Renderer<'s> {
                     surfaces: bounces.then_some(&surfaces as &dyn Surfaces),
                     light: env,
                 });
-        let (mirror, bounces) = self.traced_env();
-        let bounce = match (bounces, tracer.as_ref()) {
-            (Bounces::On, _) => true,
-            (Bounces::WhereEnclosed, Some(t)) => {
-                let rays = rays::CameraRays::new(&setup.camera, width, height);
-                bounce_pass::enclosed_share(&rays, t, &surfaces) >= bounce_pass::ENCLOSED_FROM
-            }
-            _ => false,
-        };
+        let mirror = self.traced_env().0;
+        let bounce = self.gathers_bounce(setup, (width, height), tracer.as_ref(), &surfaces);
         // The bounce pass's and the rough reflections' pass's results,
         // once they ran (`bands`).
         let screen = std::sync::OnceLock::new();

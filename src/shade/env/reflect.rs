@@ -30,8 +30,10 @@
 //! emission, unless it is one of the emitters, whose area light's
 //! highlight shows it already (`Bounce::lamp`). With the bounce on, the
 //! lights are tested for shadow at the point met (the CornellBox in the
-//! studio against Cycles, eight rays: 0.121 unshadowed, 0.106 shadowed); without
-//! it the reflections light their surfaces unshadowed, which measured
+//! studio against Cycles, eight rays: 0.121 unshadowed, 0.106 shadowed),
+//! and the bounce's second gathering adds the first's bounce to its
+//! irradiance where the frame shows it (`gathered_change`'s `prior`);
+//! without it the reflections light their surfaces unshadowed, which measured
 //! closer to Cycles where nothing else brings the walls' light (the
 //! CornellBox 0.180 against 0.183). The bounce leaves out the emission
 //! (the emitters light the point as area lights already) and clamps what
@@ -284,7 +286,7 @@ impl Reflections<'_> {
     /// hides (`HIDDEN_ROUGHNESS`), plus pi /
     /// `GATHER_RAYS` times what that surface sends back.
     pub fn gather(&self, p: Vec3, ng: Vec3, n: Vec3, e: Vec3) -> Vec3 {
-        let g = self.gathered(p, ng, n);
+        let g = self.gathered(p, ng, n, None);
         (e - g.hidden).max(Vec3::ZERO) + g.met
     }
 
@@ -292,8 +294,17 @@ impl Reflections<'_> {
     /// environment's irradiance they stand in for, before the clamp at
     /// zero), and the mean distance to the surfaces they meet (+inf where
     /// they meet none): the change varies over about that distance.
-    pub fn gathered_change(&self, p: Vec3, ng: Vec3, n: Vec3) -> (Vec3, f32) {
-        let g = self.gathered(p, ng, n);
+    /// `[ng, n]`: the geometric and the shading normal. `prior`: an
+    /// earlier gathering's bounce, which lights the surfaces met where
+    /// it shows them (light bounced twice), else they are lit as open
+    /// points.
+    pub fn gathered_change(
+        &self,
+        p: Vec3,
+        [ng, n]: [Vec3; 2],
+        prior: Option<&BounceScreen>,
+    ) -> (Vec3, f32) {
+        let g = self.gathered(p, ng, n, prior);
         let reach = if g.hits > 0 {
             g.distance / g.hits as f32
         } else {
@@ -366,8 +377,9 @@ impl Reflections<'_> {
         (change / weight, reach)
     }
 
-    /// The gathering rays at `p` about unit `n`.
-    fn gathered(&self, p: Vec3, ng: Vec3, n: Vec3) -> Gathered {
+    /// The gathering rays at `p` about unit `n` (`prior`: as
+    /// `gathered_change`).
+    fn gathered(&self, p: Vec3, ng: Vec3, n: Vec3, prior: Option<&BounceScreen>) -> Gathered {
         let off = if ng.dot(n) < 0.0 { -ng } else { ng };
         let o = p + off * self.tracer.epsilon;
         let (shift, pair) = (position_hash(p), n.any_orthonormal_pair());
@@ -384,7 +396,7 @@ impl Reflections<'_> {
             };
             hidden += self.light.prefiltered(d, HIDDEN_ROUGHNESS) * std::f32::consts::PI;
             if let Some(b) = b {
-                met += clamped(self.lit(&b, -d, true));
+                met += clamped(self.lit_with(&b, -d, true, prior));
                 distance += (b.position - o).length();
                 hits += 1;
             }
@@ -430,11 +442,21 @@ impl Reflections<'_> {
     /// What surface `b` reflects towards unit `wo`, lit as an open point
     /// (without its emission); `shadowed`: the lights tested for shadow.
     fn lit(&self, b: &Bounce, wo: Vec3, shadowed: bool) -> Vec3 {
+        self.lit_with(b, wo, shadowed, None)
+    }
+
+    /// `lit`, its irradiance with the bounce of `prior` where that shows
+    /// the surface.
+    fn lit_with(&self, b: &Bounce, wo: Vec3, shadowed: bool, prior: Option<&BounceScreen>) -> Vec3 {
         let env = self.light;
         let n = b.normal;
         let ndv = n.dot(wo).clamp(1e-4, 1.0);
         let o = b.position + b.geometric * self.tracer.epsilon;
-        let mut diffuse_light = env.irradiance(n) / std::f32::consts::PI;
+        let mut e = env.irradiance(n);
+        if let Some(delta) = prior.and_then(|s| s.at(b.position, b.geometric)) {
+            e = (e + delta).max(Vec3::ZERO);
+        }
+        let mut diffuse_light = e / std::f32::consts::PI;
         let mut glossy = Vec3::ZERO;
         for light in self.lights {
             if let Some(i) = incidence(light, b.position) {
