@@ -97,8 +97,9 @@ fn samples(
 /// The rough reflections' pass: at the pixels of `gbuf` (`width` x
 /// `height`, sampled as `samples` does) whose material has one roughness
 /// factor of at least `GLOSSY_FROM`, what `GLOSSY_RAYS` rays over its
-/// lobe change in the prefiltered light
-/// (`Reflections::reflected_change`), filtered across the surface as
+/// lobe bring from the surfaces they meet and the share of the lobe
+/// those hold (`Reflections::reflected_change`), filtered across the
+/// surface as
 /// the bounce is (a rough lobe's reflection changes slowly across the
 /// surface); `view`: the unit vector from a point towards the eye. The
 /// other pixels are left out of the filter and show nothing.
@@ -114,20 +115,28 @@ pub(super) fn glossy(
         let normals = [g.geo_normal, g.normal, view(g.position)];
         with.reflected_change(g.position, normals, g.roughness)
     });
-    let mut screen = filtered(setup, &rough, grid, camera, raw);
+    let lobe = blurred(setup, &rough, grid, raw);
+    let mut screen = screen(
+        setup,
+        &rough,
+        grid,
+        camera,
+        lobe.iter().map(|v| v.truncate()).collect(),
+    );
+    screen.hidden = lobe.iter().map(|v| v.w).collect();
     screen.position = rough.iter().map(|g| g.position).collect();
     screen
 }
 
 /// `f` of every drawn pixel of `gbuf` (rows of `width`); (0, +inf)
 /// elsewhere.
-fn per_pixel(
+fn per_pixel<T: Copy + Default + Send>(
     gbuf: &[GPixel],
     width: u32,
-    f: impl Fn(&GPixel) -> (Vec3, f32) + Sync,
-) -> Vec<(Vec3, f32)> {
+    f: impl Fn(&GPixel) -> (T, f32) + Sync,
+) -> Vec<(T, f32)> {
     let w = width as usize;
-    let mut raw = vec![(Vec3::ZERO, f32::INFINITY); gbuf.len()];
+    let mut raw = vec![(T::default(), f32::INFINITY); gbuf.len()];
     raw.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
             let g = &gbuf[y * w + x];
@@ -144,15 +153,46 @@ fn per_pixel(
 fn filtered(
     setup: &DrawList,
     gbuf: &[GPixel],
-    (width, height): (u32, u32),
-    (eye, forward): (Vec3, Vec3),
+    size: (u32, u32),
+    camera: (Vec3, Vec3),
     raw: Vec<(Vec3, f32)>,
 ) -> BounceScreen {
-    let (delta, reach): (Vec<Vec3>, Vec<f32>) = raw.into_iter().unzip();
+    let delta = blurred(setup, gbuf, size, raw);
+    screen(setup, gbuf, size, camera, delta)
+}
+
+/// The values and reaches `raw` of the pixels of `gbuf`, filtered
+/// (`TENT` at `STEPS`).
+fn blurred<T>(
+    setup: &DrawList,
+    gbuf: &[GPixel],
+    (width, height): (u32, u32),
+    raw: Vec<(T, f32)>,
+) -> Vec<T>
+where
+    T: Copy
+        + Default
+        + Send
+        + Sync
+        + std::ops::Add<Output = T>
+        + std::ops::Mul<f32, Output = T>
+        + std::ops::Div<f32, Output = T>,
+{
+    let (values, reach): (Vec<T>, Vec<f32>) = raw.into_iter().unzip();
     let view = AoView::new(&setup.camera, width, height);
-    let delta = STEPS.iter().fold(delta, |d, &step| {
-        edge_aware_blur(gbuf, &view, &d, (&TENT, step), Some(&reach), Vec3::ZERO)
-    });
+    STEPS.iter().fold(values, |d, &step| {
+        edge_aware_blur(gbuf, &view, &d, (&TENT, step), Some(&reach), T::default())
+    })
+}
+
+/// The screen the shading reads `delta` of the pixels of `gbuf` from.
+fn screen(
+    setup: &DrawList,
+    gbuf: &[GPixel],
+    (width, height): (u32, u32),
+    (eye, forward): (Vec3, Vec3),
+    delta: Vec<Vec3>,
+) -> BounceScreen {
     BounceScreen {
         width: width as usize,
         height: height as usize,
@@ -160,6 +200,7 @@ fn filtered(
         depth: gbuf.iter().map(|g| g.depth).collect(),
         geo_normal: gbuf.iter().map(|g| g.geo_normal).collect(),
         position: Vec::new(),
+        hidden: Vec::new(),
         clip_from_world: setup.clip_from_world,
         eye,
         forward,

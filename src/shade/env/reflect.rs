@@ -42,11 +42,11 @@
 
 use std::sync::OnceLock;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
+use super::EnvLight;
 use super::bounce::{Bounce, Surfaces, clamped};
 use super::pattern::{point, position_hash};
-use super::{EnvLight, dominant_direction_lanes};
 use crate::raytrace::Tracer;
 use crate::scene::light::{Light, LightKind};
 use crate::shade::ao::cosine_direction;
@@ -138,6 +138,11 @@ pub struct BounceScreen {
     /// point must lie on; empty on the frame's own grid, where the view
     /// depth is checked.
     pub position: Vec<Vec3>,
+    /// Per pixel of the rough reflections' pass: the filtered share of
+    /// the lobe (by n.l) whose rays met a surface; `delta` then holds
+    /// what those rays brought, over the whole lobe's weight. Empty for
+    /// the bounce.
+    pub hidden: Vec<f32>,
     pub clip_from_world: Mat4,
     pub eye: Vec3,
     pub forward: Vec3,
@@ -162,6 +167,18 @@ impl BounceScreen {
     /// view depth within 1%, the triangles' planes within 37 degrees);
     /// None elsewhere.
     pub fn at(&self, p: Vec3, ng: Vec3) -> Option<Vec3> {
+        self.index(p, ng).map(|i| self.delta[i])
+    }
+
+    /// The rough reflections' pass at `p` (as `at`): what the rays that
+    /// met a surface brought, and the share of the lobe they hold.
+    pub fn lobe_at(&self, p: Vec3, ng: Vec3) -> Option<(Vec3, f32)> {
+        self.index(p, ng)
+            .map(|i| (self.delta[i], self.hidden.get(i).copied().unwrap_or(0.0)))
+    }
+
+    /// The sample `at` reads for `p`.
+    fn index(&self, p: Vec3, ng: Vec3) -> Option<usize> {
         let clip = self.clip_from_world * p.extend(1.0);
         if clip.w <= 1e-6 {
             return None;
@@ -185,7 +202,7 @@ impl BounceScreen {
         };
         if self.position.is_empty() {
             let i = y * self.width + x;
-            return on(i).then(|| self.delta[i]);
+            return on(i).then_some(i);
         }
         // On the coarser grid a point lies between the samples of its
         // cell and of the cells after it: the first on its surface.
@@ -195,7 +212,6 @@ impl BounceScreen {
             .filter(|&(x, y)| x < self.width && y < self.height)
             .map(|(x, y)| y * self.width + x)
             .find(|&i| on(i))
-            .map(|i| self.delta[i])
     }
 }
 
@@ -212,8 +228,9 @@ impl<L: Lane> At<'_, L> {
     /// `light` (the prefiltered environment along `r`, for lobes of
     /// perceptual `roughness`), replaced by what a ray along `r` meets
     /// where it meets a surface; a lobe at least `GLOSSY_FROM` rough, at a
-    /// point the rough reflections' pass shows, takes the pass's filtered
-    /// change instead.
+    /// point the rough reflections' pass shows, takes what the pass's
+    /// rays brought plus `light` times the share of the lobe they did not
+    /// meet instead.
     #[inline]
     pub fn blend(&self, light: V3<L>, r: V3<L>, roughness: L) -> V3<L> {
         if !self.with.mirror {
@@ -229,7 +246,7 @@ impl<L: Lane> At<'_, L> {
         let mut changed = [None; crate::simd::MAX_WIDTH];
         for (k, c) in changed.iter_mut().enumerate().take(L::WIDTH) {
             if roughness.lane(k) >= GLOSSY_FROM {
-                *c = screen.at(self.position.lane(k), self.geo_normal[k]);
+                *c = screen.lobe_at(self.position.lane(k), self.geo_normal[k]);
             }
             own |= c.is_none();
         }
@@ -237,7 +254,7 @@ impl<L: Lane> At<'_, L> {
             out = self.with.along(self.position, self.geo_normal, r, light);
         }
         V3::from_fn(|k| match changed[k] {
-            Some(delta) => (light.lane(k) + delta).max(Vec3::ZERO),
+            Some((met, share)) => light.lane(k) * (1.0 - share) + met,
             None => out.lane(k),
         })
     }
@@ -315,30 +332,31 @@ impl Reflections<'_> {
 
     /// What `GLOSSY_RAYS` rays over the GGX lobe of perceptual
     /// `roughness` about unit `n`, seen from unit `v` (towards the
-    /// viewer), change at `p` in the prefiltered environment's light: per
-    /// ray that meets a surface, its radiance less the lobe's prefiltered
-    /// light (along its dominant direction, as the shading reads it),
-    /// weighted by n.l, over the rays' weights; and the mean distance to
-    /// the surfaces they meet (+inf where they meet none). `ng`: the
-    /// geometric normal.
+    /// viewer), find at `p`: in xyz, what the rays that meet a surface
+    /// bring, weighted by n.l, over all the rays' weights; in w, the
+    /// share of that weight they hold (the shading keeps its own
+    /// prefiltered light for the rest: `At::blend`); and the mean
+    /// distance to the surfaces they meet (+inf where they meet none).
+    /// `ng`: the geometric normal.
     ///
     /// A lobe whose rays all meet surfaces so shows exactly what they
-    /// bring. The environment along each ray, prefiltered again at the
-    /// lobe's roughness, was a blur of a blur: where the lobe faced a
-    /// bright sky it stood lower than the lobe's own light, and the
-    /// difference stayed (a Cornell box's floor reflected the sky its
-    /// ceiling hides: 0.127 -> 0.111 FLIP against Cycles in the
-    /// courtyard, with the bounce).
-    pub fn reflected_change(&self, p: Vec3, [ng, n, v]: [Vec3; 3], roughness: f32) -> (Vec3, f32) {
+    /// bring. A change to the point's light (each ray's radiance less the
+    /// environment along it, prefiltered again at the lobe's roughness)
+    /// was a blur of a blur: where the lobe faced a bright sky it stood
+    /// lower than the lobe's own light, and the difference stayed (a
+    /// Cornell box's floor reflected the sky its ceiling hides: 0.127 ->
+    /// 0.111 FLIP against Cycles in the courtyard, with the bounce);
+    /// less the lobe's own light along the isotropic dominant direction,
+    /// it missed the bent normal of an anisotropic lobe (the discs in the
+    /// courtyard 0.1010, with the share 0.0992).
+    pub fn reflected_change(&self, p: Vec3, [ng, n, v]: [Vec3; 3], roughness: f32) -> (Vec4, f32) {
         let off = if ng.dot(v) < 0.0 { -ng } else { ng };
         let o = p + off * self.tracer.epsilon;
         let a2 = (roughness * roughness).max(MIN_ALPHA).powi(2);
         let (shift, (tx, ty)) = (position_hash(p), n.any_orthonormal_pair());
         let (mut change, mut weight) = (Vec3::ZERO, 0.0);
         let (mut distance, mut hits) = (0.0, 0);
-        let r = V3::<f32>::from(n * (2.0 * n.dot(v)) - v);
-        let r = dominant_direction_lanes(V3::<f32>::from(n), r, roughness);
-        let open = self.light.prefiltered(r.into(), roughness);
+        let mut hidden = 0.0;
         for i in 0..GLOSSY_RAYS {
             let xi = point(i, GLOSSY_RAYS, shift);
             // A GGX half vector: cos^2 = (1 - u) / (1 + (a^2 - 1) u).
@@ -364,17 +382,18 @@ impl Reflections<'_> {
                 }
                 None => Vec3::ZERO,
             };
-            change += (sent - open) * ndl;
+            change += sent * ndl;
+            hidden += ndl;
         }
         if weight <= 0.0 {
-            return (Vec3::ZERO, f32::INFINITY);
+            return (Vec4::ZERO, f32::INFINITY);
         }
         let reach = if hits > 0 {
             distance / hits as f32
         } else {
             f32::INFINITY
         };
-        (change / weight, reach)
+        ((change / weight).extend(hidden / weight), reach)
     }
 
     /// The gathering rays at `p` about unit `n` (`prior`: as
