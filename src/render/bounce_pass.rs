@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use super::draw_list::DrawList;
 use super::rays::CameraRays;
 use crate::raytrace::Tracer;
-use crate::shade::ao::{AoView, GPixel, cosine_direction, edge_aware_blur};
+use crate::shade::ao::{AoView, Blurred, GPixel, cosine_direction, edge_aware_blur};
 use crate::shade::env::bounce::Surfaces;
 use crate::shade::env::pattern::{point, position_hash};
 use crate::shade::env::reflect::{BounceScreen, GLOSSY_FROM, Reflections};
@@ -163,21 +163,12 @@ fn filtered(
 
 /// The values and reaches `raw` of the pixels of `gbuf`, filtered
 /// (`TENT` at `STEPS`).
-fn blurred<T>(
+fn blurred<T: Blurred>(
     setup: &DrawList,
     gbuf: &[GPixel],
     (width, height): (u32, u32),
     raw: Vec<(T, f32)>,
-) -> Vec<T>
-where
-    T: Copy
-        + Default
-        + Send
-        + Sync
-        + std::ops::Add<Output = T>
-        + std::ops::Mul<f32, Output = T>
-        + std::ops::Div<f32, Output = T>,
-{
+) -> Vec<T> {
     let (values, reach): (Vec<T>, Vec<f32>) = raw.into_iter().unzip();
     let view = AoView::new(&setup.camera, width, height);
     STEPS.iter().fold(values, |d, &step| {

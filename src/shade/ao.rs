@@ -363,6 +363,23 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
     edge_aware_blur(g, view, raw, (&[1.0, 2.0, 2.0, 2.0, 1.0], 1), None, 1.0)
 }
 
+/// What `edge_aware_blur` filters: values that add and scale (an AO
+/// factor, a colour, a colour with a share).
+pub trait Blurred:
+    Copy
+    + Default
+    + Send
+    + Sync
+    + std::ops::Add<Output = Self>
+    + std::ops::Mul<f32, Output = Self>
+    + std::ops::Div<f32, Output = Self>
+{
+}
+
+impl Blurred for f32 {}
+impl Blurred for glam::Vec3 {}
+impl Blurred for glam::Vec4 {}
+
 /// `raw` (a value per pixel of `g`) averaged over the square `tent` (its
 /// weights along one axis, an odd count) whose taps lie `step` pixels
 /// apart, weighted by how near each tap lies to the
@@ -371,23 +388,14 @@ fn blur(g: &[GPixel], view: &AoView, raw: &[f32]) -> Vec<f32> {
 /// `reach` (per pixel, a world distance), a tap also counts less the
 /// farther it lies from the centre beyond the centre's reach. Pixels where
 /// nothing was drawn take `empty` and are not read.
-pub fn edge_aware_blur<T>(
+pub fn edge_aware_blur<T: Blurred>(
     g: &[GPixel],
     view: &AoView,
     raw: &[T],
     (tent, step): (&[f32], i32),
     reach: Option<&[f32]>,
     empty: T,
-) -> Vec<T>
-where
-    T: Copy
-        + Default
-        + Send
-        + Sync
-        + std::ops::Add<Output = T>
-        + std::ops::Mul<f32, Output = T>
-        + std::ops::Div<f32, Output = T>,
-{
+) -> Vec<T> {
     let (w, h) = (view.width as i32, view.height as i32);
     let half = (tent.len() / 2) as i32;
     let mut out = vec![empty; raw.len()];
