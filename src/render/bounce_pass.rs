@@ -69,8 +69,8 @@ pub(super) fn bounce(
 /// of 80x60, lost the lower discs' gradients (the anisotropy discs
 /// against Cycles, 0.123 -> 0.137 FLIP), while at 700x700 the full
 /// grid's filter doubled the CornellBox's frame; the bounce at 700x700
-/// took 0.45-0.6 s more a frame on every pixel, 0.02 s on every other
-/// one.
+/// took 0.4-0.5 s more a frame on every pixel (one gathering), 0.2-0.3 s
+/// on every other one (two gatherings).
 const HALF_FROM: usize = 240;
 
 /// The pixels of `gbuf` (`width` x `height`) a pass samples: every one,
@@ -98,7 +98,7 @@ fn samples(
 /// `height`, sampled as `samples` does) whose material has one roughness
 /// factor of at least `GLOSSY_FROM`, what `GLOSSY_RAYS` rays over its
 /// lobe bring from the surfaces they meet and the share of the lobe
-/// those hold (`Reflections::reflected_change`), filtered across the
+/// those hold (`Reflections::reflected_lobe`), filtered across the
 /// surface as
 /// the bounce is (a rough lobe's reflection changes slowly across the
 /// surface); `view`: the unit vector from a point towards the eye. The
@@ -113,7 +113,7 @@ pub(super) fn glossy(
     let (rough, grid, _) = samples(gbuf, size, |g| g.roughness >= GLOSSY_FROM);
     let raw = per_pixel(&rough, grid.0, |g| {
         let normals = [g.geo_normal, g.normal, view(g.position)];
-        with.reflected_change(g.position, normals, g.roughness)
+        with.reflected_lobe(g.position, normals, g.roughness)
     });
     let lobe = blurred(setup, &rough, grid, raw);
     let mut screen = screen(
@@ -123,7 +123,7 @@ pub(super) fn glossy(
         camera,
         lobe.iter().map(|v| v.truncate()).collect(),
     );
-    screen.hidden = lobe.iter().map(|v| v.w).collect();
+    screen.met_share = lobe.iter().map(|v| v.w).collect();
     screen.position = rough.iter().map(|g| g.position).collect();
     screen
 }
@@ -191,7 +191,7 @@ fn screen(
         depth: gbuf.iter().map(|g| g.depth).collect(),
         geo_normal: gbuf.iter().map(|g| g.geo_normal).collect(),
         position: Vec::new(),
-        hidden: Vec::new(),
+        met_share: Vec::new(),
         clip_from_world: setup.clip_from_world,
         eye,
         forward,

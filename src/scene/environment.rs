@@ -47,13 +47,14 @@ pub struct Environment {
     /// Prefiltered: whether the specular lobes' dominant directions are
     /// traced against the models (`shade::env::reflect`); sampled: false.
     pub reflections: bool,
-    /// Prefiltered: when light bounced once between surfaces is gathered
+    /// Prefiltered: when light bounced between surfaces is gathered
     /// (`environment.bounces`, `shade::env::reflect`); sampled: `Off`
     /// (`EnvMethod::Sampled::bounces`).
     pub bounce: Bounces,
 }
 
-/// When the prefiltered environment gathers light bounced once.
+/// When the prefiltered environment gathers light bounced between
+/// surfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Bounces {
     /// Never (`environment.bounces = 0`; the presets).

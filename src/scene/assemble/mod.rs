@@ -538,8 +538,8 @@ fn environment(
             reflections: !sampled && get(&e.reflections, e.path.is_some()),
             // Prefiltered: bounced light where the scene asks for it, and
             // under an image's light where the camera looks into an
-            // enclosure (it doubles a frame's time); sampled bounces in
-            // its own rays.
+            // enclosure (elsewhere it costs more than it gains); sampled
+            // bounces in its own rays.
             bounce: match e.bounces.as_ref().map(|b| *b.get_ref()) {
                 _ if sampled => Bounces::Off,
                 Some(b) if b > 0 => Bounces::On,

@@ -68,7 +68,7 @@ pub const GATHER_RAYS: u32 = 4;
 /// CornellBox 0.123 / 0.098), 1.0 and E further (0.128, 0.127).
 const HIDDEN_ROUGHNESS: f32 = 0.5;
 
-/// Rays per pixel of the rough reflections' pass (`reflected_change`),
+/// Rays per pixel of the rough reflections' pass (`reflected_lobe`),
 /// drawn over the lobe.
 pub const GLOSSY_RAYS: u32 = 8;
 
@@ -127,7 +127,8 @@ pub struct BounceScreen {
     pub width: usize,
     pub height: usize,
     /// Per pixel: the filtered irradiance change (what the gathering rays
-    /// bring, less the environment's irradiance they stand in for).
+    /// bring, less the environment's irradiance they stand in for); for
+    /// the rough reflections' pass, what its rays brought (`met_share`).
     pub delta: Vec<Vec3>,
     /// Per pixel: its surface's view depth (+inf: nothing) and unit
     /// geometric normal, facing the camera.
@@ -142,7 +143,7 @@ pub struct BounceScreen {
     /// the lobe (by n.l) whose rays met a surface; `delta` then holds
     /// what those rays brought, over the whole lobe's weight. Empty for
     /// the bounce.
-    pub hidden: Vec<f32>,
+    pub met_share: Vec<f32>,
     pub clip_from_world: Mat4,
     pub eye: Vec3,
     pub forward: Vec3,
@@ -174,7 +175,7 @@ impl BounceScreen {
     /// met a surface brought, and the share of the lobe they hold.
     pub fn lobe_at(&self, p: Vec3, ng: Vec3) -> Option<(Vec3, f32)> {
         self.index(p, ng)
-            .map(|i| (self.delta[i], self.hidden.get(i).copied().unwrap_or(0.0)))
+            .map(|i| (self.delta[i], self.met_share.get(i).copied().unwrap_or(0.0)))
     }
 
     /// The sample `at` reads for `p`.
@@ -349,14 +350,14 @@ impl Reflections<'_> {
     /// less the lobe's own light along the isotropic dominant direction,
     /// it missed the bent normal of an anisotropic lobe (the discs in the
     /// courtyard 0.1010, with the share 0.0992).
-    pub fn reflected_change(&self, p: Vec3, [ng, n, v]: [Vec3; 3], roughness: f32) -> (Vec4, f32) {
+    pub fn reflected_lobe(&self, p: Vec3, [ng, n, v]: [Vec3; 3], roughness: f32) -> (Vec4, f32) {
         let off = if ng.dot(v) < 0.0 { -ng } else { ng };
         let o = p + off * self.tracer.epsilon;
         let a2 = (roughness * roughness).max(MIN_ALPHA).powi(2);
         let (shift, (tx, ty)) = (position_hash(p), n.any_orthonormal_pair());
-        let (mut change, mut weight) = (Vec3::ZERO, 0.0);
+        let (mut met, mut weight) = (Vec3::ZERO, 0.0);
         let (mut distance, mut hits) = (0.0, 0);
-        let mut hidden = 0.0;
+        let mut met_weight = 0.0;
         for i in 0..GLOSSY_RAYS {
             let xi = point(i, GLOSSY_RAYS, shift);
             // A GGX half vector: cos^2 = (1 - u) / (1 + (a^2 - 1) u).
@@ -382,8 +383,8 @@ impl Reflections<'_> {
                 }
                 None => Vec3::ZERO,
             };
-            change += sent * ndl;
-            hidden += ndl;
+            met += sent * ndl;
+            met_weight += ndl;
         }
         if weight <= 0.0 {
             return (Vec4::ZERO, f32::INFINITY);
@@ -393,7 +394,7 @@ impl Reflections<'_> {
         } else {
             f32::INFINITY
         };
-        ((change / weight).extend(hidden / weight), reach)
+        ((met / weight).extend(met_weight / weight), reach)
     }
 
     /// The gathering rays at `p` about unit `n` (`prior`: as
