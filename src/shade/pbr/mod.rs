@@ -507,6 +507,7 @@ pub fn environment<L: Lane>(
     c: &PbrColor<L>,
     ao: L,
     traced: Option<&At<'_, L>>,
+    horizon: Option<V3<L>>,
 ) -> V3<L> {
     // Where the bounce is gathered, its rays see what hides the
     // environment: the AO does not darken that diffuse light again.
@@ -515,7 +516,15 @@ pub fn environment<L: Lane>(
         Some(t) => (t.irradiance(env.irradiance_lanes(n), n), L::splat(1.0)),
         None => (env.irradiance_lanes(n), ao),
     };
-    let mut base = base_environment(env, [n, v], c, [ao, ao_diffuse], irradiance, traced);
+    let mut base = base_environment(
+        env,
+        [n, v],
+        c,
+        [ao, ao_diffuse],
+        irradiance,
+        traced,
+        horizon,
+    );
     if let Some(s) = &c.sheen {
         let ndv = n.dot(v).abs().max(L::splat(1e-4));
         let e = s.albedo(ndv);
@@ -555,7 +564,9 @@ pub fn environment<L: Lane>(
 
 /// `environment` without the sheen and the clearcoat: `irradiance` the
 /// diffuse light about `n` (the environment's, or with the bounce), `ao`
-/// the occlusion of the specular lobe and `ao_diffuse` of the diffuse.
+/// the occlusion of the specular lobe and `ao_diffuse` of the diffuse;
+/// `horizon` the geometric normal (on the viewer's side) where a normal
+/// map tilts `n`.
 #[inline(always)]
 fn base_environment<L: Lane>(
     env: &EnvLight,
@@ -564,6 +575,7 @@ fn base_environment<L: Lane>(
     [ao, ao_diffuse]: [L; 2],
     irradiance: V3<L>,
     traced: Option<&At<'_, L>>,
+    horizon: Option<V3<L>>,
 ) -> V3<L> {
     let ndv = n.dot(v).abs().max(L::splat(1e-4));
     let (mut a, mut b) = ([0.0f32; MAX_WIDTH], [0.0f32; MAX_WIDTH]);
@@ -590,9 +602,40 @@ fn base_environment<L: Lane>(
     if let Some(t) = traced {
         light = t.blend(light, r, c.roughness);
     }
+    if let Some(ng) = horizon {
+        light = light.scale(above_horizon(r, [ng, nr], c.roughness));
+    }
     let so = L::from_fn(|k| specular_occlusion(ndv.lane(k), ao.lane(k), c.roughness.lane(k)));
     let specular = (light * spec).scale(so);
     (diffuse + specular).scale(c.occlusion)
+}
+
+/// The share of a reflection lobe about `r` (of perceptual `roughness`)
+/// that the surface's own plane, of normal `ng`, leaves above it, over
+/// the share the shading normal `n`'s plane leaves, which the split
+/// sum's BRDF table already counts: at most 1, and 1 where the two
+/// planes agree.
+///
+/// A normal map tilts the shading normal; raised so that the mirror
+/// direction clears the surface (`valid_reflection`), the lobe about a
+/// steep flank's reflection grazes the surface, and a path tracer loses
+/// the part of it below (Cycles gives a reflected direction under the
+/// geometric normal no light). The lobe's elevation above a plane
+/// through `r` is about twice its microfacets' slope across it, and
+/// GGX's slopes along one axis have the distribution function
+/// 1/2 + x / (2 sqrt(alpha^2 + x^2)): a plane `e` (its cosine from `r`)
+/// below `r` leaves 1/2 + u / (2 sqrt(1 + u^2)) of the lobe above it,
+/// u = e / (2 alpha). The bumpy ball against Cycles: 0.104 -> 0.090
+/// (courtyard), 0.102 -> 0.098 (studio) (`docs/cycles.md`).
+#[inline(always)]
+fn above_horizon<L: Lane>(r: V3<L>, [ng, n]: [V3<L>; 2], roughness: L) -> L {
+    let half = L::splat(0.5);
+    let two_alpha = L::splat(2.0) * (roughness * roughness).max(L::splat(1e-4));
+    let share = |e: L| {
+        let u = e / two_alpha;
+        half + half * u / (L::splat(1.0) + u * u).sqrt()
+    };
+    (share(r.dot(ng)) / share(r.dot(n)).max(L::splat(1e-6))).min(L::splat(1.0))
 }
 
 #[cfg(test)]
@@ -603,6 +646,42 @@ mod tests {
 
     fn dielectric(base: f32, roughness: f32) -> PbrColor {
         PbrColor::new(V3::from(Vec3::splat(base)), 0.0, roughness)
+    }
+
+    #[test]
+    fn the_lobe_above_the_horizon_matches_ggx_samples() {
+        // Seen head-on, the lobe reflects about n = r = +z; the surface's
+        // plane, of normal ng, passes `e` (its cosine from r) below r.
+        let n = Vec3::Z;
+        let mut next = xorshift(0x51a7_e0f1_2b3c_4d5e);
+        for roughness in [0.15f32, 0.3] {
+            let alpha = roughness * roughness;
+            let slopes: Vec<(f32, f32)> = (0..40_000)
+                .map(|_| {
+                    let (u, phi) = (next().min(0.999_999), 2.0 * PI * next());
+                    let s = alpha * (u / (1.0 - u)).sqrt();
+                    (s * phi.cos(), s * phi.sin())
+                })
+                .collect();
+            for e in [-0.1f32, -0.02, 0.0, 0.02, 0.1] {
+                let ng = Vec3::new(0.0, (1.0 - e * e).sqrt(), e);
+                let above = |plane: Vec3| {
+                    let kept = slopes.iter().filter(|&&(sx, sy)| {
+                        let m = Vec3::new(-sx, -sy, 1.0).normalize();
+                        let l = m * 2.0 * m.dot(n) - n;
+                        l.dot(plane) > 0.0 && l.dot(n) > 0.0
+                    });
+                    kept.count() as f32 / slopes.len() as f32
+                };
+                let truth = above(ng) / above(n);
+                let got = above_horizon(V3::from(n), [V3::from(ng), V3::from(n)], roughness);
+                assert!((got - truth).abs() < 0.03, "{roughness} {e}: {got} {truth}");
+            }
+        }
+        // Where the planes agree, nothing is taken.
+        let r = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let z = V3::from(n);
+        assert_eq!(above_horizon(V3::from(r), [z, z], 0.2), 1.0);
     }
 
     #[test]

@@ -363,11 +363,13 @@ impl ShadeContext<'_> {
         // widened.
         let mut spread_normals = None;
         let mut fast = None;
+        let mut horizon = None;
         let plain = c;
         let n = match &m.normal_map {
             Some(map) => {
                 let mapped = fetch.normal(map);
                 let towards = geometric_towards(f, v);
+                horizon = Some(towards);
                 // The spread is the map's own, before any raising.
                 let lit = !f.light_set(self.lights).is_empty();
                 let spread = (self.env.is_some() || self.env_sampled.is_some() || lit)
@@ -432,10 +434,10 @@ impl ShadeContext<'_> {
                     position: f.position,
                     geo_normal: &f.geo_normal[..],
                 });
-                let light = || environment(env, [n, v], &c, f.ao, traced.as_ref());
+                let light = || environment(env, [n, v], &c, f.ao, traced.as_ref(), horizon);
                 direct
                     + over_pixel(four, light, |n| {
-                        environment(env, [n, v], &plain, f.ao, traced.as_ref())
+                        environment(env, [n, v], &plain, f.ao, traced.as_ref(), horizon)
                     })
             }
             None => direct,
