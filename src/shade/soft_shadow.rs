@@ -12,6 +12,10 @@
 //! penumbra, the open share is within 0.02 of the exact one (the test). Every pattern is turned by a hash of the
 //! point's coordinates, so the same point gets the same rays on every
 //! thread and at every lane width.
+//!
+//! An emissive surface's disc (`open_share_to`) weighs each ray by its
+//! cosine to the surface, so that a surface whose plane cuts the disc
+//! gets the light of the part in front of it.
 
 use glam::Vec3;
 
@@ -53,11 +57,22 @@ pub fn open_share(tracer: &Tracer, cone: f32, p: Vec3, ng: Vec3, l: Vec3) -> f32
     share(p, |u, v| cone.open(u, v))
 }
 
-/// The unoccluded share of the rays from `p` (lifted along `ng`) to
-/// points of a disc (an emissive surface taken as a light: centre `q`,
-/// unit `axis`, `radius`), spread evenly over its area. Each ray stops
-/// just short of the disc's plane, so the emitter's own triangles, and
-/// what stands behind them, do not shadow its light.
+/// The light a disc (an emissive surface taken as a light: centre `q`,
+/// unit `axis`, `radius`) sends `p` (lifted along `ng`), over what its
+/// centre would send unshadowed: rays to points spread evenly over its
+/// area, each weighed by its cosine to `ng` and stopped just short of the
+/// disc's plane, so that the emitter's own triangles, and what stands
+/// behind them, do not shadow its light. Where the probes see the whole
+/// disc, 1; where they see none of it, 0; in between, the penumbra's
+/// rays' mean of open times cosine, over the centre's cosine (at most
+/// `MAX_GAIN`).
+///
+/// A surface whose plane cuts the disc sees the part of it in front:
+/// the cosines of that part, not the centre's, say how much light it
+/// gets. The CornellBox's tall box, whose front face's plane passes 12
+/// units from the lamp's centre, got 0.62 of the quad's exact light from
+/// the centre's cosine and about 0.6 of that from the rays' open share;
+/// Cycles' lamp-only frame lit it 2 to 2.4 times as bright.
 pub fn open_share_to(
     tracer: &Tracer,
     (q, axis, radius): (Vec3, Vec3, f32),
@@ -66,42 +81,79 @@ pub fn open_share_to(
 ) -> f32 {
     let o = p + ng * tracer.epsilon;
     let (tx, ty) = axis.any_orthonormal_pair();
-    share(p, |u, v| {
+    let centre = (q - o).normalize_or_zero().dot(ng);
+    let rays = cast(p, |u, v| {
         // u: the share of the disc's area inside the point's circle.
         let r = radius * u.sqrt();
         let phi = std::f32::consts::TAU * v;
         let to = q + tx * (r * phi.cos()) + ty * (r * phi.sin()) - o;
         let t = to.length();
         if t.is_nan() || t <= 0.0 {
-            return 1.0;
+            return (1.0, centre.max(0.0));
         }
         let d = to / t;
-        if ng.dot(d) > 0.0 {
-            tracer.transmittance(o, d, t * (1.0 - 1e-3))
+        let cos = ng.dot(d);
+        if cos > 0.0 {
+            (tracer.transmittance(o, d, t * (1.0 - 1e-3)), cos)
         } else {
-            0.0
+            (0.0, 0.0)
         }
-    })
+    });
+    match rays {
+        Rays::Agreed(open) => open,
+        Rays::Penumbra { weighted, count } => {
+            (weighted / (count as f32 * centre.max(1e-3))).min(MAX_GAIN)
+        }
+    }
+}
+
+/// The most `open_share_to` gives a point whose plane cuts the disc,
+/// over its centre's light (a normal map could tilt the shading normal
+/// towards the centre while the plane turns away).
+const MAX_GAIN: f32 = 4.0;
+
+/// What the rays of `share` found: the probes agreed (the share they
+/// saw: 0 or 1 where the rays are opaque), or the sum of every ray's
+/// open share times its weight and their count.
+enum Rays {
+    Agreed(f32),
+    Penumbra { weighted: f32, count: u32 },
 }
 
 /// Three probes `open(u, v)`, evenly turned near the rim; where they
 /// disagree, the penumbra's rays join them. `u` and `v` in [0, 1).
 fn share(p: Vec3, open: impl Fn(f32, f32) -> f32) -> f32 {
+    match cast(p, |u, v| (open(u, v), 1.0)) {
+        Rays::Agreed(open) => open,
+        Rays::Penumbra { weighted, count } => weighted / count as f32,
+    }
+}
+
+/// The rays of `share`, `open(u, v)` giving each its open share and its
+/// weight.
+fn cast(p: Vec3, open: impl Fn(f32, f32) -> (f32, f32)) -> Rays {
     let (su, sv) = point_hash(p);
-    let probes: f32 = (0..PROBES)
-        .map(|k| open(PROBE_U, (sv + k as f32 / PROBES as f32).fract()))
-        .sum();
+    let (mut probes, mut weighted) = (0.0, 0.0);
+    for k in 0..PROBES {
+        let (o, w) = open(PROBE_U, (sv + k as f32 / PROBES as f32).fract());
+        probes += o;
+        weighted += o * w;
+    }
     if probes == 0.0 || probes == PROBES as f32 {
-        return probes / PROBES as f32;
+        return Rays::Agreed(probes / PROBES as f32);
     }
     let rest: f32 = (0..PENUMBRA_RAYS)
         .map(|i| {
             let u = (i as f32 + 0.5) / PENUMBRA_RAYS as f32 + su;
             let v = i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0) + sv;
-            open(u.fract(), v.fract())
+            let (o, w) = open(u.fract(), v.fract());
+            o * w
         })
         .sum();
-    (probes + rest) / (PENUMBRA_RAYS + PROBES) as f32
+    Rays::Penumbra {
+        weighted: weighted + rest,
+        count: PENUMBRA_RAYS + PROBES,
+    }
 }
 
 /// The rays' common part: origin, the frame around the axis, the cone.
@@ -167,6 +219,19 @@ mod tests {
     use crate::shade::shadow::Filter;
     use glam::Mat4;
 
+    /// A tracer of `bvh` alone, placed as it is, within `bounds`.
+    fn alone(bvh: &Bvh, bounds: (Vec3, Vec3)) -> Tracer<'_> {
+        Tracer::new(
+            [Placed {
+                bvh,
+                cutout: None,
+                bounds,
+                world_from_object: Mat4::IDENTITY,
+            }],
+            1.0,
+        )
+    }
+
     /// The open share of the cone of half angle `cone` around +Y from a
     /// point at x = s under the half plane x < 0 at height 1, by a
     /// 1000x1000 midpoint rule over the cone's solid angle.
@@ -195,14 +260,9 @@ mod tests {
             Vec3::new(-50.0, 1.0, 50.0),
         ];
         let bvh = Bvh::build(&positions, &[[0, 1, 2], [0, 2, 3]]);
-        let tracer = Tracer::new(
-            [Placed {
-                bvh: &bvh,
-                cutout: None,
-                bounds: (Vec3::new(-50.0, 1.0, -50.0), Vec3::new(0.0, 1.0, 50.0)),
-                world_from_object: Mat4::IDENTITY,
-            }],
-            1.0,
+        let tracer = alone(
+            &bvh,
+            (Vec3::new(-50.0, 1.0, -50.0), Vec3::new(0.0, 1.0, 50.0)),
         );
         let shadows = Shadows {
             lights: std::sync::Arc::new([]),
@@ -263,14 +323,9 @@ mod tests {
             [8, 10, 11],
         ];
         let bvh = Bvh::build(&positions, &tris);
-        let tracer = Tracer::new(
-            [Placed {
-                bvh: &bvh,
-                cutout: None,
-                bounds: (Vec3::new(-9.0, 1.0, -9.0), Vec3::new(9.0, 2.05, 9.0)),
-                world_from_object: Mat4::IDENTITY,
-            }],
-            1.0,
+        let tracer = alone(
+            &bvh,
+            (Vec3::new(-9.0, 1.0, -9.0), Vec3::new(9.0, 2.05, 9.0)),
         );
         let disc = (
             Vec3::new(0.0, 2.0, 0.0),
@@ -299,5 +354,61 @@ mod tests {
         );
         let above = open_share_to(&tracer, disc, Vec3::new(0.3, 3.0, 0.0), -Vec3::Y);
         assert_eq!(above, 0.0);
+    }
+
+    #[test]
+    fn a_wall_whose_plane_cuts_the_lamp_gets_the_light_of_the_part_in_front() {
+        // A lamp of area 1 at y = 2 (a disc, nothing else in the scene)
+        // and a wall facing +x whose plane passes a little behind the
+        // lamp's centre: the lamp's light at a point of the wall is the
+        // centre's (A cos_l cos_r / (r^2 + R^2)) times the share.
+        let radius = (1.0 / std::f32::consts::PI).sqrt();
+        let positions = [
+            Vec3::new(-0.5, 2.0, -0.5),
+            Vec3::new(0.5, 2.0, -0.5),
+            Vec3::new(0.5, 2.0, 0.5),
+        ];
+        let bvh = Bvh::build(&positions, &[[0, 1, 2]]);
+        let tracer = alone(&bvh, (Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, 0.5)));
+        let disc = (Vec3::new(0.0, 2.0, 0.0), Vec3::Y, radius);
+        let ng = Vec3::X;
+        for (x, y) in [(-0.1f32, 0.5f32), (-0.05, 1.2), (-0.2, 1.0)] {
+            let points = 200;
+            // The disc's exact light (radiance 1), by the midpoint rule
+            // in polar coordinates, and the model's, averaged over points
+            // along the wall (the rays' pattern turns with the point).
+            let mut exact = 0.0;
+            for i in 0..points {
+                for j in 0..points {
+                    let r = radius * (i as f32 + 0.5) / points as f32;
+                    let phi = std::f32::consts::TAU * (j as f32 + 0.5) / points as f32;
+                    let q = Vec3::new(r * phi.cos(), 2.0, r * phi.sin());
+                    let d = q - Vec3::new(x, y, 0.0);
+                    let d2 = d.length_squared();
+                    let cos_r = (d.dot(ng) / d2.sqrt()).max(0.0);
+                    let cos_l = d.y / d2.sqrt();
+                    let area =
+                        r * (radius / points as f32) * (std::f32::consts::TAU / points as f32);
+                    exact += cos_r * cos_l / d2 * area;
+                }
+            }
+            let model = (0..64)
+                .map(|k| {
+                    let p = Vec3::new(x, y, -0.032 + 0.001 * k as f32);
+                    let d = disc.0 - p;
+                    let d2 = d.length_squared();
+                    let centre = d.dot(ng).max(0.0) * d.y / d2 / (d2 + radius * radius);
+                    centre * open_share_to(&tracer, disc, p, ng)
+                })
+                .sum::<f32>()
+                / 64.0;
+            // (z spread over +-0.032 changes the exact light by under
+            // 0.5%; the centre's cosine with the rays' open share, as
+            // before, gave 0.36 of it at the first point.)
+            assert!(
+                (model / exact - 1.0).abs() < 0.1,
+                "({x}, {y}): {model} against {exact}"
+            );
+        }
     }
 }
