@@ -130,6 +130,10 @@ impl ShadeContext<'_> {
     }
 }
 
+/// The most `Fetch::normal_spread` gives: each axis's squared change is
+/// counted up to a turn of 60 degrees (1), beyond which it is a seam.
+pub(crate) const MAX_SPREAD: f32 = 2.0;
+
 /// Where shading code (written once over the lane type `L`) reads a
 /// material's texels and perturbs its normals: a lane call's through its
 /// prepared maps (`shade::lanes`).
@@ -143,7 +147,8 @@ pub(crate) trait Fetch<L: Lane> {
 
     /// How far the normals `n` that `map` gives (`normal`) turn across
     /// a pixel: the squared lengths of their changes one pixel's step
-    /// along u and along v, summed (0 where not measured).
+    /// along u and along v, summed (0 where not measured); at most
+    /// `MAX_SPREAD` (or NaN).
     fn normal_spread(&mut self, map: &NormalMap, n: V3<L>) -> L {
         let _ = (map, n);
         L::splat(0.0)

@@ -189,6 +189,32 @@ impl Words8 {
         Words8 { v }
     }
 
+    /// The words of `t` at `at[k]` (lanes 0-3) and `at[k] + step[k]`
+    /// (lanes 4-7) for the lanes k whose bit is set in `live`, 0 in the
+    /// others (which read nothing): two masked gathers.
+    ///
+    /// # Safety
+    /// For every live lane, `at[k] + step[k] < t.len()`, and `t.len()`
+    /// fits an `i32` (the gathers' indices).
+    #[inline(always)]
+    pub unsafe fn gather_pair(t: &[u32], at: [u32; 4], step: [u32; 4], live: u32) -> Words8 {
+        use std::arch::x86_64::*;
+        debug_assert!(t.len() <= i32::MAX as usize);
+        // SAFETY: AVX2 is enabled for the build; the live lanes' indices
+        // lie in `t` (the caller's contract), and a masked gather reads
+        // nothing at the lanes its mask clears.
+        let v = unsafe {
+            let lo = _mm_loadu_si128(at.as_ptr().cast());
+            let hi = _mm_add_epi32(lo, _mm_loadu_si128(step.as_ptr().cast()));
+            let idx = _mm256_set_m128i(hi, lo);
+            let bits = _mm256_set_epi32(8, 4, 2, 1, 8, 4, 2, 1);
+            let mask =
+                _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(live as i32), bits), bits);
+            _mm256_mask_i32gather_epi32::<4>(_mm256_setzero_si256(), t.as_ptr().cast(), idx, mask)
+        };
+        Words8 { v }
+    }
+
     /// Byte `shift / 8` of each word, 0..=255.
     #[inline(always)]
     fn byte(self, shift: u32) -> std::arch::x86_64::__m256i {
@@ -224,6 +250,29 @@ impl Words8 {
 impl Words8 {
     #[inline(always)]
     pub fn new(lo: [u32; 4], hi: [u32; 4]) -> Words8 {
+        Words8 { v: (lo, hi) }
+    }
+
+    /// The words of `t` at `at[k]` (lanes 0-3) and `at[k] + step[k]`
+    /// (lanes 4-7) for the lanes k whose bit is set in `live`, 0 in the
+    /// others (which read nothing).
+    ///
+    /// # Safety
+    /// For every live lane, `at[k] + step[k] < t.len()`.
+    #[inline(always)]
+    pub unsafe fn gather_pair(t: &[u32], at: [u32; 4], step: [u32; 4], live: u32) -> Words8 {
+        let (mut lo, mut hi) = ([0u32; 4], [0u32; 4]);
+        for k in 0..4 {
+            if live & (1 << k) != 0 {
+                let i = at[k] as usize;
+                debug_assert!(i + (step[k] as usize) < t.len());
+                // SAFETY: the caller's contract.
+                unsafe {
+                    lo[k] = u32::from_le(*t.get_unchecked(i));
+                    hi[k] = u32::from_le(*t.get_unchecked(i + step[k] as usize));
+                }
+            }
+        }
         Words8 { v: (lo, hi) }
     }
 
@@ -533,6 +582,54 @@ pub fn lerp3<L: Lane>(a: V3<L>, b: V3<L>, c: V3<L>, l: V3<L>) -> V3<L> {
 
 #[cfg(test)]
 mod tests {
+    /// `Words8::gather_pair` reads the live lanes' two words and nothing
+    /// else: the dead lanes' indices lie far outside the slice (a read
+    /// there would fault or give garbage), and they come back 0.
+    #[test]
+    fn a_gathered_pair_reads_only_the_live_lanes() {
+        let t: Vec<u32> = (0..64u32).map(|i| i.wrapping_mul(0x9e37_79b9)).collect();
+        let far = u32::MAX / 8;
+        for live in 0..16u32 {
+            let at: [u32; 4] = std::array::from_fn(|k| {
+                if live & (1 << k) != 0 {
+                    [3, 9, 17, 40][k]
+                } else {
+                    far
+                }
+            });
+            let step = [4, 13, 1, 20];
+            // SAFETY: every live lane's at + step lies in `t` (at most 60).
+            let w = unsafe { Words8::gather_pair(&t, at, step, live) };
+            let bytes = w.bytes(0);
+            for k in 0..4 {
+                let on = live & (1 << k) != 0;
+                let (lo, hi) = if on {
+                    (t[at[k] as usize], t[(at[k] + step[k]) as usize])
+                } else {
+                    (0, 0)
+                };
+                assert_eq!(
+                    bytes.quad(0)[k],
+                    (lo & 0xff) as f32,
+                    "live {live:04b} lane {k}"
+                );
+                assert_eq!(
+                    bytes.quad(1)[k],
+                    (hi & 0xff) as f32,
+                    "live {live:04b} lane {k}"
+                );
+            }
+            let high = w.bytes(24);
+            for k in (0..4).filter(|k| live & (1 << k) != 0) {
+                assert_eq!(high.quad(0)[k], (t[at[k] as usize] >> 24) as f32);
+                assert_eq!(
+                    high.quad(1)[k],
+                    (t[(at[k] + step[k]) as usize] >> 24) as f32
+                );
+            }
+        }
+    }
+
     /// The SSE2 block steps equal the scalar formula (`Level::index`
     /// and `footprint`) over positions and widths up to 2^14
     /// blocks, at every remainder mod 4.

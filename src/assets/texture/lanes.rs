@@ -371,32 +371,8 @@ impl<'t> Chain<'t> {
     /// decoded, then blended along x and then along y, a (1 - f) + b f.
     #[inline(always)]
     fn bilinear4<const N: usize>(&self, place: &Place4, u: Vec4, v: Vec4, mode: Wrap) -> [Vec4; N] {
-        // Corner j (top-left, top-right, bottom-left, bottom-right) of
-        // lane k, as stored.
-        let mut texels = [[0u32; 4]; 4];
         let read = place.inside & place.live;
-        for k in 0..4 {
-            if read & (1 << k) != 0 {
-                let t = self.texels[place.level[k]];
-                let (i, dx, dy) = (
-                    place.at[k] as usize,
-                    place.dx[k] as usize,
-                    place.dy[k] as usize,
-                );
-                debug_assert!(i + dx + dy < t.len());
-                // SAFETY: an inside lane's footprint has x0 + 1 < width and
-                // y0 + 1 < height in its level (`Place4::new`, for a level
-                // of this size: `read` checks the shape), so its four
-                // texels, the last at i + dx + dy, lie in the level's
-                // blocks (`Level::footprint`'s steps).
-                unsafe {
-                    texels[0][k] = u32::from_le(*t.get_unchecked(i));
-                    texels[1][k] = u32::from_le(*t.get_unchecked(i + dx));
-                    texels[2][k] = u32::from_le(*t.get_unchecked(i + dy));
-                    texels[3][k] = u32::from_le(*t.get_unchecked(i + dx + dy));
-                }
-            }
-        }
+        let (left, right) = self.corners(place, read);
         let (fx, fy) = (place.fx, place.fy);
         let (gx, gy) = (Vec4::ONE - fx, Vec4::ONE - fy);
         // The corners go in pairs, eight lanes at once: top-left with
@@ -407,10 +383,6 @@ impl<'t> Chain<'t> {
         let mut out = [Vec4::ZERO; N];
         // Channel by channel: its four corners decoded
         // (`Texture::decode`), then blended, a (1 - f) + b f.
-        let (left, right) = (
-            Words8::new(texels[0], texels[2]),
-            Words8::new(texels[1], texels[3]),
-        );
         for (ch, o) in out.iter_mut().enumerate() {
             let shift = 8 * ch as u32;
             let (left, right) = if self.texture.srgb {
@@ -442,6 +414,58 @@ impl<'t> Chain<'t> {
             }
         }
         out
+    }
+
+    /// The four lanes' bilinear footprints in `place`, as stored: the
+    /// left texels (top in lanes 0-3, bottom in lanes 4-7) and the right
+    /// ones; 0 in the lanes not in `read` (bit k: lane k), which read
+    /// nothing.
+    #[inline(always)]
+    fn corners(&self, place: &Place4, read: u32) -> (Words8, Words8) {
+        let right = std::array::from_fn(|k| place.at[k].wrapping_add(place.dx[k]));
+        let first = read.trailing_zeros() as usize;
+        let level = place.level.get(first).map_or(0, |&l| l);
+        let one_level = (0..4).all(|k| read & (1 << k) == 0 || place.level[k] == level);
+        let t = self.texels[level];
+        if read != 0 && one_level && t.len() <= i32::MAX as usize {
+            // SAFETY: an inside lane's footprint has x0 + 1 < width and
+            // y0 + 1 < height in its level (`Place4::new`, for a level of
+            // this size: `read` checks the shape), so its four texels, the
+            // last at at + dx + dy, lie in the level's blocks
+            // (`Level::footprint`'s steps); the read lanes are all in
+            // level `level`, whose length fits an i32.
+            return unsafe {
+                (
+                    Words8::gather_pair(t, place.at, place.dy, read),
+                    Words8::gather_pair(t, right, place.dy, read),
+                )
+            };
+        }
+        // Corner j (top-left, top-right, bottom-left, bottom-right) of
+        // lane k, as stored.
+        let mut texels = [[0u32; 4]; 4];
+        for k in 0..4 {
+            if read & (1 << k) != 0 {
+                let t = self.texels[place.level[k]];
+                let (i, dx, dy) = (
+                    place.at[k] as usize,
+                    place.dx[k] as usize,
+                    place.dy[k] as usize,
+                );
+                debug_assert!(i + dx + dy < t.len());
+                // SAFETY: as above, lane by lane in its own level.
+                unsafe {
+                    texels[0][k] = u32::from_le(*t.get_unchecked(i));
+                    texels[1][k] = u32::from_le(*t.get_unchecked(i + dx));
+                    texels[2][k] = u32::from_le(*t.get_unchecked(i + dy));
+                    texels[3][k] = u32::from_le(*t.get_unchecked(i + dx + dy));
+                }
+            }
+        }
+        (
+            Words8::new(texels[0], texels[2]),
+            Words8::new(texels[1], texels[3]),
+        )
     }
 
     /// Four lanes of which some take anisotropic probes (`each_probe`):

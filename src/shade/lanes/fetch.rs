@@ -222,8 +222,7 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
         // seam, the edge of an atlas chart) and does not count.
         let change = |d: (L, L)| {
             let m = tangent_space(self.normal, frame, self.offset_rgb(i, d, Some(0.0)), scale) - n;
-            let m2 = m.dot(m);
-            L::select(m2.cmpgt(L::splat(SEAM)), zero, m2)
+            counted(m.dot(m))
         };
         change((su, zero)) + change((zero, sv))
     }
@@ -250,6 +249,13 @@ impl<L: Lane> Fetch<L> for LaneFetch<'_, '_, '_, L> {
             }
         }
     }
+}
+
+/// A squared change of the normal in one step as `normal_spread` counts
+/// it: 0 past `SEAM` (a seam), so at most `SEAM` (or NaN).
+#[inline(always)]
+fn counted<L: Lane>(m2: L) -> L {
+    L::select(m2.cmpgt(L::splat(SEAM)), L::splat(0.0), m2)
 }
 
 /// An object-space normal map whose texels are `c` (RGB) at unit normals
@@ -376,6 +382,39 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
             x: L::from_quads(|q| rgb[q][0]),
             y: L::from_quads(|q| rgb[q][1]),
             z: L::from_quads(|q| rgb[q][2]),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `normal_spread` is at most `MAX_SPREAD` whatever the map holds,
+    /// which lets `pbr_color` skip measuring it where no spread could
+    /// pass `FAST_TURN` (the frames are the same either way).
+    #[test]
+    fn a_step_counts_at_most_the_seam() {
+        for m2 in [
+            0.0,
+            0.5,
+            1.0,
+            1.0 + f32::EPSILON,
+            2.0,
+            4.0,
+            f32::MAX,
+            f32::INFINITY,
+        ] {
+            let c = counted(m2);
+            assert!(c <= SEAM, "{m2} counted as {c}");
+            assert!(counted(m2) + counted(m2) <= crate::shade::MAX_SPREAD);
+        }
+        assert!(counted(f32::NAN).is_nan());
+        // Lanes alike: eight at once give each lane's one-lane value.
+        let m2 = crate::simd::F8::from_fn(|k| [0.0, 0.9, 1.0, 1.5, 3.0, 0.25, 8.0, 1e30][k]);
+        let c = counted(m2);
+        for k in 0..8 {
+            assert_eq!(c.lane(k), counted(m2.lane(k)));
         }
     }
 }

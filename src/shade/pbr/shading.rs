@@ -13,7 +13,7 @@ use crate::scene::light::{Light, LightKind};
 use crate::shade::env::reflect::At;
 use crate::shade::env::sampled::{self as env_sampled, Lobes};
 use crate::shade::lanes::{Lanes, Lit};
-use crate::shade::{Fetch, ShadeContext};
+use crate::shade::{Fetch, MAX_SPREAD, ShadeContext};
 use crate::simd::{Lane, Mask, V3, clamp01};
 
 /// Where a normal map's spread (`Fetch::normal_spread`: the squared turn
@@ -372,12 +372,18 @@ impl ShadeContext<'_> {
                 horizon = Some(towards);
                 // The spread is the map's own, before any raising.
                 let lit = !f.light_set(self.lights).is_empty();
-                let spread = (self.env.is_some() || self.env_sampled.is_some() || lit)
+                // Where only `FAST_TURN` reads the spread, lanes whose lobe
+                // no spread can pass (at most 2, `Fetch::normal_spread`)
+                // need no measure.
+                let widens = self.env_sampled.is_some() || lit;
+                let wide = L::splat(FAST_TURN) * c.a2.max(L::splat(MIN_LOBE));
+                let may_be_fast = !wide.cmpge(L::splat(MAX_SPREAD)).all();
+                let spread = (self.env.is_some() && may_be_fast || widens)
                     .then(|| fetch.normal_spread(map, mapped));
                 // Four normals of the pixel: always under `sampled`, and
                 // under `prefiltered` where the map turns fast across it.
                 // Lane by lane, so that every lane width shades alike.
-                fast = spread.map(|s| s.cmpgt(L::splat(FAST_TURN) * c.a2.max(L::splat(MIN_LOBE))));
+                fast = spread.map(|s| s.cmpgt(wide));
                 let any_fast = fast.is_some_and(|m| m.any());
                 if (self.env_sampled.is_some() || any_fast) && c.aniso.is_none() {
                     spread_normals = fetch
@@ -386,7 +392,7 @@ impl ShadeContext<'_> {
                 }
                 // The widened lobe is the lights' and the sampled
                 // environment's: without either, not measured at all.
-                if let Some(spread) = spread.filter(|_| self.env_sampled.is_some() || lit) {
+                if let Some(spread) = spread.filter(|_| widens) {
                     c.widen(spread);
                 }
                 // Tilted by the map, the normal may reflect the view
