@@ -378,7 +378,7 @@ impl ShadeContext<'_> {
                 let widens = self.env_sampled.is_some() || lit;
                 let wide = L::splat(FAST_TURN) * c.a2.max(L::splat(MIN_LOBE));
                 let may_be_fast = !wide.cmpge(L::splat(MAX_SPREAD)).all();
-                let spread = (self.env.is_some() && may_be_fast || widens)
+                let spread = ((self.env.is_some() && may_be_fast) || widens)
                     .then(|| fetch.normal_spread(map, mapped));
                 // Four normals of the pixel: always under `sampled`, and
                 // under `prefiltered` where the map turns fast across it.
