@@ -491,20 +491,26 @@ impl<'a> BandInputs<'a> {
         let n = raw.normalize_or(V3::splat(Vec3::Y));
         let front = L::from_fn(|k| c(k).front as u32 as f32).cmpgt(L::splat(0.0));
         let normal = V3::select(front, n, -n);
+        // The triangles' normals facing the viewer (`ShadeContext::
+        // view_vector`), all lanes at once.
+        let geo = if self.geo_normal {
+            let a = corner3(0, |k| k.world);
+            let g = (corner3(1, |k| k.world) - a)
+                .cross(corner3(2, |k| k.world) - a)
+                .normalize_or(normal);
+            let away = V3::splat(-ctx.forward);
+            let view = if ctx.orthographic {
+                away
+            } else {
+                (V3::splat(ctx.eye) - position).normalize_or(away)
+            };
+            V3::select(g.dot(view).cmplt(L::splat(0.0)), -g, g)
+        } else {
+            normal
+        };
         let mut geo_normal = [Vec3::ZERO; MAX_LANES];
         for (k, g) in geo_normal.iter_mut().enumerate().take(L::WIDTH) {
-            let n = normal.lane(k);
-            *g = if self.geo_normal {
-                let [a, b, cc] = c(k).world;
-                let g = (b - a).cross(cc - a).normalize_or(n);
-                if g.dot(ctx.view_vector(position.lane(k))) < 0.0 {
-                    -g
-                } else {
-                    g
-                }
-            } else {
-                n
-            };
+            *g = geo.lane(k);
         }
         let uv = |set: usize| {
             let at = |j: usize| {

@@ -242,58 +242,42 @@ impl Shadows<'_> {
         }
     }
 
-    /// The lookup at texel coordinates (`fx`, `fy`) of the receiver's
-    /// plane (depth `z` there, `gx`, `gy` per texel, capped at
-    /// `z_per_texel` times the slope cap), by the filter.
-    #[inline]
-    fn filtered(
-        &self,
-        m: &ShadowMap,
-        (fx, fy): (f32, f32),
-        z: f32,
-        (gx, gy): (f32, f32),
-        z_per_texel: f32,
-    ) -> f32 {
-        let size = m.size as f32;
-        // The plane's slope, capped like the slope bias.
-        let cap = z_per_texel * MAX_TAN;
-        // (min/max, not clamp: with extreme geometry cap can be NaN.)
-        let (gx, gy) = (gx.max(-cap).min(cap), gy.max(-cap).min(cap));
-        if !(fx.is_finite() && fy.is_finite()) || fx < 0.0 || fy < 0.0 || fx >= size || fy >= size {
-            return 1.0;
-        }
-        match self.filter {
-            Filter::Hard => hard(m, fx, fy, z, gx, gy),
-            Filter::Pcf => pcf(m, fx, fy, z, gx, gy),
-        }
-    }
-
     /// Fraction of light `i` reaching the four points `p` (geometric unit
     /// normals `ng`, facing the viewer; `l` unit towards the light), for
     /// the lanes k in `lanes` (bit k; the others are 1): 0 in shadow, 1
     /// lit. A surface facing away from the light is in its own shadow. A
     /// map's lookups are placed four at a time (`place4`; a point light's
-    /// cube once per face the lanes look into), then filtered lane by
-    /// lane; rays are cast lane by lane.
+    /// cube once per face the lanes look into), then filtered: by the PCF
+    /// kernel four at once (`pcf4`), by the hard one lane by lane; rays
+    /// are cast lane by lane. No lane in `lanes`: nothing is looked up.
     pub fn visibility4(&self, i: usize, p: V3, ng: &[Vec3; 4], l: V3, lanes: u32) -> Vec4 {
         let mut out = Vec4::ONE;
-        let Some(s) = self.lights.get(i) else {
+        let Some(s) = self.lights.get(i).filter(|_| lanes != 0) else {
             return out;
         };
         let n = V3::from_lanes(*ng);
         let cos = n.dot(l);
         let mut lookup = |m: &ShadowMap, lanes: u32| {
             let placed = self.place4(m, p, n, cos);
-            for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
-                out[k] = if cos[k] <= 0.0 {
-                    0.0
-                } else if placed.before_near & (1 << k) != 0 {
-                    1.0
-                } else {
-                    let at = (placed.fx[k], placed.fy[k]);
-                    let slope = (placed.gx[k], placed.gy[k]);
-                    self.filtered(m, at, placed.z[k], slope, placed.z_per_texel[k])
-                };
+            let k = kernels4(m, &placed);
+            // Facing the light, behind the near plane, inside the map.
+            let read = lanes & !cos.cmple(Vec4::ZERO).bitmask() & !placed.before_near & k.inside;
+            for k in (0..4).filter(|k| lanes & !read & (1 << k) != 0) {
+                out[k] = if cos[k] <= 0.0 { 0.0 } else { 1.0 };
+            }
+            match self.filter {
+                Filter::Pcf if read != 0 => {
+                    let lit = pcf4(m, &k, read);
+                    for k in (0..4).filter(|k| read & (1 << k) != 0) {
+                        out[k] = lit[k];
+                    }
+                }
+                Filter::Pcf => {}
+                Filter::Hard => {
+                    for j in (0..4).filter(|j| read & (1 << j) != 0) {
+                        out[j] = hard(m, (k.fx[j], k.fy[j]), k.z[j], (k.gx[j], k.gy[j]));
+                    }
+                }
             }
         };
         match s {
@@ -461,7 +445,7 @@ fn vector4(m: &Mat4, v: V3) -> V3 {
 /// stored depth is not nearer (greater) than the receiver's plane at its
 /// center.
 #[inline]
-fn hard(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+fn hard(m: &ShadowMap, (fx, fy): (f32, f32), z: f32, (gx, gy): (f32, f32)) -> f32 {
     let n = m.size as i32;
     let (ix, iy) = (fx as i32, fy as i32);
     let (cx, cy) = (ix.clamp(0, n - 1), iy.clamp(0, n - 1));
@@ -470,63 +454,130 @@ fn hard(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     if stored <= zr { 1.0 } else { 0.0 }
 }
 
-/// The PCF kernel at texel coordinates (`fx`, `fy`) inside the map: the
-/// lit fraction of a 3x3-texel box, each texel compared with the
-/// receiver's plane (depth `z` at the point, `gx`, `gy` per texel).
+/// Where four lookups read a map (`kernels4`): per lane, texel
+/// coordinates, the receiver plane's depth there and its slopes per
+/// texel, capped; the lanes inside the map (bit k: lane k).
+struct Kernels4 {
+    fx: Vec4,
+    fy: Vec4,
+    z: Vec4,
+    gx: Vec4,
+    gy: Vec4,
+    inside: u32,
+}
+
+/// The kernels of four lookups placed in `m` (`Shadows::place4`): the
+/// plane's slopes capped at `z_per_texel` times the slope cap (`f32`'s
+/// max and min: a NaN cap, from extreme geometry, caps nothing), and the
+/// lanes whose point lies inside the map (the others are lit).
 #[inline]
-fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
-    let n = m.size as i32;
-    // Box [f - 1.5, f + 1.5] per axis; texel i covers [i, i+1].
-    let (bx, by) = (floor_i32(fx - 1.5), floor_i32(fy - 1.5));
-    let w = |i: i32, f: f32| {
-        let lo = (i as f32).max(f - 1.5);
-        let hi = (i as f32 + 1.0).min(f + 1.5);
-        (hi - lo).max(0.0) / 3.0
-    };
-    let wx = [0, 1, 2, 3].map(|k| w(bx + k, fx));
-    let wy = [0, 1, 2, 3].map(|k| w(by + k, fy));
-    // `lit` over the 4x4 texels, its terms hoisted: the
-    // receiver's depth at texel (i, j) is (z + tx[i]) + ty[j]
-    // (the same sums, in the same order). A zero weight adds
-    // nothing, so every texel is read (clamped to the map).
-    // Four columns at once: per row the products
-    // wx[i] * (0 or 1) (= wx[i] or +0), summed along the row
-    // from 0 in column order, then the rows weighted and
-    // summed from 0 in row order, as one texel at a time.
-    let xs = lanes4(bx as f32, (bx + 1) as f32, (bx + 2) as f32, (bx + 3) as f32);
-    let ztx = Vec4::splat(z) + Vec4::splat(gx) * (xs + Vec4::splat(0.5) - Vec4::splat(fx));
-    let wxv = Vec4::from(wx);
-    let inside = bx >= 0 && bx + 3 < n;
-    let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
-    // Where nothing was drawn under the 4x4 texels they are all 0: not
-    // read (the same values; the reads would mostly miss the cache).
-    let (r0, r3) = (
-        by.clamp(0, n - 1) as usize,
-        (by + 3).clamp(0, n - 1) as usize,
-    );
-    let clear = m.drawn.clear_box(cols[0], cols[3], r0, r3);
-    let mut p = [Vec4::ZERO; 4];
-    for (j, pj) in p.iter_mut().enumerate() {
-        let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
-        let stored = if clear {
-            Vec4::ZERO
-        } else if inside {
-            let at = base + bx as usize;
-            Vec4::from_slice(&m.depth[at..at + 4])
-        } else {
-            let d = |i: usize| m.depth[base + cols[i]];
-            lanes4(d(0), d(1), d(2), d(3))
-        };
-        let ty = gy * ((by + j as i32) as f32 + 0.5 - fy);
-        let zr = ztx + Vec4::splat(ty);
-        *pj = Vec4::select(stored.cmple(zr), wxv, Vec4::ZERO);
+fn kernels4(m: &ShadowMap, p: &Placed4) -> Kernels4 {
+    let cap = p.z_per_texel * Vec4::splat(MAX_TAN);
+    // `f32::max`, `f32::min`: a NaN lane takes the other operand (the
+    // sign of a zero may differ; it only enters sums compared with <=).
+    let max = |a: Vec4, b: Vec4| Vec4::select(b.is_nan_mask(), a, a.max(b));
+    let min = |a: Vec4, b: Vec4| Vec4::select(b.is_nan_mask(), a, a.min(b));
+    let size = Vec4::splat(m.size as f32);
+    let inside = p.fx.is_finite_mask()
+        & p.fy.is_finite_mask()
+        & p.fx.cmpge(Vec4::ZERO)
+        & p.fy.cmpge(Vec4::ZERO)
+        & p.fx.cmplt(size)
+        & p.fy.cmplt(size);
+    Kernels4 {
+        fx: p.fx,
+        fy: p.fy,
+        z: p.z,
+        gx: min(max(p.gx, -cap), cap),
+        gy: min(max(p.gy, -cap), cap),
+        inside: inside.bitmask(),
     }
-    // Columns of the rows' products: lane j of c[i] is row j's
-    // term i.
-    let c = Mat4::from_cols(p[0], p[1], p[2], p[3]).transpose();
-    let rows = (((Vec4::ZERO + c.x_axis) + c.y_axis) + c.z_axis) + c.w_axis;
-    let t = Vec4::from(wy) * rows;
-    (((0.0 + t.x) + t.y) + t.z) + t.w
+}
+
+/// The PCF kernel of the lanes in `live` (bit k: lane k, of `k`), four
+/// at a time; the other lanes' values are unspecified. Per lane: the lit
+/// fraction of a 3x3-texel box around (`fx`, `fy`), each texel compared
+/// with the receiver's plane (depth `z` at the point, `gx`, `gy` per
+/// texel). The box covers 4x4 texels, the outer ones in part. Each lane
+/// takes the same sums in the same order as it would alone: per row the
+/// products wx[i] * (0 or 1) (= wx[i] or +0) summed along the row from 0
+/// in column order, then the rows weighted and summed from 0 in row order.
+#[inline]
+fn pcf4(m: &ShadowMap, k: &Kernels4, live: u32) -> Vec4 {
+    let n = m.size as i32;
+    let sp = Vec4::splat;
+    let (fx, fy, z, gx, gy) = (k.fx, k.fy, k.z, k.gx, k.gy);
+    // Per lane the box's first texel column and row: [f - 1.5, f + 1.5]
+    // per axis, texel i covering [i, i + 1].
+    let corner: [(i32, i32); 4] =
+        std::array::from_fn(|k| (floor_i32(fx[k] - 1.5), floor_i32(fy[k] - 1.5)));
+    // Per row j and lane k, the 4 texels the box reads (clamped to the
+    // map). Where nothing was drawn under them they are all 0: not read
+    // (the same values; the reads would mostly miss the cache).
+    let mut rows = [[Vec4::ZERO; 4]; 4];
+    for k in (0..4).filter(|k| live & (1 << k) != 0) {
+        let (bx, by) = corner[k];
+        let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
+        let (r0, r3) = (
+            by.clamp(0, n - 1) as usize,
+            (by + 3).clamp(0, n - 1) as usize,
+        );
+        if m.drawn.clear_box(cols[0], cols[3], r0, r3) {
+            continue;
+        }
+        let inside = bx >= 0 && bx + 3 < n;
+        for (j, row) in rows.iter_mut().enumerate() {
+            let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
+            row[k] = if inside {
+                let at = base + bx as usize;
+                Vec4::from_slice(&m.depth[at..at + 4])
+            } else {
+                let d = |i: usize| m.depth[base + cols[i]];
+                lanes4(d(0), d(1), d(2), d(3))
+            };
+        }
+    }
+    // The corners as floats (exact: integers far below 2^24), so column
+    // i of the box is bx + i per lane.
+    let bx = Vec4::from_array(corner.map(|c| c.0 as f32));
+    let by = Vec4::from_array(corner.map(|c| c.1 as f32));
+    let w = |i: Vec4, f: Vec4| {
+        let lo = i.max(f - sp(1.5));
+        let hi = (i + sp(1.0)).min(f + sp(1.5));
+        (hi - lo).max(Vec4::ZERO) / sp(3.0)
+    };
+    let xs = [0.0, 1.0, 2.0, 3.0].map(|i| bx + sp(i));
+    let wx = xs.map(|x| w(x, fx));
+    // The receiver's depth at texel (i, j) is (z + tx[i]) + ty[j].
+    let ztx = xs.map(|x| z + gx * ((x + sp(0.5)) - fx));
+    let mut sum = Vec4::ZERO;
+    for (j, row) in rows.iter().enumerate() {
+        let y = by + sp(j as f32);
+        let ty = gy * ((y + sp(0.5)) - fy);
+        // Lane k of `stored.x_axis` is lane k's texel in column 0.
+        let stored = Mat4::from_cols(row[0], row[1], row[2], row[3]).transpose();
+        let term = |i: usize, s: Vec4| Vec4::select(s.cmple(ztx[i] + ty), wx[i], Vec4::ZERO);
+        let along = (((Vec4::ZERO + term(0, stored.x_axis)) + term(1, stored.y_axis))
+            + term(2, stored.z_axis))
+            + term(3, stored.w_axis);
+        sum += w(y, fy) * along;
+    }
+    sum
+}
+
+/// `pcf4` of one lane.
+#[cfg(test)]
+fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+    let sp = Vec4::splat;
+    let k = Kernels4 {
+        fx: sp(fx),
+        fy: sp(fy),
+        z: sp(z),
+        gx: sp(gx),
+        gy: sp(gy),
+        inside: 1,
+    };
+    pcf4(m, &k, 1)[0]
 }
 
 /// `x.floor() as i32` for x in [-2^31, 2^31) (the PCF box's corner, from
