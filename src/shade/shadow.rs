@@ -259,23 +259,24 @@ impl Shadows<'_> {
         let cos = n.dot(l);
         let mut lookup = |m: &ShadowMap, lanes: u32| {
             let placed = self.place4(m, p, n, cos);
-            let k = kernels4(m, &placed);
-            // Facing the light, behind the near plane, inside the map.
-            let read = lanes & !cos.cmple(Vec4::ZERO).bitmask() & !placed.before_near & k.inside;
+            let at = kernels4(m, &placed);
+            // The lanes that read the map: facing the light, beyond the
+            // near plane, inside the map. The others: 0 facing away, else 1.
+            let read = lanes & !cos.cmple(Vec4::ZERO).bitmask() & !placed.before_near & at.inside;
             for k in (0..4).filter(|k| lanes & !read & (1 << k) != 0) {
                 out[k] = if cos[k] <= 0.0 { 0.0 } else { 1.0 };
             }
             match self.filter {
                 Filter::Pcf if read != 0 => {
-                    let lit = pcf4(m, &k, read);
+                    let lit = pcf4(m, &at, read);
                     for k in (0..4).filter(|k| read & (1 << k) != 0) {
                         out[k] = lit[k];
                     }
                 }
                 Filter::Pcf => {}
                 Filter::Hard => {
-                    for j in (0..4).filter(|j| read & (1 << j) != 0) {
-                        out[j] = hard(m, (k.fx[j], k.fy[j]), k.z[j], (k.gx[j], k.gy[j]));
+                    for k in (0..4).filter(|k| read & (1 << k) != 0) {
+                        out[k] = hard(m, (at.fx[k], at.fy[k]), at.z[k], (at.gx[k], at.gy[k]));
                     }
                 }
             }
@@ -494,7 +495,7 @@ fn kernels4(m: &ShadowMap, p: &Placed4) -> Kernels4 {
     }
 }
 
-/// The PCF kernel of the lanes in `live` (bit k: lane k, of `k`), four
+/// The PCF kernel of the lanes in `live` (bit k: lane k of `at`), four
 /// at a time; the other lanes' values are unspecified. Per lane: the lit
 /// fraction of a 3x3-texel box around (`fx`, `fy`), each texel compared
 /// with the receiver's plane (depth `z` at the point, `gx`, `gy` per
@@ -503,10 +504,10 @@ fn kernels4(m: &ShadowMap, p: &Placed4) -> Kernels4 {
 /// products wx[i] * (0 or 1) (= wx[i] or +0) summed along the row from 0
 /// in column order, then the rows weighted and summed from 0 in row order.
 #[inline]
-fn pcf4(m: &ShadowMap, k: &Kernels4, live: u32) -> Vec4 {
+fn pcf4(m: &ShadowMap, at: &Kernels4, live: u32) -> Vec4 {
     let n = m.size as i32;
     let sp = Vec4::splat;
-    let (fx, fy, z, gx, gy) = (k.fx, k.fy, k.z, k.gx, k.gy);
+    let (fx, fy, z, gx, gy) = (at.fx, at.fy, at.z, at.gx, at.gy);
     // Per lane the box's first texel column and row: [f - 1.5, f + 1.5]
     // per axis, texel i covering [i, i + 1].
     let corner: [(i32, i32); 4] =
@@ -529,8 +530,8 @@ fn pcf4(m: &ShadowMap, k: &Kernels4, live: u32) -> Vec4 {
         for (j, row) in rows.iter_mut().enumerate() {
             let base = (by + j as i32).clamp(0, n - 1) as usize * n as usize;
             row[k] = if inside {
-                let at = base + bx as usize;
-                Vec4::from_slice(&m.depth[at..at + 4])
+                let first = base + bx as usize;
+                Vec4::from_slice(&m.depth[first..first + 4])
             } else {
                 let d = |i: usize| m.depth[base + cols[i]];
                 lanes4(d(0), d(1), d(2), d(3))
@@ -569,7 +570,7 @@ fn pcf4(m: &ShadowMap, k: &Kernels4, live: u32) -> Vec4 {
 #[cfg(test)]
 fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
     let sp = Vec4::splat;
-    let k = Kernels4 {
+    let at = Kernels4 {
         fx: sp(fx),
         fy: sp(fy),
         z: sp(z),
@@ -577,7 +578,7 @@ fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
         gy: sp(gy),
         inside: 1,
     };
-    pcf4(m, &k, 1)[0]
+    pcf4(m, &at, 1)[0]
 }
 
 /// `x.floor() as i32` for x in [-2^31, 2^31) (the PCF box's corner, from
@@ -802,11 +803,13 @@ mod tests {
         assert!(marked.drawn.fits(n as u32) && !other.drawn.fits(n as u32));
         let mut lit = 0;
         let mut seen = std::collections::HashSet::new();
+        let mut points = Vec::new();
         for k in 0..4000 {
             let fx = (k % 80) as f32 * 0.83 - 1.2;
             let fy = (k / 80) as f32 * 1.37 - 1.7;
             let (fx, fy) = (fx.clamp(0.0, 63.99), fy.clamp(0.0, 63.99));
             let z = 0.25 + 0.05 * (k % 5) as f32;
+            points.push((fx, fy, z));
             let (a, b) = (
                 pcf(&marked, fx, fy, z, 0.001, -0.002),
                 pcf(&all, fx, fy, z, 0.001, -0.002),
@@ -829,6 +832,109 @@ mod tests {
             "{lit} partial, {} values",
             seen.len()
         );
+        // Four lanes at once, each at another point (lanes in clear
+        // tiles beside lanes that read, some lanes left out): each live
+        // lane is its own lookup. The points are taken out of order so
+        // that a group's lanes lie far apart.
+        let order: Vec<usize> = (0..points.len()).map(|i| i * 37 % points.len()).collect();
+        for (g, group) in order.chunks_exact(4).enumerate() {
+            let lane = |f: fn(&(f32, f32, f32)) -> f32| {
+                Vec4::from_array([0, 1, 2, 3].map(|k| f(&points[group[k]])))
+            };
+            let at = Kernels4 {
+                fx: lane(|p| p.0),
+                fy: lane(|p| p.1),
+                z: lane(|p| p.2),
+                gx: Vec4::splat(0.001),
+                gy: Vec4::splat(-0.002),
+                inside: 0b1111,
+            };
+            let live = [0b1111, 0b0101, 0b1000, 0b0110][g % 4];
+            let got = pcf4(&marked, &at, live);
+            for k in (0..4).filter(|k| live & (1 << k) != 0) {
+                let (fx, fy, z) = points[group[k]];
+                let want = pcf(&marked, fx, fy, z, 0.001, -0.002);
+                assert_eq!(got[k].to_bits(), want.to_bits(), "lane {k} at {fx} {fy}");
+            }
+        }
+    }
+
+    /// The four lanes' kernels (`kernels4`) cap the slopes as `f32::max`
+    /// and `f32::min` do, lane by lane (a NaN takes the other operand; a
+    /// zero's sign aside), and take the lanes inside the map as the
+    /// one-lane test does, at NaN, infinite, negative, edge and inside
+    /// coordinates and NaN, infinite and zero caps and slopes.
+    #[test]
+    fn four_kernels_cap_and_test_as_one_lane_does() {
+        let m = map();
+        let size = m.size as f32;
+        let coords = [
+            f32::NAN,
+            f32::INFINITY,
+            -f32::INFINITY,
+            -0.5,
+            -0.0,
+            0.0,
+            3.3,
+            size - 1e-4,
+            size,
+            9.0,
+        ];
+        let values = [
+            f32::NAN,
+            f32::INFINITY,
+            -f32::INFINITY,
+            -2.0,
+            -0.0,
+            0.0,
+            0.07,
+            1e30,
+        ];
+        let caps = [f32::NAN, f32::INFINITY, 0.0, 0.01, 3.0];
+        let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
+        let mut i = 0usize;
+        for &zpt in &caps {
+            for _ in 0..200 {
+                let pick =
+                    |set: &[f32], k: usize| set[(i * 7 + k * 13 + i / set.len()) % set.len()];
+                let lanes = |set: &[f32], s: usize| {
+                    Vec4::from_array([0, 1, 2, 3].map(|k| pick(set, k + s)))
+                };
+                let placed = Placed4 {
+                    before_near: 0,
+                    fx: lanes(&coords, 0),
+                    fy: lanes(&coords, 5),
+                    z: Vec4::splat(0.5),
+                    gx: lanes(&values, 2),
+                    gy: lanes(&values, 7),
+                    z_per_texel: Vec4::splat(zpt),
+                };
+                i += 1;
+                let at = kernels4(&m, &placed);
+                for k in 0..4 {
+                    let cap = zpt * MAX_TAN;
+                    let (gx, gy) = (placed.gx[k], placed.gy[k]);
+                    let (wx, wy) = (gx.max(-cap).min(cap), gy.max(-cap).min(cap));
+                    assert!(
+                        same(at.gx[k], wx),
+                        "gx {gx} cap {cap}: {} not {wx}",
+                        at.gx[k]
+                    );
+                    assert!(
+                        same(at.gy[k], wy),
+                        "gy {gy} cap {cap}: {} not {wy}",
+                        at.gy[k]
+                    );
+                    let (fx, fy) = (placed.fx[k], placed.fy[k]);
+                    let outside = !(fx.is_finite() && fy.is_finite())
+                        || fx < 0.0
+                        || fy < 0.0
+                        || fx >= size
+                        || fy >= size;
+                    assert_eq!(at.inside & (1 << k) != 0, !outside, "at {fx} {fy}");
+                }
+            }
+        }
     }
 
     /// A perspective map (a spot light's, or a cube face's) of `n` x `n`
