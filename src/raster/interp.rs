@@ -50,13 +50,24 @@ impl Interpolator {
     #[inline]
     pub fn at_pixel(&self, px: i32, py: i32) -> Fragment {
         let (x, y) = (px as i64, py as i64);
-        let e = &self.edges;
-        let g = [
-            e[0].at(x, y) as f64 * self.inv_w[0],
-            e[1].at(x, y) as f64 * self.inv_w[1],
-            e[2].at(x, y) as f64 * self.inv_w[2],
-        ];
-        self.finish(g)
+        let [f] = self.finish(self.edges.map(|e| [e.at(x, y)]));
+        f
+    }
+
+    /// At the centers of the 2x2 quad whose top-left pixel is (px, py), in
+    /// reading order, with whether the triangle covers each center: what
+    /// `at_pixel` and `covers_center` give at each pixel, the edge values
+    /// stepped by `a` and `b` (the same integers) and the rest four lanes
+    /// at a time.
+    #[inline]
+    pub fn at_quad(&self, px: i32, py: i32) -> ([Fragment; 4], [bool; 4]) {
+        let (x, y) = (px as i64, py as i64);
+        let e = self.edges.map(|e| {
+            let e0 = e.at(x, y);
+            [e0, e0 + e.a, e0 + e.b, e0 + e.a + e.b]
+        });
+        let covers = std::array::from_fn(|p| (0..3).all(|k| e[k][p] + self.edges[k].bias >= 0));
+        (self.finish(e), covers)
     }
 
     /// Whether the center of pixel (px, py) is inside the triangle (top-left
@@ -74,30 +85,38 @@ impl Interpolator {
             let e = &self.edges[k];
             e.a as f64 * (x - 0.5) + e.b as f64 * (y - 0.5) + e.c as f64
         };
-        self.finish([
-            e(0) * self.inv_w[0],
-            e(1) * self.inv_w[1],
-            e(2) * self.inv_w[2],
-        ])
+        let [f] = self.finish_g([0, 1, 2].map(|k| [e(k) * self.inv_w[k]]));
+        f
     }
 
-    #[inline]
-    fn finish(&self, g: [f64; 3]) -> Fragment {
-        let sum = g[0] + g[1] + g[2];
-        let inv = 1.0 / sum;
-        let k = [g[0] * inv, g[1] * inv, g[2] * inv];
-        let lambda = match &self.bary {
-            None => Vec3::new(k[0] as f32, k[1] as f32, k[2] as f32),
-            Some(b) => {
-                let lam = |c: usize| k[0] * b[0][c] + k[1] * b[1][c] + k[2] * b[2][c];
-                Vec3::new(lam(0) as f32, lam(1) as f32, lam(2) as f32)
-            }
+    /// From integer edge values, per lane.
+    #[inline(always)]
+    fn finish<const N: usize>(&self, e: [[i64; N]; 3]) -> [Fragment; N] {
+        self.finish_g([0, 1, 2].map(|k| e[k].map(|e| e as f64 * self.inv_w[k])))
+    }
+
+    /// From the edge values over w (`g`), per lane: each lane computes
+    /// alone what one fragment would.
+    #[inline(always)]
+    fn finish_g<const N: usize>(&self, g: [[f64; N]; 3]) -> [Fragment; N] {
+        let sum: [f64; N] = std::array::from_fn(|p| g[0][p] + g[1][p] + g[2][p]);
+        let inv = sum.map(|s| 1.0 / s);
+        let k: [[f64; N]; 3] = g.map(|g| std::array::from_fn(|p| g[p] * inv[p]));
+        let lambda: [[f64; N]; 3] = match &self.bary {
+            None => k,
+            Some(b) => std::array::from_fn(|c| {
+                std::array::from_fn(|p| k[0][p] * b[0][c] + k[1][p] * b[1][c] + k[2][p] * b[2][c])
+            }),
         };
-        Fragment {
-            lambda,
+        std::array::from_fn(|p| Fragment {
+            lambda: Vec3::new(
+                lambda[0][p] as f32,
+                lambda[1][p] as f32,
+                lambda[2][p] as f32,
+            ),
             // sum = area2 * (1/w) interpolated, in edge-function units.
-            w: (self.area2 / sum) as f32,
-        }
+            w: (self.area2 / sum[p]) as f32,
+        })
     }
 }
 
@@ -145,5 +164,75 @@ mod tests {
             assert!((a.w - b.w).abs() < 1e-5 * a.w.abs());
             assert!((a.lambda.element_sum() - 1.0).abs() < 1e-5);
         }
+    }
+
+    /// `at_quad` steps the edge values and works four lanes at a time;
+    /// each of its pixels must be bit for bit what `at_pixel` and
+    /// `covers_center` give there, on clipped and unclipped triangles,
+    /// inside, on the edges of and far outside them.
+    #[test]
+    fn a_quad_is_its_four_pixels() {
+        let mut seed = 0x2545_f491_u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let vp = Viewport {
+            width: 64,
+            height: 48,
+            msaa: true,
+        };
+        let (mut tested, mut on_edge) = ([0; 2], 0);
+        for i in 0..300 {
+            // The first third's corners on pixel centers (w a power of
+            // two), so that edges run through centers: the top-left rule.
+            let snap = i < 100;
+            // Unclipped (the identity) or a part of a clipped triangle.
+            let b = if rnd() < 0.5 {
+                Vec3::X
+            } else {
+                Vec3::new(0.2, 0.3, 0.5)
+            };
+            let mut v = |b: Vec3| {
+                let (w, x, y) = if snap {
+                    let center = |n: f32, r: f32| ((n * r).floor() + 0.5) / (n / 2.0) - 1.0;
+                    let w = [0.5, 1.0, 2.0, 4.0][(4.0 * rnd()) as usize % 4];
+                    (w, center(64.0, rnd()), center(48.0, rnd()))
+                } else {
+                    (0.2 + 8.0 * rnd(), 2.4 * rnd() - 1.2, 2.4 * rnd() - 1.2)
+                };
+                ClipVertex {
+                    pos: Vec4::new(x * w, y * w, 0.5 * w, w),
+                    bary: b,
+                }
+            };
+            let corners = [v(b), v(Vec3::Y), v(Vec3::Z)];
+            let Some(t) = setup(corners, vp, CullMode::None, 0, 0) else {
+                continue;
+            };
+            let it = Interpolator::new(&t);
+            tested[it.bary.is_some() as usize] += 1;
+            for py in (-3..52).step_by(3) {
+                for px in (-5..70).step_by(3) {
+                    let (f, covered) = it.at_quad(px, py);
+                    let pixels = [(px, py), (px + 1, py), (px, py + 1), (px + 1, py + 1)];
+                    for (k, (x, y)) in pixels.into_iter().enumerate() {
+                        let one = it.at_pixel(x, y);
+                        assert_eq!(
+                            f[k].lambda.to_array().map(f32::to_bits),
+                            one.lambda.to_array().map(f32::to_bits)
+                        );
+                        assert_eq!(f[k].w.to_bits(), one.w.to_bits());
+                        assert_eq!(covered[k], it.covers_center(x, y), "({x}, {y})");
+                        let (x, y) = (x as i64, y as i64);
+                        on_edge += it.edges.iter().any(|e| e.at(x, y) + e.bias == 0) as u32;
+                    }
+                }
+            }
+        }
+        assert!(tested[0] > 50 && tested[1] > 50, "{tested:?}");
+        assert!(on_edge > 100, "{on_edge}");
     }
 }

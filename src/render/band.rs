@@ -32,6 +32,20 @@ use crate::shade::ao::GPixel;
 use crate::shade::lanes::{Footprints, LaneMaterial};
 use crate::shade::light::LightMask;
 
+/// A worker thread's buffers for `shade_visible`, kept from band to band
+/// (grown anew in each band, they cost 1% of an MSAA frame's
+/// instructions): the lane results kept by slot, and the pixels resolved
+/// after the lanes, with their fragments.
+#[derive(Default)]
+struct Scratch {
+    shaded: Vec<(Vec3, f32)>,
+    deferred: Vec<(usize, smallvec::SmallVec<[PixelShare; 4]>)>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::Cell<Scratch> = std::cell::Cell::new(Scratch::default());
+}
+
 impl<'a> BandInputs<'a> {
     /// Visibility of band `ti` (pixels `rect`): the nearest opaque or
     /// alpha-tested triangle per pixel, and the blended triangles to
@@ -341,14 +355,17 @@ impl<'a> BandInputs<'a> {
         let empty_at = |i: usize| empty(vis, i);
         let (spans, drawn) = self.fill_background(vis, filled, known, color, depth);
         let lanes = &mut LaneBatches::new(self.draws.len(), self.lane_width);
-        let mut shaded = Vec::new();
+        // (Taken, so that a band shaded within this one on the same
+        // thread finds none and makes its own.)
+        let mut scratch = SCRATCH.take();
+        let Scratch { shaded, deferred } = &mut scratch;
+        shaded.clear();
         let sink = &mut Sink {
             color: &mut *color,
             depth: &mut *depth,
-            shaded: &mut shaded,
+            shaded,
             inv_n,
         };
-        let mut deferred: Vec<(usize, smallvec::SmallVec<[PixelShare; 4]>)> = Vec::new();
         for qy in (0..th).step_by(2) {
             let below = spans.get(qy + 1).copied().unwrap_or((usize::MAX, 0));
             let (x0, x1) = (spans[qy].0.min(below.0), spans[qy].1.max(below.1));
@@ -425,9 +442,10 @@ impl<'a> BandInputs<'a> {
         }
         // The lanes' last groups, then the pixels that wait for them.
         lanes.finish(self, sink);
-        for (i, parts) in deferred {
+        for (i, parts) in deferred.drain(..) {
             (sink.color[i], sink.depth[i]) = resolve(&parts, sink.shaded, inv_n);
         }
+        SCRATCH.set(scratch);
         // Over a flat background, the pixels outside the drawn columns
         // were filled with it above, and no quad reaches them.
         filled.then_some(PlainBackground {

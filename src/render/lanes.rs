@@ -726,10 +726,10 @@ impl<'a> BandInputs<'a> {
         let (it, t) = (q.it, q.t);
         let (x, y) = q.q0;
         let px = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
-        let centers = px.map(|(x, y)| it.at_pixel(x, y));
+        let (centers, covered) = it.at_quad(x, y);
         // With MSAA the shading point leaves a center the triangle does not
         // cover (`shading_point`); the derivatives stay the centers'.
-        let f = if self.pattern.len() == 1 {
+        let f = if self.pattern.len() == 1 || covered == [true; 4] {
             centers
         } else {
             // `shading_point`: the center where the triangle covers it
@@ -737,7 +737,7 @@ impl<'a> BandInputs<'a> {
             let all = (1u32 << self.pattern.len()) - 1;
             [0, 1, 2, 3].map(|k| {
                 let (x, y) = px[k];
-                if it.covers_center(x, y) {
+                if covered[k] {
                     centers[k]
                 } else {
                     self.shading_point(it, x, y, all)
