@@ -70,6 +70,14 @@ impl Interpolator {
         (self.finish(e), covers)
     }
 
+    /// Which of `at_quad(q0)`'s four results is pixel (px, py)'s (a pixel
+    /// of that quad).
+    #[inline(always)]
+    pub fn quad_lane(q0: (i32, i32), px: i32, py: i32) -> usize {
+        debug_assert!((0..2).contains(&(px - q0.0)) && (0..2).contains(&(py - q0.1)));
+        ((px - q0.0) + 2 * (py - q0.1)) as usize
+    }
+
     /// Whether the center of pixel (px, py) is inside the triangle (top-left
     /// rule).
     #[inline]
@@ -169,7 +177,8 @@ mod tests {
     /// `at_quad` steps the edge values and works four lanes at a time;
     /// each of its pixels must be bit for bit what `at_pixel` and
     /// `covers_center` give there, on clipped and unclipped triangles,
-    /// inside, on the edges of and far outside them.
+    /// inside, on the edges of and far outside them; `quad_lane` names
+    /// which result is which pixel's.
     #[test]
     fn a_quad_is_its_four_pixels() {
         let mut seed = 0x2545_f491_u32;
@@ -217,8 +226,9 @@ mod tests {
             for py in (-3..52).step_by(3) {
                 for px in (-5..70).step_by(3) {
                     let (f, covered) = it.at_quad(px, py);
-                    let pixels = [(px, py), (px + 1, py), (px, py + 1), (px + 1, py + 1)];
-                    for (k, (x, y)) in pixels.into_iter().enumerate() {
+                    let pixels = [(px + 1, py + 1), (px, py + 1), (px + 1, py), (px, py)];
+                    for (x, y) in pixels {
+                        let k = Interpolator::quad_lane((px, py), x, y);
                         let one = it.at_pixel(x, y);
                         assert_eq!(
                             f[k].lambda.to_array().map(f32::to_bits),

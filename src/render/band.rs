@@ -601,19 +601,39 @@ impl<'a> BandInputs<'a> {
         let k = match quad.iter().position(|q| q.id == id) {
             Some(k) => k,
             None => {
-                let grads = self.lane_gradients(lm, t, it, at.q0);
+                // The triangle at the quad's four centres, kept: the
+                // derivatives are taken between the first three, and the
+                // pixels it covers are shaded there.
+                let centers = self.wants_gradients().then(|| it.at_quad(at.q0.0, at.q0.1));
+                let grads = match &centers {
+                    Some((c, _)) => self.lane_gradients_at(lm, t, &[c[0], c[1], c[2]]),
+                    None => [Gradients::default(); 2],
+                };
                 let footprints = lm.footprints(&self.ctx, grads);
                 quad.push(QuadEntry {
                     id,
                     grads,
                     footprints,
+                    centers,
                 });
                 quad.len() - 1
             }
         };
         let (px, py) = at.px;
-        let frag = self.shading_point(it, px, py, mask);
         let q = &quad[k];
+        // `shading_point`: at the centre where the triangle covers it
+        // (`at_pixel`, or the same value kept), else the centroid.
+        let frag = match q.centers {
+            Some((c, covers)) => {
+                let k = Interpolator::quad_lane(at.q0, px, py);
+                if self.pattern.len() == 1 || covers[k] {
+                    c[k]
+                } else {
+                    self.centroid_point(it, px, py, mask)
+                }
+            }
+            None => self.shading_point(it, px, py, mask),
+        };
         let p = Pending {
             id,
             pixel: 0,
@@ -665,6 +685,10 @@ struct QuadEntry {
     id: u32,
     grads: [Gradients; 2],
     footprints: Footprints,
+    /// The triangle at the quad's four centres and whether it covers
+    /// each (`Interpolator::at_quad`), where the derivatives were taken
+    /// (their first three).
+    centers: Option<([Fragment; 4], [bool; 4])>,
 }
 
 /// Where `BandInputs::fragment` shades: the pixel's position and its

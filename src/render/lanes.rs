@@ -475,9 +475,19 @@ impl<'a> BandInputs<'a> {
         let d = self.draws[p.draw];
         let mesh = &self.setup.scene.models[d.model].mesh;
         let ctx = &self.ctx;
-        let c = |k: usize| corners[at + k];
         let l = V3::<L>::from_fn(|k| p.lambda[at + k]);
-        let corner3 = |j: usize, f: fn(&Corners) -> [Vec3; 3]| V3::<L>::from_fn(|k| f(c(k))[j]);
+        // Whether each quad of lanes holds one triangle's corners (a
+        // quad's pixels): then each value is loaded once per quad.
+        let by_quad = (0..L::QUADS).all(|q| {
+            let first = corners[at + 4 * q];
+            (1..L::WIDTH.min(4)).all(|k| std::ptr::eq(first, corners[at + 4 * q + k]))
+        });
+        let of = (corners, at, by_quad);
+        let corner3 = |j: usize, f: fn(&Corners) -> [Vec3; 3]| V3::<L> {
+            x: lanes_of(of, |c| f(c)[j].x),
+            y: lanes_of(of, |c| f(c)[j].y),
+            z: lanes_of(of, |c| f(c)[j].z),
+        };
         let lerp =
             |f: fn(&Corners) -> [Vec3; 3]| lerp3(corner3(0, f), corner3(1, f), corner3(2, f), l);
         let position = lerp(|k| k.world);
@@ -489,7 +499,7 @@ impl<'a> BandInputs<'a> {
         };
         let raw = lerp(|k| k.normal);
         let n = raw.normalize_or(V3::splat(Vec3::Y));
-        let front = L::from_fn(|k| c(k).front as u32 as f32).cmpgt(L::splat(0.0));
+        let front = lanes_of::<L>(of, |c| c.front as u32 as f32).cmpgt(L::splat(0.0));
         let normal = V3::select(front, n, -n);
         // The triangles' normals facing the viewer (`ShadeContext::
         // view_vector`), all lanes at once.
@@ -514,8 +524,8 @@ impl<'a> BandInputs<'a> {
         }
         let uv = |set: usize| {
             let at = |j: usize| {
-                let u = L::from_fn(|k| c(k).uv[set][j].x);
-                (u, L::from_fn(|k| c(k).uv[set][j].y))
+                let u = lanes_of::<L>(of, |c| c.uv[set][j].x);
+                (u, lanes_of::<L>(of, |c| c.uv[set][j].y))
             };
             let ((u0, v0), (u1, v1), (u2, v2)) = (at(0), at(1), at(2));
             (
@@ -547,7 +557,7 @@ impl<'a> BandInputs<'a> {
         let coords = Coords {
             uv: lm.coords([uv0, uv1]),
             tangent,
-            sign: L::from_fn(|k| c(k).tangent[0].w),
+            sign: lanes_of::<L>(of, |c| c.tangent[0].w),
             normal_from_object: self.verts[d.model].normal_from_object,
             back: normal.dot(raw).cmplt(L::splat(0.0)),
             footprints: &p.footprints,
@@ -720,7 +730,7 @@ impl<'a> BandInputs<'a> {
     /// The four pixels of the quad `q`, all of one triangle, one sample
     /// each, in reading order, ready for the lanes (lanes 4 .. 8 repeat
     /// them). The quad's texture derivatives are its lanes' differences
-    /// (what `gradients0` computes).
+    /// (what `gradients0_at` computes).
     #[inline(always)]
     pub(super) fn prepare_quad(&self, q: &QuadAt, corners: &Corners) -> Prepared {
         let (it, t) = (q.it, q.t);
@@ -825,5 +835,20 @@ impl<'a> BandInputs<'a> {
                 fp
             })
             .collect()
+    }
+}
+
+/// Lanes `at` .. `at + L::WIDTH` of a value of their triangles' corners
+/// (`g`): loaded once per quad where each quad holds one triangle's
+/// (`by_quad`), else lane by lane. The same values either way.
+#[inline(always)]
+fn lanes_of<L: Lane>(
+    (corners, at, by_quad): (&[&Corners; MAX_LANES], usize, bool),
+    g: impl Fn(&Corners) -> f32,
+) -> L {
+    if by_quad {
+        L::from_quads(|q| Vec4::splat(g(corners[at + 4 * q])))
+    } else {
+        L::from_fn(|k| g(corners[at + k]))
     }
 }

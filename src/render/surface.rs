@@ -24,6 +24,18 @@ impl<'a> BandInputs<'a> {
         if self.pattern.len() == 1 || it.covers_center(px, py) {
             return it.at_pixel(px, py);
         }
+        self.centroid_point(it, px, py, mask)
+    }
+
+    /// `shading_point` where the triangle does not cover the pixel's
+    /// center (with MSAA): the covered samples' centroid.
+    pub(super) fn centroid_point(
+        &self,
+        it: &Interpolator,
+        px: i32,
+        py: i32,
+        mask: u32,
+    ) -> Fragment {
         let (mut sx, mut sy, mut k) = (0i32, 0i32, 0i32);
         for (s, &(ox, oy)) in self.pattern.iter().enumerate() {
             if mask & (1 << s) != 0 {
@@ -67,10 +79,10 @@ impl<'a> BandInputs<'a> {
     }
 
     /// Texture-coordinate derivatives of `t` (both sets) over the quad
-    /// whose top-left pixel is `q0`.
-    pub(super) fn gradients(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> [Gradients; 2] {
-        let uv = |px: i32, py: i32| self.material_uv(t, it.at_pixel(px, py).lambda).1;
-        let (a, b, c) = (uv(q0.0, q0.1), uv(q0.0 + 1, q0.1), uv(q0.0, q0.1 + 1));
+    /// whose top three pixels' centres (`quad_centers`) are `centers`.
+    fn gradients_at(&self, t: &Tri, centers: &[Fragment; 3]) -> [Gradients; 2] {
+        let uv = |k: usize| self.material_uv(t, centers[k].lambda).1;
+        let (a, b, c) = (uv(0), uv(1), uv(2));
         [0, 1].map(|k| match (a[k], b[k], c[k]) {
             (Some(a), Some(b), Some(c)) => Gradients {
                 dx: b - a,
@@ -92,15 +104,34 @@ impl<'a> BandInputs<'a> {
     ) -> [Gradients; 2] {
         if !self.grads {
             [Gradients::default(); 2]
-        } else if lm.reads_set1() {
-            self.gradients(t, it, q0)
         } else {
-            [self.gradients0(t, it, q0), Gradients::default()]
+            self.lane_gradients_at(lm, t, &quad_centers(it, q0))
         }
     }
 
-    /// `gradients` of set 0 alone.
-    pub(super) fn gradients0(&self, t: &Tri, it: &Interpolator, q0: (i32, i32)) -> Gradients {
+    /// `lane_gradients` where they are wanted (`self.grads`), from the
+    /// quad's `quad_centers`.
+    pub(super) fn lane_gradients_at(
+        &self,
+        lm: &LaneMaterial,
+        t: &Tri,
+        centers: &[Fragment; 3],
+    ) -> [Gradients; 2] {
+        if lm.reads_set1() {
+            self.gradients_at(t, centers)
+        } else {
+            [self.gradients0_at(t, centers), Gradients::default()]
+        }
+    }
+
+    /// Whether fragments need their texture-coordinate derivatives.
+    #[inline(always)]
+    pub(super) fn wants_gradients(&self) -> bool {
+        self.grads
+    }
+
+    /// `gradients_at` of set 0 alone.
+    fn gradients0_at(&self, t: &Tri, centers: &[Fragment; 3]) -> Gradients {
         let d = self.draws[t.draw as usize];
         let mesh = &self.setup.scene.models[d.model].mesh;
         let uv = &mesh.uvs;
@@ -108,11 +139,11 @@ impl<'a> BandInputs<'a> {
             return Gradients::default();
         }
         let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
-        let at = |px: i32, py: i32| {
-            let l = it.at_pixel(px, py).lambda;
+        let at = |k: usize| {
+            let l = centers[k].lambda;
             uv[idx[0]] * l.x + uv[idx[1]] * l.y + uv[idx[2]] * l.z
         };
-        let (a, b, c) = (at(q0.0, q0.1), at(q0.0 + 1, q0.1), at(q0.0, q0.1 + 1));
+        let (a, b, c) = (at(0), at(1), at(2));
         Gradients {
             dx: b - a,
             dy: c - a,
@@ -197,4 +228,16 @@ fn edge_distance(it: &Interpolator, px: i32, py: i32, l: Vec3) -> f32 {
         }
     }
     best
+}
+
+/// The centres of the quad whose top-left pixel is `q0` that texture
+/// derivatives are taken between: its top-left, top-right and
+/// bottom-left pixels' (`Interpolator::at_pixel`).
+#[inline]
+pub(super) fn quad_centers(it: &Interpolator, q0: (i32, i32)) -> [Fragment; 3] {
+    [
+        it.at_pixel(q0.0, q0.1),
+        it.at_pixel(q0.0 + 1, q0.1),
+        it.at_pixel(q0.0, q0.1 + 1),
+    ]
 }
