@@ -78,8 +78,9 @@ impl<'a> BandInputs<'a> {
         )
     }
 
-    /// Texture-coordinate derivatives of `t` (both sets) over the quad
-    /// whose top three pixels' centres (`quad_centers`) are `centers`.
+    /// Texture-coordinate derivatives of `t` (both sets) over a quad,
+    /// from its top-left, top-right and bottom-left centres `centers`
+    /// (`quad_centers`).
     fn gradients_at(&self, t: &Tri, centers: &[Fragment; 3]) -> [Gradients; 2] {
         let uv = |k: usize| self.material_uv(t, centers[k].lambda).1;
         let (a, b, c) = (uv(0), uv(1), uv(2));
