@@ -13,11 +13,16 @@ use glam::Vec4;
 use rayon::prelude::*;
 
 use super::texture::{Level, Texture};
-use crate::color::{encode_linear, encode_srgb};
 
 /// Levels 1.. of `t` (empty for a 1x1 texture), built from level 0.
 /// `Texture::mip_chain(build_chain)` keeps them with the texture.
 pub fn build_chain(t: &Texture) -> Vec<Level> {
+    chain_with(t, true)
+}
+
+/// `build_chain`, halving even sizes by `halve` where `fast`, else every
+/// level by `area` (the same values: the test compares them).
+fn chain_with(t: &Texture, fast: bool) -> Vec<Level> {
     let mut levels = Vec::new();
     let base = t.base();
     // Level 0 decoded on the fly; later levels from the floats kept.
@@ -25,46 +30,101 @@ pub fn build_chain(t: &Texture) -> Vec<Level> {
     let mut prev: Option<Vec<Vec4>> = None;
     while w > 1 || h > 1 {
         let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-        let src = |x: u32, y: u32| -> Vec4 {
-            match &prev {
-                Some(p) => p[(y * w + x) as usize],
-                None => t.decode(base.texel(x, y)),
-            }
+        let src = Source {
+            texture: t,
+            base,
+            prev: prev.as_deref(),
+            width: w,
         };
-        let wx = weights(w, nw);
-        let wy = weights(h, nh);
         let mut next = vec![Vec4::ZERO; (nw * nh) as usize];
-        next.par_chunks_mut(nw as usize)
-            .enumerate()
-            .for_each(|(y, row)| {
-                for (x, out) in row.iter_mut().enumerate() {
-                    let mut acc = Vec4::ZERO;
-                    for &(sy, fy) in &wy[y] {
-                        for &(sx, fx) in &wx[x] {
-                            acc += src(sx, sy) * (fx * fy);
-                        }
-                    }
-                    *out = acc;
-                }
-            });
-        let bytes: Vec<[u8; 4]> = next
-            .par_iter()
-            .map(|c| {
-                let e = |v: f32| {
-                    if t.srgb {
-                        encode_srgb(v)
-                    } else {
-                        encode_linear(v)
-                    }
-                };
-                [e(c.x), e(c.y), e(c.z), encode_linear(c.w)]
-            })
-            .collect();
+        if fast && w == 2 * nw && h == 2 * nh {
+            halve(&src, &mut next, nw);
+        } else {
+            area(&src, &mut next, (w, h), (nw, nh));
+        }
+        let bytes: Vec<[u8; 4]> = next.par_iter().map(|&c| t.encode(c)).collect();
         levels.push(Level::from_rows(nw, nh, &bytes));
         prev = Some(next);
         (w, h) = (nw, nh);
     }
     levels
+}
+
+/// The level a mip level is filtered from: level 0 (`base`, decoded
+/// texel by texel) or the floats of the level above (`prev`), `width`
+/// texels a row.
+struct Source<'a> {
+    texture: &'a Texture,
+    base: &'a Level,
+    prev: Option<&'a [Vec4]>,
+    width: u32,
+}
+
+impl Source<'_> {
+    #[inline(always)]
+    fn at(&self, x: u32, y: u32) -> Vec4 {
+        match self.prev {
+            Some(p) => p[(y * self.width + x) as usize],
+            None => self.texture.decode(self.base.texel(x, y)),
+        }
+    }
+
+    /// Row `y`, `self.width` texels: the floats kept, or level 0's texels
+    /// decoded into `buf`.
+    #[inline(always)]
+    fn row<'b>(&'b self, y: u32, buf: &'b mut Vec<Vec4>) -> &'b [Vec4] {
+        let w = self.width as usize;
+        match self.prev {
+            Some(p) => &p[y as usize * w..][..w],
+            None => {
+                buf.resize(w, Vec4::ZERO);
+                self.base.read_row(y, buf, self.texture.decoder());
+                buf
+            }
+        }
+    }
+}
+
+/// A level of even width and height halved (`next`, `nw` texels a row):
+/// each texel the mean of the 2x2 under it, added in `area`'s order with
+/// its weights (1/2 x 1/2), so the same values.
+fn halve(src: &Source, next: &mut [Vec4], nw: u32) {
+    next.par_chunks_mut(nw as usize).enumerate().for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(a, b), (y, row)| {
+            let sy = 2 * y as u32;
+            let (top, bottom) = (src.row(sy, a), src.row(sy + 1, b));
+            let pairs = top.chunks_exact(2).zip(bottom.chunks_exact(2));
+            for (out, (t, b)) in row.iter_mut().zip(pairs) {
+                let mut acc = Vec4::ZERO;
+                acc += t[0] * 0.25;
+                acc += t[1] * 0.25;
+                acc += b[0] * 0.25;
+                acc += b[1] * 0.25;
+                *out = acc;
+            }
+        },
+    );
+}
+
+/// A level of size `(w, h)` filtered into `next` of size `(nw, nh)` by the
+/// area-weighted box (`weights` along each axis).
+fn area(src: &Source, next: &mut [Vec4], (w, h): (u32, u32), (nw, nh): (u32, u32)) {
+    let wx = weights(w, nw);
+    let wy = weights(h, nh);
+    next.par_chunks_mut(nw as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, out) in row.iter_mut().enumerate() {
+                let mut acc = Vec4::ZERO;
+                for &(sy, fy) in &wy[y] {
+                    for &(sx, fx) in &wx[x] {
+                        acc += src.at(sx, sy) * (fx * fy);
+                    }
+                }
+                *out = acc;
+            }
+        });
 }
 
 /// For each of the `dst` texels along one axis, the `src` texels under its
@@ -112,13 +172,42 @@ mod tests {
         }
     }
 
+    /// Halving even levels gives the area-weighted box's bytes, for color
+    /// and data maps, square or not, with odd sizes further down.
+    #[test]
+    fn halving_is_the_area_box() {
+        for (w, h, srgb) in [
+            (64, 16, true),
+            (64, 16, false),
+            (12, 20, true),
+            (6, 10, true),
+            (8, 8, false),
+        ] {
+            // Scrambled texels: every byte value turns up.
+            let texels: Vec<[u8; 4]> = (0..w * h)
+                .map(|i: u32| (i.wrapping_mul(2_654_435_761) ^ (i << 7)).to_le_bytes())
+                .collect();
+            let t = Texture::from_rgba8(w, h, &texels, srgb);
+            let (fast, slow) = (chain_with(&t, true), chain_with(&t, false));
+            assert_eq!(fast.len(), slow.len());
+            for (a, b) in fast.iter().zip(&slow) {
+                assert_eq!((a.width, a.height), (b.width, b.height));
+                for y in 0..a.height {
+                    for x in 0..a.width {
+                        assert_eq!(a.texel(x, y), b.texel(x, y), "{w}x{h} {x},{y}");
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn chain_of_a_non_power_of_two_keeps_the_mean_in_linear_space() {
         // 5x3 sRGB texture: half black, half white columns.
         let texels: Vec<[u8; 4]> = (0..15)
             .map(|i| if i % 5 < 2 { [0, 0, 0, 255] } else { [255; 4] })
             .collect();
-        let t = Texture::from_rgba8(5, 3, texels, true);
+        let t = Texture::from_rgba8(5, 3, &texels, true);
         let chain = build_chain(&t);
         let sizes: Vec<_> = chain.iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, vec![(2, 1), (1, 1)]);

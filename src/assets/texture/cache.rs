@@ -106,7 +106,7 @@ mod tests {
     use crate::assets::mip::build_chain;
 
     fn texture(w: u32, h: u32, srgb: bool) -> Texture {
-        let texels = (0..w * h)
+        let texels: Vec<[u8; 4]> = (0..w * h)
             .map(|i| {
                 [
                     (i * 7) as u8,
@@ -116,7 +116,7 @@ mod tests {
                 ]
             })
             .collect();
-        Texture::from_rgba8(w, h, texels, srgb)
+        Texture::from_rgba8(w, h, &texels, srgb)
     }
 
     fn same_levels(a: &Texture, b: &Texture) {

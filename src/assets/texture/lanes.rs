@@ -686,7 +686,7 @@ mod tests {
 
     fn noise(w: u32, h: u32, srgb: bool) -> Texture {
         let mut s = 0x9e37_79b9u32;
-        let texels = (0..w * h)
+        let texels: Vec<[u8; 4]> = (0..w * h)
             .map(|_| {
                 let mut b = [0u8; 4];
                 for c in &mut b {
@@ -698,7 +698,7 @@ mod tests {
                 b
             })
             .collect();
-        Texture::from_rgba8(w, h, texels, srgb)
+        Texture::from_rgba8(w, h, &texels, srgb)
     }
 
     /// Bilinear filtering as the GL specification states it, texel by

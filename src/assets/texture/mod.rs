@@ -257,10 +257,12 @@ impl Level {
     /// From row-major texels (row 0 at the top).
     pub(crate) fn from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
         let mut l = Level::new(width, height);
+        let blocks_x = l.blocks_x as usize;
         for (y, row) in rows.chunks_exact(width as usize).enumerate() {
-            for (x, &texel) in row.iter().enumerate() {
-                let i = l.index(x as u32, y as u32);
-                l.blocks[i >> 4].0[i & 15] = texel;
+            // Row y is row y % 4 of its blocks: four texels in each.
+            let (first, r) = ((y / 4) * blocks_x, 4 * (y % 4));
+            for (block, texels) in l.blocks[first..].iter_mut().zip(row.chunks(4)) {
+                block.0[r..r + texels.len()].copy_from_slice(texels);
             }
         }
         l
@@ -270,6 +272,20 @@ impl Level {
     #[inline(always)]
     fn index(&self, x: u32, y: u32) -> usize {
         ((((y >> 2) * self.blocks_x + (x >> 2)) << 4) | ((y & 3) << 2) | (x & 3)) as usize
+    }
+
+    /// Row `y`'s texels, left to right, each through `f` into `out`
+    /// (`width` values).
+    #[inline(always)]
+    pub(crate) fn read_row<T>(&self, y: u32, out: &mut [T], f: impl Fn([u8; 4]) -> T) {
+        let (first, r) = ((y / 4 * self.blocks_x) as usize, 4 * (y % 4) as usize);
+        let blocks = &self.blocks[first..first + self.blocks_x as usize];
+        let out = &mut out[..self.width as usize];
+        for (o, b) in out.chunks_mut(4).zip(blocks) {
+            for (o, &t) in o.iter_mut().zip(&b.0[r..r + 4]) {
+                *o = f(t);
+            }
+        }
     }
 
     #[inline]
@@ -324,7 +340,7 @@ impl Texture {
                 input.check_file(name, "texture", need.saturating_mul(3))?;
             }
             let d = decode(bytes).map_err(|e| refuse(format!("cannot decode texture: {e}")))?;
-            let t = Texture::from_rgba8(d.width, d.height, d.texels, srgb);
+            let t = Texture::from_rgba8(d.width, d.height, &d.texels, srgb);
             input.keep(t.kept_bytes());
             return Ok(t);
         }
@@ -386,13 +402,22 @@ impl Texture {
                 })
                 .collect()
         } else {
-            img.to_rgba8().pixels().map(|p| p.0).collect()
+            // 8-bit images: their texels read in place (one copy fewer of
+            // a map in fresh memory, which the first touch makes costly).
+            let rgba = img.into_rgba8();
+            let bytes = &rgba.as_raw()[..width as usize * height as usize * 4];
+            return Ok(Texture::from_rgba8(
+                width,
+                height,
+                bytemuck::cast_slice(bytes),
+                srgb,
+            ));
         };
-        Ok(Texture::from_rgba8(width, height, texels, srgb))
+        Ok(Texture::from_rgba8(width, height, &texels, srgb))
     }
 
     /// From row-major texels (row 0 at the top); width and height > 0.
-    pub fn from_rgba8(width: u32, height: u32, texels: Vec<[u8; 4]>, srgb: bool) -> Texture {
+    pub fn from_rgba8(width: u32, height: u32, texels: &[[u8; 4]], srgb: bool) -> Texture {
         assert_eq!(texels.len(), (width as usize) * (height as usize));
         assert!(width > 0 && height > 0);
         let grey = texels.iter().all(|t| t[0] == t[1] && t[1] == t[2]);
@@ -401,7 +426,7 @@ impl Texture {
         Texture {
             width,
             height,
-            base: Level::from_rows(width, height, &texels),
+            base: Level::from_rows(width, height, texels),
             srgb,
             id: 0,
             has_alpha: partial > 0,
@@ -622,20 +647,46 @@ impl Texture {
         }
     }
 
+    /// Linear RGBA stored as a texel: `decode`'s inverse, to the nearest
+    /// byte (sRGB color by `encode_srgb`, data and alpha by
+    /// `encode_linear`).
+    #[inline]
+    pub(crate) fn encode(&self, c: Vec4) -> [u8; 4] {
+        use crate::color::encode_linear;
+        let a = encode_linear(c.w);
+        if self.srgb {
+            let [r, g, b] = crate::color::encode_srgb_xyz(c);
+            [r, g, b, a]
+        } else {
+            [
+                encode_linear(c.x),
+                encode_linear(c.y),
+                encode_linear(c.z),
+                a,
+            ]
+        }
+    }
+
     /// A stored texel as linear RGBA: sRGB color decoded by table, data
     /// /255.
     #[inline(always)]
     pub(crate) fn decode(&self, t: [u8; 4]) -> Vec4 {
-        if !self.srgb {
-            return decode_data(t);
+        self.decoder()(t)
+    }
+
+    /// `decode` with its table found once, for many texels.
+    #[inline(always)]
+    pub(crate) fn decoder(&self) -> impl Fn([u8; 4]) -> Vec4 + use<> {
+        let lut = self.srgb.then(srgb_to_linear_table);
+        move |t| match lut {
+            None => decode_data(t),
+            Some(lut) => Vec4::new(
+                lut[t[0] as usize],
+                lut[t[1] as usize],
+                lut[t[2] as usize],
+                ALPHA_TABLE[t[3] as usize],
+            ),
         }
-        let lut = srgb_to_linear_table();
-        Vec4::new(
-            lut[t[0] as usize],
-            lut[t[1] as usize],
-            lut[t[2] as usize],
-            ALPHA_TABLE[t[3] as usize],
-        )
     }
 
     /// The general case: any finite coordinate, through the address mode.
@@ -792,7 +843,7 @@ mod tests {
         Texture::from_rgba8(
             2,
             2,
-            vec![[255; 4], [0, 0, 0, 255], [0, 0, 0, 255], [255; 4]],
+            &[[255; 4], [0, 0, 0, 255], [0, 0, 0, 255], [255; 4]],
             false,
         )
     }
@@ -808,7 +859,9 @@ mod tests {
         let big = Texture::from_rgba8(
             3,
             3,
-            (0..9u8).map(|i| [i * 20, i, 255 - i, 255]).collect(),
+            &(0..9u8)
+                .map(|i| [i * 20, i, 255 - i, 255])
+                .collect::<Vec<_>>(),
             true,
         );
         for uv in [

@@ -89,11 +89,40 @@ pub(super) fn build(
         crate::scene::settings::ShadingMode::Depth | crate::scene::settings::ShadingMode::Wireframe
     );
     let normals_view = settings.shading == crate::scene::settings::ShadingMode::Normals;
-    let (textures, by_key) = if textured {
-        decode_textures(d, &files, &model_mats, normals_view, cache, input, warnings)?
-    } else {
-        (Vec::new(), BTreeMap::new())
-    };
+    // The meshes are displaced and given tangents while the textures
+    // decode: the tangents for the set the materials would read if every
+    // image decodes (checked below, once the materials are made).
+    let mut texture_warnings = Vec::new();
+    let (decoded, shaped) = rayon::join(
+        || {
+            if textured {
+                let w = &mut texture_warnings;
+                decode_textures(d, &files, &model_mats, normals_view, cache, input, w)
+            } else {
+                Ok((Vec::new(), BTreeMap::new()))
+            }
+        },
+        || {
+            let placeholder = Arc::new(Texture::from_rgba8(1, 1, &[[0; 4]], false));
+            let any = |_: &Path, _: bool| Some(placeholder.clone());
+            let shape = |(m, mats): (&desc::Spanned<desc::ModelDesc>, &Vec<SourceMaterial>)| {
+                let md = m.get_ref();
+                let guess: Vec<Material> = mats
+                    .iter()
+                    .map(|mm| materials::to_material(mm, &any))
+                    .collect();
+                let set = tangent_set(&guess).filter(|_| textured);
+                Shaped::new(md, ctx, files.of(md), mats, set, input)
+            };
+            d.models
+                .iter()
+                .zip(&model_mats)
+                .map(shape)
+                .collect::<Vec<_>>()
+        },
+    );
+    warnings.append(&mut texture_warnings);
+    let (textures, by_key) = decoded?;
     let lookup = |p: &Path, srgb: bool| by_key.get(&(p.to_path_buf(), srgb)).cloned();
 
     let mut out = Models {
@@ -103,7 +132,8 @@ pub(super) fn build(
         node_lights: Vec::new(),
         cameras: Vec::new(),
     };
-    for (i, (m, mats)) in d.models.iter().zip(&model_mats).enumerate() {
+    let models = d.models.iter().zip(&model_mats).zip(shaped);
+    for (i, ((m, mats), shaped)) in models.enumerate() {
         let md = m.get_ref();
         let src = files.of(md);
         let materials: Vec<Material> = mats
@@ -111,22 +141,14 @@ pub(super) fn build(
             .map(|mm| materials::to_material(mm, &lookup))
             .collect();
         let world = placement(md, &src.mesh);
-        let mut mesh = src.mesh.clone();
-        for (gi, mm) in mats.iter().enumerate() {
-            if let SourceMaterial::Mtl(mm) = mm
-                && let Some(spec) = &mm.mtl.disp
-            {
-                // Lenient: a displacement map that cannot be read leaves
-                // the surface as it is.
-                if let Err(e) = displace(&mut mesh, gi, spec, mm.disp_scale, input) {
-                    warnings.push(format!("{e}; the surface is not displaced"));
-                }
-            }
-        }
-        // After displacement, which can move positions anywhere.
-        check_magnitude(md, ctx, &mesh, world)?;
-        if textured && let Some(set) = tangent_set(&materials) {
-            mesh.compute_tangents(set);
+        let mut mesh = shaped.mesh;
+        warnings.extend(shaped.warnings);
+        shaped.checked?;
+        let set = tangent_set(&materials).filter(|_| textured);
+        match (set, shaped.tangents) {
+            (Some(s), Some((g, t))) if s == g => mesh.tangents = t,
+            (Some(s), _) => mesh.compute_tangents(s),
+            (None, _) => {}
         }
         let playback = playback(md, ctx, src, &mesh)?;
         let first_light = out.lights.len();
@@ -157,6 +179,56 @@ pub(super) fn build(
         });
     }
     Ok(out)
+}
+
+/// A model's mesh made ready while its textures decode (`build`): its
+/// file's mesh displaced by its materials' displacement maps (with a
+/// warning for each that cannot be read), its size checked, and the
+/// tangents of one texture-coordinate set computed.
+struct Shaped {
+    mesh: Mesh,
+    warnings: Vec<String>,
+    checked: Result<(), Error>,
+    /// The set and its tangents (the mesh's own are left as they were).
+    tangents: Option<(usize, Vec<glam::Vec4>)>,
+}
+
+impl Shaped {
+    fn new(
+        md: &desc::ModelDesc,
+        ctx: &Ctx,
+        src: &SourceModel,
+        mats: &[SourceMaterial],
+        set: Option<usize>,
+        input: &Input,
+    ) -> Shaped {
+        let mut mesh = src.mesh.clone();
+        let mut warnings = Vec::new();
+        for (gi, mm) in mats.iter().enumerate() {
+            if let SourceMaterial::Mtl(mm) = mm
+                && let Some(spec) = &mm.mtl.disp
+            {
+                // Lenient: a displacement map that cannot be read leaves
+                // the surface as it is.
+                if let Err(e) = displace(&mut mesh, gi, spec, mm.disp_scale, input) {
+                    warnings.push(format!("{e}; the surface is not displaced"));
+                }
+            }
+        }
+        // After displacement, which can move positions anywhere.
+        let checked = check_magnitude(md, ctx, &mesh, placement(md, &src.mesh));
+        let tangents = set.filter(|_| checked.is_ok()).map(|set| {
+            let own = mesh.tangents.clone();
+            mesh.compute_tangents(set);
+            (set, std::mem::replace(&mut mesh.tangents, own))
+        });
+        Shaped {
+            mesh,
+            warnings,
+            checked,
+            tangents,
+        }
+    }
 }
 
 /// `model.name`, else the file's stem (`bunny`, then `bunny_2` for a

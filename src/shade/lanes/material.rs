@@ -547,7 +547,7 @@ mod tests {
 
     fn map(size: u32) -> TextureRef {
         let texels = vec![[200, 100, 50, 255]; (size * size) as usize];
-        TextureRef::new(Arc::new(Texture::from_rgba8(size, size, texels, false)))
+        TextureRef::new(Arc::new(Texture::from_rgba8(size, size, &texels, false)))
     }
 
     /// Which materials go to the wider calls: glTF's packed pbr maps, MTL
