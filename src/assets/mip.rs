@@ -28,6 +28,13 @@ fn chain_with(t: &Texture, fast: bool) -> Vec<Level> {
     // Level 0 decoded on the fly; later levels from the floats kept.
     let (mut w, mut h) = (t.width, t.height);
     let mut prev: Option<Vec<Vec4>> = None;
+    let k = if fast { halvings(w, h) } else { 0 };
+    if k > 0 {
+        let last;
+        (levels, last) = strips(t, k);
+        prev = Some(last);
+        (w, h) = (w >> k, h >> k);
+    }
     while w > 1 || h > 1 {
         let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
         let src = Source {
@@ -48,6 +55,88 @@ fn chain_with(t: &Texture, fast: bool) -> Vec<Level> {
         (w, h) = (nw, nh);
     }
     levels
+}
+
+/// The most levels made strip by strip (`strips`): 32 rows of level 0 a
+/// strip.
+const STRIP_LEVELS: u32 = 5;
+
+/// How many of the first levels halve both sides exactly (at most
+/// `STRIP_LEVELS`).
+fn halvings(w: u32, h: u32) -> u32 {
+    (0..STRIP_LEVELS)
+        .take_while(|&k| w.is_multiple_of(2 << k) && h.is_multiple_of(2 << k))
+        .count() as u32
+}
+
+/// A strip's rows of levels 1..=k (`strips`), encoded, and of level k as
+/// floats.
+type Strip = (Vec<Vec<[u8; 4]>>, Vec<Vec4>);
+
+/// Levels 1..=`k` of `t`, which halve exactly (`halvings`), made strip by
+/// strip: each strip of 2^k rows of level 0 is decoded and halved `k`
+/// times in a thread's scratch rows, so no level is held as floats whole
+/// (a 4096² map's level 1 would be 64 MB of them, fresh memory the first
+/// touch makes slow); the values are `halve`'s. Also the floats of level
+/// `k`, which the smaller levels are made from.
+fn strips(t: &Texture, k: u32) -> (Vec<Level>, Vec<Vec4>) {
+    let (w, rows) = (t.width as usize, 1usize << k);
+    let decode = t.decoder();
+    let per_strip: Vec<Strip> = (0..t.height as usize / rows)
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(a, b): &mut (Vec<Vec4>, Vec<Vec4>), strip| {
+                a.resize(w * rows, Vec4::ZERO);
+                for (r, row) in a.chunks_exact_mut(w).enumerate() {
+                    t.base().read_row((strip * rows + r) as u32, row, &decode);
+                }
+                let mut bytes = Vec::with_capacity(k as usize);
+                for j in 1..=k {
+                    let (sw, nw) = (w >> (j - 1), w >> j);
+                    b.resize(nw * (rows >> j), Vec4::ZERO);
+                    let pairs = a.chunks_exact(2 * sw);
+                    for (out, pair) in b.chunks_exact_mut(nw).zip(pairs) {
+                        let (top, bottom) = pair.split_at(sw);
+                        halve_rows(top, bottom, out);
+                    }
+                    bytes.push(b.iter().map(|&c| t.encode(c)).collect());
+                    std::mem::swap(a, b);
+                }
+                (bytes, a.clone())
+            },
+        )
+        .collect();
+    let levels = (1..=k)
+        .map(|j| {
+            let mut texels = Vec::new();
+            for (bytes, _) in &per_strip {
+                texels.extend_from_slice(&bytes[j as usize - 1]);
+            }
+            Level::from_rows(t.width >> j, t.height >> j, &texels)
+        })
+        .collect();
+    let mut last = Vec::new();
+    for (_, floats) in &per_strip {
+        last.extend_from_slice(floats);
+    }
+    (levels, last)
+}
+
+/// One row of a halved level from the two rows under it: each texel the
+/// mean of the 2x2 under it, added in `area`'s order with its weights
+/// (1/2 x 1/2), so the same values.
+#[inline(always)]
+fn halve_rows(top: &[Vec4], bottom: &[Vec4], out: &mut [Vec4]) {
+    let pairs = top.chunks_exact(2).zip(bottom.chunks_exact(2));
+    for (o, (t, b)) in out.iter_mut().zip(pairs) {
+        let mut acc = Vec4::ZERO;
+        acc += t[0] * 0.25;
+        acc += t[1] * 0.25;
+        acc += b[0] * 0.25;
+        acc += b[1] * 0.25;
+        *o = acc;
+    }
 }
 
 /// The level a mip level is filtered from: level 0 (`base`, decoded
@@ -85,24 +174,14 @@ impl Source<'_> {
     }
 }
 
-/// A level of even width and height halved (`next`, `nw` texels a row):
-/// each texel the mean of the 2x2 under it, added in `area`'s order with
-/// its weights (1/2 x 1/2), so the same values.
+/// A level of even width and height halved (`next`, `nw` texels a row;
+/// `halve_rows`).
 fn halve(src: &Source, next: &mut [Vec4], nw: u32) {
     next.par_chunks_mut(nw as usize).enumerate().for_each_init(
         || (Vec::new(), Vec::new()),
         |(a, b), (y, row)| {
             let sy = 2 * y as u32;
-            let (top, bottom) = (src.row(sy, a), src.row(sy + 1, b));
-            let pairs = top.chunks_exact(2).zip(bottom.chunks_exact(2));
-            for (out, (t, b)) in row.iter_mut().zip(pairs) {
-                let mut acc = Vec4::ZERO;
-                acc += t[0] * 0.25;
-                acc += t[1] * 0.25;
-                acc += b[0] * 0.25;
-                acc += b[1] * 0.25;
-                *out = acc;
-            }
+            halve_rows(src.row(sy, a), src.row(sy + 1, b), row);
         },
     );
 }
@@ -179,6 +258,8 @@ mod tests {
         for (w, h, srgb) in [
             (64, 16, true),
             (64, 16, false),
+            (256, 128, true),
+            (96, 192, false),
             (12, 20, true),
             (6, 10, true),
             (8, 8, false),

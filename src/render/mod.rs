@@ -662,8 +662,26 @@ impl<'s> Renderer<'s> {
         }
     }
 
+    /// What refracting surfaces see: the opaque surfaces shaded into
+    /// `out`.
+    fn opaque_frame(data: &fragment::BandInputs, out: &Frame) -> OpaqueFrame {
+        let camera = refraction::Camera {
+            clip_from_world: data.setup.clip_from_world,
+            eye: data.ctx.eye,
+            forward: data.ctx.forward,
+        };
+        let sky = data.setup.scene.settings.background == Background::Environment;
+        OpaqueFrame::new((&out.color, &out.depth), out.width, out.height, camera)
+            .sky_behind(sky)
+            .image_lights(backdrop::image_discs(data.setup))
+    }
+
     /// Visibility, AO and shading, band by band, into `out`; with
     /// `display`, each band's display bytes as soon as it is shaded.
+    /// Every band is a task of its own (`with_max_len(1)`): bands differ in
+    /// cost (a model across some, background in others), and a thread done
+    /// early takes the next band instead of waiting while the other
+    /// finishes a run of them.
     fn bands(
         &self,
         data: &fragment::BandInputs,
@@ -738,6 +756,7 @@ impl<'s> Renderer<'s> {
                 .zip(bytes.par_iter_mut())
                 .zip(known.par_iter_mut())
                 .enumerate()
+                .with_max_len(1)
                 .map(|(ti, ((((color, depth), aov), bytes), known))| {
                     let visible = data.visibility(grid.rect(ti), ti, &bins);
                     if !aov.is_empty() {
@@ -754,6 +773,7 @@ impl<'s> Renderer<'s> {
             let visible: Vec<_> = gbuf
                 .par_chunks_mut(band)
                 .enumerate()
+                .with_max_len(1)
                 .map(|(ti, g)| {
                     let (vis, blended) = data.visibility(grid.rect(ti), ti, &bins);
                     data.gbuffer(&vis, g);
@@ -775,6 +795,7 @@ impl<'s> Renderer<'s> {
                 .zip(chunks)
                 .zip(bytes.par_iter_mut())
                 .zip(known.par_iter_mut())
+                .with_max_len(1)
                 .map(|((((((color, depth), ao), visible), aov), bytes), known)| {
                     if !aov.is_empty() {
                         data.aovs(&visible.0, aov);
@@ -784,21 +805,13 @@ impl<'s> Renderer<'s> {
                 .collect()
         };
         if refracts {
-            let camera = refraction::Camera {
-                clip_from_world: data.setup.clip_from_world,
-                eye: data.ctx.eye,
-                forward: data.ctx.forward,
-            };
-            let sky = data.setup.scene.settings.background == Background::Environment;
-            let opaque = OpaqueFrame::new((&out.color, &out.depth), out.width, out.height, camera)
-                .sky_behind(sky)
-                .image_lights(backdrop::image_discs(data.setup));
             // One `bands` call per frame's inputs: set here only.
-            let _ = data.ctx.refraction.set(opaque);
+            let _ = data.ctx.refraction.set(Self::opaque_frame(data, out));
             out.color
                 .par_chunks_mut(band)
                 .zip(later)
                 .zip(bytes.par_iter_mut())
+                .with_max_len(1)
                 .for_each(|((color, later), bytes)| {
                     if let Some((vis, blended)) = later {
                         data.blend(&vis, blended, color);
