@@ -256,13 +256,26 @@ impl Level {
 
     /// From row-major texels (row 0 at the top).
     pub(crate) fn from_rows(width: u32, height: u32, rows: &[[u8; 4]]) -> Level {
+        Level::from_texels(width, height, rows, |t| t)
+    }
+
+    /// From row-major texels of any kind, each stored as `rgba` of it.
+    #[inline(always)]
+    fn from_texels<T: Copy>(
+        width: u32,
+        height: u32,
+        rows: &[T],
+        rgba: impl Fn(T) -> [u8; 4],
+    ) -> Level {
         let mut l = Level::new(width, height);
         let blocks_x = l.blocks_x as usize;
         for (y, row) in rows.chunks_exact(width as usize).enumerate() {
             // Row y is row y % 4 of its blocks: four texels in each.
             let (first, r) = ((y / 4) * blocks_x, 4 * (y % 4));
             for (block, texels) in l.blocks[first..].iter_mut().zip(row.chunks(4)) {
-                block.0[r..r + texels.len()].copy_from_slice(texels);
+                for (o, &t) in block.0[r..r + texels.len()].iter_mut().zip(texels) {
+                    *o = rgba(t);
+                }
             }
         }
         l
@@ -404,29 +417,49 @@ impl Texture {
         } else {
             // 8-bit images: their texels read in place (one copy fewer of
             // a map in fresh memory, which the first touch makes costly).
+            let n = width as usize * height as usize;
+            if let image::DynamicImage::ImageRgb8(rgb) = &img {
+                let texels = bytemuck::cast_slice(&rgb.as_raw()[..n * 3]);
+                return Ok(Texture::from_rgb8(width, height, texels, srgb));
+            }
             let rgba = img.into_rgba8();
-            let bytes = &rgba.as_raw()[..width as usize * height as usize * 4];
-            return Ok(Texture::from_rgba8(
-                width,
-                height,
-                bytemuck::cast_slice(bytes),
-                srgb,
-            ));
+            let texels = bytemuck::cast_slice(&rgba.as_raw()[..n * 4]);
+            return Ok(Texture::from_rgba8(width, height, texels, srgb));
         };
         Ok(Texture::from_rgba8(width, height, &texels, srgb))
     }
 
     /// From row-major texels (row 0 at the top); width and height > 0.
     pub fn from_rgba8(width: u32, height: u32, texels: &[[u8; 4]], srgb: bool) -> Texture {
+        Texture::from_texels(width, height, texels, srgb, |t| t)
+    }
+
+    /// `from_rgba8` of opaque texels given as RGB.
+    pub fn from_rgb8(width: u32, height: u32, texels: &[[u8; 3]], srgb: bool) -> Texture {
+        Texture::from_texels(width, height, texels, srgb, |[r, g, b]| [r, g, b, 255])
+    }
+
+    /// From row-major texels of any kind, each `rgba` of it.
+    #[inline(always)]
+    fn from_texels<T: Copy>(
+        width: u32,
+        height: u32,
+        texels: &[T],
+        srgb: bool,
+        rgba: impl Fn(T) -> [u8; 4] + Copy,
+    ) -> Texture {
         assert_eq!(texels.len(), (width as usize) * (height as usize));
         assert!(width > 0 && height > 0);
-        let grey = texels.iter().all(|t| t[0] == t[1] && t[1] == t[2]);
-        let partial = texels.iter().filter(|t| t[3] < 255).count();
-        let hard = texels.iter().filter(|t| t[3] < 8).count();
+        let grey = texels.iter().all(|&t| {
+            let t = rgba(t);
+            t[0] == t[1] && t[1] == t[2]
+        });
+        let partial = texels.iter().filter(|&&t| rgba(t)[3] < 255).count();
+        let hard = texels.iter().filter(|&&t| rgba(t)[3] < 8).count();
         Texture {
             width,
             height,
-            base: Level::from_rows(width, height, texels),
+            base: Level::from_texels(width, height, texels, rgba),
             srgb,
             id: 0,
             has_alpha: partial > 0,
@@ -846,6 +879,27 @@ mod tests {
             &[[255; 4], [0, 0, 0, 255], [0, 0, 0, 255], [255; 4]],
             false,
         )
+    }
+
+    /// RGB texels are stored as the same texels with alpha 255, in every
+    /// block, partial ones included.
+    #[test]
+    fn rgb_is_rgba_made_opaque() {
+        for (w, h) in [(5, 3), (8, 4), (1, 1)] {
+            let rgb: Vec<[u8; 3]> = (0..w * h)
+                .map(|i| [(i * 37) as u8, (i * 11) as u8, (255 - i) as u8])
+                .collect();
+            let rgba: Vec<[u8; 4]> = rgb.iter().map(|&[r, g, b]| [r, g, b, 255]).collect();
+            let (a, b) = (
+                Texture::from_rgb8(w, h, &rgb, true),
+                Texture::from_rgba8(w, h, &rgba, true),
+            );
+            assert_eq!(a.base.texels(), b.base.texels(), "{w}x{h}");
+            assert_eq!((a.grey, a.has_alpha), (b.grey, b.has_alpha));
+            assert!(!a.has_alpha && a.binary_alpha == 1.0);
+        }
+        let grey = Texture::from_rgb8(2, 1, &[[7, 7, 7], [9, 9, 9]], false);
+        assert!(grey.grey);
     }
 
     #[test]
