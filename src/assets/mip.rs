@@ -20,8 +20,9 @@ pub fn build_chain(t: &Texture) -> Vec<Level> {
     chain_with(t, true)
 }
 
-/// `build_chain`, halving even sizes by `halve` where `fast`, else every
-/// level by `area` (the same values: the test compares them).
+/// `build_chain`: where `fast`, the first exact halvings strip by strip
+/// (`strips`) and later even sizes by `halve`; else every level by `area`
+/// (the same values: the test compares them).
 fn chain_with(t: &Texture, fast: bool) -> Vec<Level> {
     let mut levels = Vec::new();
     let base = t.base();
