@@ -62,10 +62,14 @@ impl Interpolator {
     #[inline]
     pub fn at_quad(&self, px: i32, py: i32) -> ([Fragment; 4], [bool; 4]) {
         let (x, y) = (px as i64, py as i64);
-        let e = self.edges.map(|e| {
+        let quad = |e: &Edge| {
             let e0 = e.at(x, y);
             [e0, e0 + e.a, e0 + e.b, e0 + e.a + e.b]
-        });
+        };
+        // Written out, not `array::map`: that call is left out of line,
+        // and this runs once per quad.
+        let [e0, e1, e2] = &self.edges;
+        let e = [quad(e0), quad(e1), quad(e2)];
         let covers = std::array::from_fn(|p| (0..3).all(|k| e[k][p] + self.edges[k].bias >= 0));
         (self.finish(e), covers)
     }
@@ -97,24 +101,44 @@ impl Interpolator {
         f
     }
 
-    /// From integer edge values, per lane.
+    /// From integer edge values, per lane. (Loops, not `array::map`, here
+    /// and in `finish_g`: the compiler leaves `map` out of line, and these
+    /// run once per quad.)
     #[inline(always)]
     fn finish<const N: usize>(&self, e: [[i64; N]; 3]) -> [Fragment; N] {
-        self.finish_g([0, 1, 2].map(|k| e[k].map(|e| e as f64 * self.inv_w[k])))
+        let mut g = [[0.0; N]; 3];
+        for k in 0..3 {
+            for p in 0..N {
+                g[k][p] = e[k][p] as f64 * self.inv_w[k];
+            }
+        }
+        self.finish_g(g)
     }
 
     /// From the edge values over w (`g`), per lane: each lane computes
     /// alone what one fragment would.
     #[inline(always)]
     fn finish_g<const N: usize>(&self, g: [[f64; N]; 3]) -> [Fragment; N] {
-        let sum: [f64; N] = std::array::from_fn(|p| g[0][p] + g[1][p] + g[2][p]);
-        let inv = sum.map(|s| 1.0 / s);
-        let k: [[f64; N]; 3] = g.map(|g| std::array::from_fn(|p| g[p] * inv[p]));
-        let lambda: [[f64; N]; 3] = match &self.bary {
+        let mut sum = [0.0; N];
+        let mut k = [[0.0; N]; 3];
+        for p in 0..N {
+            sum[p] = g[0][p] + g[1][p] + g[2][p];
+            let inv = 1.0 / sum[p];
+            for c in 0..3 {
+                k[c][p] = g[c][p] * inv;
+            }
+        }
+        let lambda = match &self.bary {
             None => k,
-            Some(b) => std::array::from_fn(|c| {
-                std::array::from_fn(|p| k[0][p] * b[0][c] + k[1][p] * b[1][c] + k[2][p] * b[2][c])
-            }),
+            Some(b) => {
+                let mut l = [[0.0; N]; 3];
+                for c in 0..3 {
+                    for p in 0..N {
+                        l[c][p] = k[0][p] * b[0][c] + k[1][p] * b[1][c] + k[2][p] * b[2][c];
+                    }
+                }
+                l
+            }
         };
         std::array::from_fn(|p| Fragment {
             lambda: Vec3::new(

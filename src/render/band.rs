@@ -430,9 +430,7 @@ impl<'a> BandInputs<'a> {
                         // One fragment over every sample: the lanes write
                         // it.
                         let all = (1u32 << n) - 1;
-                        let (draw, mut p) = self.fragment(&mut at, ids[0], all);
-                        p.pixel = i as u32;
-                        lanes.push(self, draw, p, sink);
+                        self.fragment(&mut at, (ids[0], all), i as u32, (lanes, sink));
                         continue;
                     }
                     let parts = self.pixel_parts(&mut at, ids, bg, lanes, sink);
@@ -513,9 +511,7 @@ impl<'a> BandInputs<'a> {
                 parts.push(PixelShare::Shaded(bg, f32::INFINITY, count));
                 continue;
             }
-            let (draw, mut p) = self.fragment(at, id, mask);
-            p.pixel = LANE_SLOT;
-            let slot = lanes.push(self, draw, p, sink);
+            let slot = self.fragment(at, (id, mask), LANE_SLOT, (&mut *lanes, &mut *sink));
             parts.push(PixelShare::Queued(slot, count));
         }
         parts
@@ -592,8 +588,15 @@ impl<'a> BandInputs<'a> {
     }
 
     /// The fragment of triangle `id` covering samples `mask` of the pixel
-    /// `at` describes, for the lanes: its draw, and the fragment.
-    fn fragment(&self, at: &mut FragmentAt, id: u32, mask: u32) -> (u32, Pending) {
+    /// `at` describes, added to the lanes with `pixel` as where its result
+    /// goes (written in its place there, not copied in); its slot.
+    fn fragment(
+        &self,
+        at: &mut FragmentAt,
+        (id, mask): (u32, u32),
+        pixel: u32,
+        (lanes, sink): (&mut LaneBatches, &mut Sink),
+    ) -> u32 {
         let t = &self.tris[id as usize];
         let it = at.cache.get(id, t);
         let lm = self.lane_material(t.draw as usize);
@@ -634,9 +637,9 @@ impl<'a> BandInputs<'a> {
             }
             None => self.shading_point(it, px, py, mask),
         };
-        let p = Pending {
+        *lanes.next(t.draw) = Pending {
             id,
-            pixel: 0,
+            pixel,
             count: mask.count_ones() as f32,
             lambda: frag.lambda,
             w: frag.w,
@@ -646,7 +649,7 @@ impl<'a> BandInputs<'a> {
             lights: at.reach.lights,
             edge: self.edge_distance(it, px, py, frag.lambda),
         };
-        (t.draw, p)
+        lanes.commit(self, t.draw, sink)
     }
 }
 

@@ -162,14 +162,21 @@ impl LaneBatches {
         }
     }
 
-    /// Adds `p` (of draw `draw`) as the next slot, which it returns; a
-    /// full group of its draw is shaded into `sink`.
+    /// Where draw `draw`'s next fragment goes: filled in there, then
+    /// added by `commit`.
     #[inline]
-    pub fn push(&mut self, data: &BandInputs, draw: u32, p: Pending, sink: &mut Sink) -> u32 {
+    pub fn next(&mut self, draw: u32) -> &mut Pending {
+        let w = &mut self.waiting[draw as usize];
+        &mut w.group[w.len]
+    }
+
+    /// Adds the fragment written at `next(draw)` as the next slot, which
+    /// it returns; a full group of its draw is shaded into `sink`.
+    #[inline]
+    pub fn commit(&mut self, data: &BandInputs, draw: u32, sink: &mut Sink) -> u32 {
         let slot = self.next;
         self.next += 1;
         let w = &mut self.waiting[draw as usize];
-        w.group[w.len] = p;
         w.slots[w.len] = slot;
         w.len += 1;
         if w.len == self.width {
@@ -432,7 +439,21 @@ impl<'a> BandInputs<'a> {
         let d = self.draws[draw];
         let mesh = &self.setup.scene.models[d.model].mesh;
         let mv = &self.verts[d.model];
-        let idx = mesh.triangles[t.prim as usize].map(|i| i as usize);
+        let [i0, i1, i2] = mesh.triangles[t.prim as usize];
+        let k = [i0 as usize, i1 as usize, i2 as usize];
+        // Written out, not `array::map`: that call is left out of line,
+        // and this runs once per triangle a lane group shades.
+        #[inline(always)]
+        fn pick<T: Copy>(v: &[T], [a, b, c]: [usize; 3]) -> [T; 3] {
+            [v[a], v[b], v[c]]
+        }
+        let uv = |uv: &[Vec2]| {
+            if uv.is_empty() {
+                [Vec2::ZERO; 3]
+            } else {
+                pick(uv, k)
+            }
+        };
         let tt = &self.tangents[d.model];
         let tangent = if tt.is_empty() {
             [Vec4::ZERO; 3]
@@ -441,20 +462,14 @@ impl<'a> BandInputs<'a> {
             [tt[c], tt[c + 1], tt[c + 2]]
         };
         Corners {
-            world: idx.map(|i| mv.world[i]),
-            normal: idx.map(|i| mv.normal[i]),
-            uv: [&mesh.uvs, &mesh.uvs1].map(|uv| {
-                if uv.is_empty() {
-                    [Vec2::ZERO; 3]
-                } else {
-                    idx.map(|i| uv[i])
-                }
-            }),
+            world: pick(&mv.world, k),
+            normal: pick(&mv.normal, k),
+            uv: [uv(&mesh.uvs), uv(&mesh.uvs1)],
             tangent,
             color: if mesh.colors.is_empty() {
                 [Vec4::ONE; 3]
             } else {
-                idx.map(|i| mesh.colors[i])
+                pick(&mesh.colors, k)
             },
             prim: t.prim,
             front: t.front,

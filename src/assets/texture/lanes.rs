@@ -359,9 +359,12 @@ impl<'t> Chain<'t> {
     /// lies in it unless it crosses a block's edge).
     #[inline(always)]
     fn prefetch_place(&self, place: &Place4) {
+        // The slice once, not the small vector's inline-or-heap check per
+        // lane.
+        let texels = self.texels.as_slice();
         for k in 0..4 {
             if place.inside & (1 << k) != 0 {
-                prefetch_texel(self.texels[place.level[k]], place.at[k] as usize);
+                prefetch_texel(texels[place.level[k]], place.at[k] as usize);
             }
         }
     }
