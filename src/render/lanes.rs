@@ -62,8 +62,10 @@ pub(super) struct LaneBatches {
     width: usize,
     /// With eight lanes: a quad of one triangle waiting for a second of
     /// its draw, with its triangle's corners, the band pixels its
-    /// results go to and their samples.
+    /// results go to and their samples, where `quad_waits`; kept once
+    /// made, and written over in place.
     quad: Option<WaitingQuad>,
+    quad_waits: bool,
 }
 
 /// How many triangles' corners a band keeps at hand.
@@ -159,6 +161,7 @@ impl LaneBatches {
             corners: CornerCache::new(),
             width,
             quad: None,
+            quad_waits: false,
         }
     }
 
@@ -216,42 +219,55 @@ impl LaneBatches {
         let (draw, id) = (q.t.draw as usize, q.id);
         if self.width != 8 {
             let c = self.corners.get(data, draw, id, q.t);
-            let p = data.prepare_quad(&q, c);
+            let mut p = Prepared::EMPTY;
+            data.prepare_quad_into(&q, c, &mut p, 0);
             let out = data.shade_prepared(&p, &[c; MAX_LANES], &[], self.width);
             put_quad(&out[..4], pixels, color, depth, n);
             return;
         }
-        match self.quad.take() {
-            Some(mut first) if first.prepared.draw == draw => {
-                let c = self.corners.get(data, draw, id, q.t);
-                let p = data.prepare_quad(&q, c);
-                first.prepared.append(&p);
+        let (waiting, corners) = (&mut self.quad, &mut self.corners);
+        let c = corners.get(data, draw, id, q.t);
+        match waiting {
+            // The second quad goes into the first's lanes 4 .. 8, in place.
+            Some(first) if self.quad_waits && first.prepared.draw == draw => {
+                data.prepare_quad_into(&q, c, &mut first.prepared, 4);
                 let a = &first.corners;
                 let refs = [a, a, a, a, c, c, c, c];
                 let out = data.shade_prepared(&first.prepared, &refs, &[], 8);
                 put_quad(&out[..4], first.pixels, color, depth, first.samples);
                 put_quad(&out[4..], pixels, color, depth, n);
+                self.quad_waits = false;
             }
-            other => {
-                if let Some(first) = other {
-                    first.shade(data, color, depth);
+            // The waiting one shaded alone, and this one written over it
+            // (kept in place: a `WaitingQuad` is over a kilobyte).
+            Some(w) => {
+                if self.quad_waits {
+                    w.shade(data, color, depth);
                 }
-                let c = self.corners.get(data, draw, id, q.t);
+                data.prepare_quad_into(&q, c, &mut w.prepared, 0);
+                (w.corners, w.pixels, w.samples) = (*c, pixels, n);
+                self.quad_waits = true;
+            }
+            None => {
+                let mut prepared = Prepared::EMPTY;
+                data.prepare_quad_into(&q, c, &mut prepared, 0);
                 self.quad = Some(WaitingQuad {
-                    prepared: data.prepare_quad(&q, c),
+                    prepared,
                     corners: *c,
                     pixels,
                     samples: n,
                 });
+                self.quad_waits = true;
             }
         }
     }
 
     /// Shades a quad still waiting for a second.
     fn flush_quad(&mut self, data: &BandInputs, color: &mut [glam::Vec4], depth: &mut [f32]) {
-        if let Some(first) = self.quad.take() {
+        if let Some(first) = self.quad.as_ref().filter(|_| self.quad_waits) {
             first.shade(data, color, depth);
         }
+        self.quad_waits = false;
     }
 }
 
@@ -380,19 +396,18 @@ pub(super) struct Prepared {
 }
 
 impl Prepared {
-    /// `other`'s first four lanes after this one's first four.
-    fn append(&mut self, other: &Prepared) {
-        self.lambda[4..].copy_from_slice(&other.lambda[..4]);
-        self.w[4..].copy_from_slice(&other.w[..4]);
-        self.ao[4..].copy_from_slice(&other.ao[..4]);
-        self.edge[4..].copy_from_slice(&other.edge[..4]);
-        for s in 0..MAX_SIZES {
-            self.footprints[s][4..].copy_from_slice(&other.footprints[s][..4]);
-        }
-        self.bump[4..].copy_from_slice(&other.bump[..4]);
-        self.len = 8;
-        self.lights = self.lights.union(other.lights);
-    }
+    /// No fragment: filled in by `prepare_quad_into` or `prepare_group`.
+    const EMPTY: Prepared = Prepared {
+        draw: 0,
+        len: 0,
+        lambda: [Vec3::ZERO; MAX_LANES],
+        w: [0.0; MAX_LANES],
+        ao: [1.0; MAX_LANES],
+        edge: [f32::INFINITY; MAX_LANES],
+        footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
+        bump: [Vec2::ZERO; MAX_LANES],
+        lights: LightMask::NONE,
+    };
 }
 
 /// A lane call's fragments, their triangles' corners, and the footprints
@@ -743,11 +758,19 @@ impl<'a> BandInputs<'a> {
     }
 
     /// The four pixels of the quad `q`, all of one triangle, one sample
-    /// each, in reading order, ready for the lanes (lanes 4 .. 8 repeat
-    /// them). The quad's texture derivatives are its lanes' differences
+    /// each, in reading order, ready for the lanes, written into `out`:
+    /// at `at` 0, into lanes 0 .. 4 (lanes 4 .. 8 repeat them); at 4,
+    /// into lanes 4 .. 8 after a quad of the same draw (`out` then holds
+    /// eight). The quad's texture derivatives are its lanes' differences
     /// (what `gradients0_at` computes).
     #[inline(always)]
-    pub(super) fn prepare_quad(&self, q: &QuadAt, corners: &Corners) -> Prepared {
+    pub(super) fn prepare_quad_into(
+        &self,
+        q: &QuadAt,
+        corners: &Corners,
+        out: &mut Prepared,
+        at: usize,
+    ) {
         let (it, t) = (q.it, q.t);
         let (x, y) = q.q0;
         let px = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
@@ -786,20 +809,24 @@ impl<'a> BandInputs<'a> {
         };
         let grads = [grads(0), grads(1)];
         let fp = q.lm.footprints(&self.ctx, grads);
-        let pick = |k: usize| k.min(3);
-        Prepared {
-            draw: t.draw as usize,
-            len: 4,
-            lambda: std::array::from_fn(|k| f[pick(k)].lambda),
-            w: std::array::from_fn(|k| f[pick(k)].w),
-            ao: std::array::from_fn(|k| q.ao[pick(k)]),
-            edge: std::array::from_fn(|k| {
-                let ((x, y), l) = (px[pick(k)], f[pick(k)].lambda);
-                self.edge_distance(it, x, y, l)
-            }),
-            footprints: fp.slots.map(|f| [f; MAX_LANES]),
-            bump: [fp.bump; MAX_LANES],
-            lights: q.lights,
+        // Lane k takes the quad's pixel k - at (the last past the fourth).
+        let lanes = if at == 0 { 0..MAX_LANES } else { at..at + 4 };
+        for k in lanes {
+            let j = (k - at).min(3);
+            out.lambda[k] = f[j].lambda;
+            out.w[k] = f[j].w;
+            out.ao[k] = q.ao[j];
+            out.edge[k] = self.edge_distance(it, px[j].0, px[j].1, f[j].lambda);
+            for (s, fs) in out.footprints.iter_mut().enumerate() {
+                fs[k] = fp.slots[s];
+            }
+            out.bump[k] = fp.bump;
+        }
+        if at == 0 {
+            (out.draw, out.len, out.lights) = (t.draw as usize, 4, q.lights);
+        } else {
+            out.len = at + 4;
+            out.lights = out.lights.union(q.lights);
         }
     }
 
@@ -808,15 +835,8 @@ impl<'a> BandInputs<'a> {
     #[inline(always)]
     fn prepare_group(&self, frags: &[Pending; MAX_LANES], width: usize) -> Prepared {
         let mut p = Prepared {
-            draw: 0,
             len: width,
-            lambda: [Vec3::ZERO; MAX_LANES],
-            w: [0.0; MAX_LANES],
-            ao: [1.0; MAX_LANES],
-            edge: [f32::INFINITY; MAX_LANES],
-            footprints: [[Footprint::Lod(0.0); MAX_LANES]; MAX_SIZES],
-            bump: [Vec2::ZERO; MAX_LANES],
-            lights: LightMask::NONE,
+            ..Prepared::EMPTY
         };
         for (k, f) in frags.iter().enumerate().take(width) {
             p.lambda[k] = f.lambda;
