@@ -34,7 +34,9 @@ pub struct Interpolator {
 }
 
 impl Interpolator {
-    #[inline]
+    /// (Inlined, so that a cache slot is written from registers, not
+    /// copied from a return slot just written.)
+    #[inline(always)]
     pub fn new(t: &Tri) -> Interpolator {
         let identity = t.bary == [Vec3::X, Vec3::Y, Vec3::Z];
         Interpolator {

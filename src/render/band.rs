@@ -601,32 +601,10 @@ impl<'a> BandInputs<'a> {
         let it = at.cache.get(id, t);
         let lm = self.lane_material(t.draw as usize);
         let quad = &mut *at.quad;
-        let k = match quad.iter().position(|q| q.id == id) {
-            Some(k) => k,
-            None => {
-                // The triangle at the quad's four centres, kept: the
-                // derivatives are taken between the first three, and the
-                // pixels it covers are shaded there.
-                let centers = self.wants_gradients().then(|| it.at_quad(at.q0.0, at.q0.1));
-                let grads = match &centers {
-                    Some((c, _)) => self.lane_gradients_at(lm, t, &[c[0], c[1], c[2]]),
-                    None => [Gradients::default(); 2],
-                };
-                let footprints = lm.footprints(&self.ctx, grads);
-                quad.push(QuadEntry {
-                    id,
-                    grads,
-                    footprints,
-                    centers,
-                });
-                quad.len() - 1
-            }
-        };
         let (px, py) = at.px;
-        let q = &quad[k];
         // `shading_point`: at the centre where the triangle covers it
         // (`at_pixel`, or the same value kept), else the centroid.
-        let frag = match q.centers {
+        let point = |centers: &Option<([Fragment; 4], [bool; 4])>| match centers {
             Some((c, covers)) => {
                 let k = Interpolator::quad_lane(at.q0, px, py);
                 if self.pattern.len() == 1 || covers[k] {
@@ -637,14 +615,38 @@ impl<'a> BandInputs<'a> {
             }
             None => self.shading_point(it, px, py, mask),
         };
+        // (What a new entry holds is taken from the values made, not read
+        // back from the entry just written.)
+        let (frag, footprints, grads) = match quad.iter().find(|q| q.id == id) {
+            Some(q) => (point(&q.centers), q.footprints, q.grads),
+            None => {
+                // The triangle at the quad's four centres, kept: the
+                // derivatives are taken between the first three, and the
+                // pixels it covers are shaded there.
+                let centers = self.wants_gradients().then(|| it.at_quad(at.q0.0, at.q0.1));
+                let grads = match &centers {
+                    Some((c, _)) => self.lane_gradients_at(lm, t, c),
+                    None => [Gradients::default(); 2],
+                };
+                let footprints = lm.footprints(&self.ctx, grads);
+                let frag = point(&centers);
+                quad.push(QuadEntry {
+                    id,
+                    grads,
+                    footprints,
+                    centers,
+                });
+                (frag, footprints, grads)
+            }
+        };
         *lanes.next(t.draw) = Pending {
             id,
             pixel,
             count: mask.count_ones() as f32,
             lambda: frag.lambda,
             w: frag.w,
-            footprints: q.footprints,
-            grads: q.grads,
+            footprints,
+            grads,
             ao: at.reach.ao,
             lights: at.reach.lights,
             edge: self.edge_distance(it, px, py, frag.lambda),

@@ -81,7 +81,7 @@ impl<'a> BandInputs<'a> {
     /// Texture-coordinate derivatives of `t` (both sets) over a quad,
     /// from its top-left, top-right and bottom-left centres `centers`
     /// (`quad_centers`).
-    fn gradients_at(&self, t: &Tri, centers: &[Fragment; 3]) -> [Gradients; 2] {
+    fn gradients_at(&self, t: &Tri, centers: &[Fragment]) -> [Gradients; 2] {
         let uv = |k: usize| self.material_uv(t, centers[k].lambda).1;
         let (a, b, c) = (uv(0), uv(1), uv(2));
         [0, 1].map(|k| match (a[k], b[k], c[k]) {
@@ -111,12 +111,12 @@ impl<'a> BandInputs<'a> {
     }
 
     /// `lane_gradients` where they are wanted (`self.grads`), from the
-    /// quad's `quad_centers`.
+    /// quad's `quad_centers` (the first three of `centers`).
     pub(super) fn lane_gradients_at(
         &self,
         lm: &LaneMaterial,
         t: &Tri,
-        centers: &[Fragment; 3],
+        centers: &[Fragment],
     ) -> [Gradients; 2] {
         if lm.reads_set1() {
             self.gradients_at(t, centers)
@@ -132,7 +132,7 @@ impl<'a> BandInputs<'a> {
     }
 
     /// `gradients_at` of set 0 alone.
-    fn gradients0_at(&self, t: &Tri, centers: &[Fragment; 3]) -> Gradients {
+    fn gradients0_at(&self, t: &Tri, centers: &[Fragment]) -> Gradients {
         let d = self.draws[t.draw as usize];
         let mesh = &self.setup.scene.models[d.model].mesh;
         let uv = &mesh.uvs;
