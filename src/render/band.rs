@@ -433,8 +433,12 @@ impl<'a> BandInputs<'a> {
                         self.fragment(&mut at, (ids[0], all), i as u32, (lanes, sink));
                         continue;
                     }
-                    let parts = self.pixel_parts(&mut at, ids, bg, lanes, sink);
-                    deferred.push((i, parts));
+                    // (Filled where it is kept: a pixel's parts are over a
+                    // hundred bytes.)
+                    deferred.push((i, smallvec::SmallVec::new()));
+                    if let Some((_, parts)) = deferred.last_mut() {
+                        self.pixel_parts(&mut at, (ids, bg), (lanes, sink), parts);
+                    }
                 }
             }
         }
@@ -494,17 +498,15 @@ impl<'a> BandInputs<'a> {
     }
 
     /// The parts of a pixel whose samples hold several fragments `ids`
-    /// (the background `bg` where none), the fragments queued for the
-    /// lanes (the pixel waits for them).
+    /// (the background `bg` where none), into `parts`, the fragments
+    /// queued for the lanes (the pixel waits for them).
     fn pixel_parts(
         &self,
         at: &mut FragmentAt,
-        ids: &[u32],
-        bg: Vec4,
-        lanes: &mut LaneBatches,
-        sink: &mut Sink,
-    ) -> smallvec::SmallVec<[PixelShare; 4]> {
-        let mut parts: smallvec::SmallVec<[PixelShare; 4]> = smallvec::SmallVec::new();
+        (ids, bg): (&[u32], Vec4),
+        (lanes, sink): (&mut LaneBatches, &mut Sink),
+        parts: &mut smallvec::SmallVec<[PixelShare; 4]>,
+    ) {
         for (id, mask) in fragments(ids) {
             let count = mask.count_ones() as f32;
             if id == NO_TRIANGLE {
@@ -514,7 +516,6 @@ impl<'a> BandInputs<'a> {
             let slot = self.fragment(at, (id, mask), LANE_SLOT, (&mut *lanes, &mut *sink));
             parts.push(PixelShare::Queued(slot, count));
         }
-        parts
     }
 
     /// The background at band pixel (px, py): the environment or the
