@@ -66,6 +66,8 @@ pub(super) struct LaneBatches {
     /// made, and written over in place.
     quad: Option<WaitingQuad>,
     quad_waits: bool,
+    /// A queued group as the lanes take it (`shade_group`).
+    prepared: Prepared,
 }
 
 /// How many triangles' corners a band keeps at hand.
@@ -162,6 +164,7 @@ impl LaneBatches {
             width,
             quad: None,
             quad_waits: false,
+            prepared: Prepared::EMPTY,
         }
     }
 
@@ -183,7 +186,14 @@ impl LaneBatches {
         w.slots[w.len] = slot;
         w.len += 1;
         if w.len == self.width {
-            shade_group(data, draw as usize, w, &mut self.corners, sink, self.width);
+            shade_group(
+                data,
+                draw as usize,
+                w,
+                (&mut self.corners, &mut self.prepared),
+                sink,
+                self.width,
+            );
             w.len = 0;
         }
         slot
@@ -198,7 +208,14 @@ impl LaneBatches {
                 for k in w.len..MAX_LANES {
                     w.group[k] = w.group[w.len - 1];
                 }
-                shade_group(data, draw, w, &mut self.corners, sink, self.width);
+                shade_group(
+                    data,
+                    draw,
+                    w,
+                    (&mut self.corners, &mut self.prepared),
+                    sink,
+                    self.width,
+                );
                 w.len = 0;
             }
         }
@@ -327,13 +344,16 @@ fn shade_group(
     data: &BandInputs,
     draw: usize,
     w: &Waiting,
-    corners: &mut CornerCache,
+    (corners, p): (&mut CornerCache, &mut Prepared),
     sink: &mut Sink,
     width: usize,
 ) {
     let lm = data.lane_material(draw);
-    let mut p = data.prepare_group(&w.group, width);
+    // (Made in the batches' own, which is reused, not returned and
+    // copied: its lanes from `width` on stay empty.)
+    data.prepare_group_into(&w.group, width, p);
     p.draw = draw;
+    let p = &*p;
     let extra = data.extra_footprints(lm, &w.group, width);
     let id = |k: usize| w.group[k].id;
     let tri = |k: usize| &data.tris[id(k) as usize];
@@ -357,7 +377,7 @@ fn shade_group(
         for k in width..MAX_LANES {
             refs[k] = refs[width - 1];
         }
-        data.shade_prepared(&p, &refs, &extra, width)
+        data.shade_prepared(p, &refs, &extra, width)
     } else {
         let mut own = [Corners::NONE; MAX_LANES];
         for k in 0..width {
@@ -370,7 +390,7 @@ fn shade_group(
         }
         let own = &own;
         let refs = std::array::from_fn(|k| &own[k.min(width - 1)]);
-        data.shade_prepared(&p, &refs, &extra, width)
+        data.shade_prepared(p, &refs, &extra, width)
     };
     for (k, &(c, d)) in out.iter().enumerate().take(w.len) {
         sink.put(w.slots[k], w.group[k].pixel, w.group[k].count, c, d);
@@ -834,10 +854,16 @@ impl<'a> BandInputs<'a> {
     /// where fewer wait), ready for the lanes.
     #[inline(always)]
     fn prepare_group(&self, frags: &[Pending; MAX_LANES], width: usize) -> Prepared {
-        let mut p = Prepared {
-            len: width,
-            ..Prepared::EMPTY
-        };
+        let mut p = Prepared::EMPTY;
+        self.prepare_group_into(frags, width, &mut p);
+        p
+    }
+
+    /// `prepare_group` into `p`, whose lanes from `width` on are left as
+    /// they are.
+    #[inline(always)]
+    fn prepare_group_into(&self, frags: &[Pending; MAX_LANES], width: usize, p: &mut Prepared) {
+        (p.len, p.lights) = (width, LightMask::NONE);
         for (k, f) in frags.iter().enumerate().take(width) {
             p.lambda[k] = f.lambda;
             p.w[k] = f.w;
@@ -849,7 +875,6 @@ impl<'a> BandInputs<'a> {
             p.bump[k] = f.footprints.bump;
             p.lights = p.lights.union(f.lights);
         }
-        p
     }
 
     /// The footprints of `lm`'s slots past `MAX_SIZES`
