@@ -10,7 +10,7 @@
 //! weights. That depends only on the texture's size and mip chain, so the
 //! maps of a material that share a size (diffuse, specular and normal map,
 //! mostly) share it, anisotropic probes included (`Chain::place4_into`).
-//! `Chain::read_placed` then loads, decodes and blends each map's texels.
+//! `Chain::read_placed_into` then loads, decodes and blends each map's texels.
 //! A lane whose footprint leaves the image (an address mode applies) takes
 //! the one-lookup path.
 
@@ -219,7 +219,7 @@ impl<'t> Chain<'t> {
     }
 
     /// `*out` = where `sample4(u, v, fps, _)` reads, in this chain or any
-    /// other of its shape (`read_placed`), written in place.
+    /// other of its shape (`read_placed_into`), written in place.
     #[inline]
     pub fn place4_into(&self, u: Vec4, v: Vec4, fps: &[Footprint; 4], out: &mut Placed4) {
         out.probes = None;
@@ -240,17 +240,20 @@ impl<'t> Chain<'t> {
     }
 
     /// What `sample4` gives at the lookups `placed` places (found in a
-    /// chain of this shape), in this texture; None where they are not
-    /// placed.
+    /// chain of this shape), in this texture, written into `out`; false
+    /// (and `out` as it was) where they are not placed. (Into place: a
+    /// caller's copy of a returned result would load wide over the
+    /// lookup's narrow stores, and wait on them.)
     #[inline]
-    pub fn read_placed(&self, placed: &Placed4, mode: Wrap) -> Option<Rgb4> {
+    pub fn read_placed_into(&self, placed: &Placed4, mode: Wrap, out: &mut Rgb4) -> bool {
         match placed {
-            Placed4 { taps: Some(t), .. } => Some(self.read::<3>(t, mode)),
+            Placed4 { taps: Some(t), .. } => self.read_into::<3>(t, mode, out),
             Placed4 {
                 probes: Some(p), ..
-            } => Some(self.read_probes::<3>(p, mode)),
-            _ => None,
+            } => *out = self.read_probes::<3>(p, mode),
+            _ => return false,
         }
+        true
     }
 
     /// The taps of `sample_lod(mips, uv_k, mode, lod[k])` per lane: the
@@ -316,18 +319,27 @@ impl<'t> Chain<'t> {
     /// The lookups `taps` describe, in this texture: the first `N`
     /// channels (taps found in a chain of another shape are found again
     /// here).
-    #[inline]
+    #[inline(always)]
     fn read<const N: usize>(&self, taps: &Taps4, mode: Wrap) -> [Vec4; N] {
+        let mut out = [Vec4::ZERO; N];
+        self.read_into(taps, mode, &mut out);
+        out
+    }
+
+    /// `read` into `out`, each channel stored alone: a caller that reads
+    /// them one by one does not wait on a wide copy of narrow stores.
+    #[inline]
+    fn read_into<const N: usize>(&self, taps: &Taps4, mode: Wrap, out: &mut [Vec4; N]) {
         if taps.shape != self.shape() {
             // Taps of another shape: found again here.
             let again = self.lod_taps4(taps.u, taps.v, taps.lod);
-            return self.read(&again.only(taps.near.live), mode);
+            return self.read_into(&again.only(taps.near.live), mode, out);
         }
         let a = self.bilinear4(&taps.near, taps.u, taps.v, mode);
-        match &taps.far {
+        *out = match &taps.far {
             None => a,
             Some((far, f)) => blend(a, self.bilinear4(far, taps.u, taps.v, mode), *f),
-        }
+        };
     }
 
     /// `prefetch` of the lookups `placed` places.

@@ -368,15 +368,16 @@ impl<'f, 'p, L: Lane> Lookups<'f, 'p, L> {
         let mut rgb = [[Vec4::ZERO; 3]; 2];
         for (q, out) in rgb.iter_mut().enumerate().take(L::QUADS) {
             let placed = self.taps[q].get(map.slot);
-            *out = match placed.and_then(|p| map.chain.read_placed(p, map.mode)) {
-                Some(rgb) => rgb,
-                None => map.chain.sample4(
+            // (Read into place: a copy of a returned result would load
+            // wide over the lookup's narrow stores, and wait on them.)
+            if !placed.is_some_and(|p| map.chain.read_placed_into(p, map.mode, out)) {
+                *out = map.chain.sample4(
                     f.uv(map).0.quad(q),
                     f.uv(map).1.quad(q),
                     &f.footprints4(map.slot, q),
                     map.mode,
-                ),
-            };
+                );
+            }
         }
         V3 {
             x: L::from_quads(|q| rgb[q][0]),
