@@ -62,9 +62,9 @@ pub(super) struct LaneBatches {
     width: usize,
     /// With eight lanes: a quad of one triangle waiting for a second of
     /// its draw, with its triangle's corners, the band pixels its
-    /// results go to and their samples, where `quad_waits`; kept once
-    /// made, and written over in place.
-    quad: Option<WaitingQuad>,
+    /// results go to and their samples, where `quad_waits`. Written over
+    /// in place, never moved: it is over a kilobyte.
+    quad: WaitingQuad,
     quad_waits: bool,
     /// A queued group as the lanes take it (`shade_group`).
     prepared: Prepared,
@@ -162,7 +162,7 @@ impl LaneBatches {
             next: 0,
             corners: CornerCache::new(),
             width,
-            quad: None,
+            quad: WaitingQuad::NONE,
             quad_waits: false,
             prepared: Prepared::EMPTY,
         }
@@ -234,55 +234,40 @@ impl LaneBatches {
         n: usize,
     ) {
         let (draw, id) = (q.t.draw as usize, q.id);
+        let c = self.corners.get(data, draw, id, q.t);
         if self.width != 8 {
-            let c = self.corners.get(data, draw, id, q.t);
             let mut p = Prepared::EMPTY;
             data.prepare_quad_into(&q, c, &mut p, 0);
             let out = data.shade_prepared(&p, &[c; MAX_LANES], &[], self.width);
             put_quad(&out[..4], pixels, color, depth, n);
             return;
         }
-        let (waiting, corners) = (&mut self.quad, &mut self.corners);
-        let c = corners.get(data, draw, id, q.t);
-        match waiting {
-            // The second quad goes into the first's lanes 4 .. 8, in place.
-            Some(first) if self.quad_waits && first.prepared.draw == draw => {
-                data.prepare_quad_into(&q, c, &mut first.prepared, 4);
-                let a = &first.corners;
-                let refs = [a, a, a, a, c, c, c, c];
-                let out = data.shade_prepared(&first.prepared, &refs, &[], 8);
-                put_quad(&out[..4], first.pixels, color, depth, first.samples);
-                put_quad(&out[4..], pixels, color, depth, n);
-                self.quad_waits = false;
-            }
-            // The waiting one shaded alone, and this one written over it
-            // (kept in place: a `WaitingQuad` is over a kilobyte).
-            Some(w) => {
-                if self.quad_waits {
-                    w.shade(data, color, depth);
-                }
-                data.prepare_quad_into(&q, c, &mut w.prepared, 0);
-                (w.corners, w.pixels, w.samples) = (*c, pixels, n);
-                self.quad_waits = true;
-            }
-            None => {
-                let mut prepared = Prepared::EMPTY;
-                data.prepare_quad_into(&q, c, &mut prepared, 0);
-                self.quad = Some(WaitingQuad {
-                    prepared,
-                    corners: *c,
-                    pixels,
-                    samples: n,
-                });
-                self.quad_waits = true;
-            }
+        let w = &mut self.quad;
+        if self.quad_waits && w.prepared.draw == draw {
+            // The second quad goes into the first's lanes 4 .. 8.
+            data.prepare_quad_into(&q, c, &mut w.prepared, 4);
+            let a = &w.corners;
+            let refs = [a, a, a, a, c, c, c, c];
+            let out = data.shade_prepared(&w.prepared, &refs, &[], 8);
+            put_quad(&out[..4], w.pixels, color, depth, w.samples);
+            put_quad(&out[4..], pixels, color, depth, n);
+            self.quad_waits = false;
+            return;
         }
+        // A quad of another draw waiting is shaded alone; this one is
+        // written over it and waits.
+        if self.quad_waits {
+            w.shade(data, color, depth);
+        }
+        data.prepare_quad_into(&q, c, &mut w.prepared, 0);
+        (w.corners, w.pixels, w.samples) = (*c, pixels, n);
+        self.quad_waits = true;
     }
 
     /// Shades a quad still waiting for a second.
     fn flush_quad(&mut self, data: &BandInputs, color: &mut [glam::Vec4], depth: &mut [f32]) {
-        if let Some(first) = self.quad.as_ref().filter(|_| self.quad_waits) {
-            first.shade(data, color, depth);
+        if self.quad_waits {
+            self.quad.shade(data, color, depth);
         }
         self.quad_waits = false;
     }
@@ -298,6 +283,14 @@ struct WaitingQuad {
 }
 
 impl WaitingQuad {
+    /// None waiting (`LaneBatches::quad_waits` false).
+    const NONE: WaitingQuad = WaitingQuad {
+        prepared: Prepared::EMPTY,
+        corners: Corners::NONE,
+        pixels: [0; 4],
+        samples: 0,
+    };
+
     /// Shades it alone.
     fn shade(&self, data: &BandInputs, color: &mut [glam::Vec4], depth: &mut [f32]) {
         let c = &self.corners;
