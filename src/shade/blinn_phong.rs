@@ -171,12 +171,8 @@ impl ShadeContext<'_> {
                     // Lanes that do not shine give what they give (x = 0:
                     // 2^-126 raised), left out by the select.
                     let pw = match ns {
-                        Exponent::One(ns) => {
-                            L::from_quads(|q| crate::powers::pow4(ndh.quad(q), ns))
-                        }
-                        Exponent::PerLane(ns) => {
-                            L::from_fn(|k| crate::powers::pow_unit(ndh.lane(k), ns.lane(k)))
-                        }
+                        Exponent::One(ns) => crate::powers::pow(ndh, L::splat(ns)),
+                        Exponent::PerLane(ns) => crate::powers::pow(ndh, ns),
                     };
                     spec = spec + V3::select(shine, e.scale(pw), V3::zero());
                 }

@@ -62,6 +62,15 @@ pub trait Lane:
     fn is_finite(self) -> Self::Mask;
     /// Lane by lane: `a` where `m`, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Each lane, a positive normal float 2^e m, as (m in [1, 2), e): its
+    /// bits taken apart (`powers`).
+    fn split_exponent(self) -> (Self, Self);
+    /// Each lane, whole or not, in [-2^22, 2^22], to the nearest whole
+    /// number, ties to even; a zero is +0.
+    fn round_even(self) -> Self;
+    /// 2^n per lane for whole n in [-127, 127], with 2^-127 as 0: n put
+    /// in the exponent bits.
+    fn exp2_whole(self) -> Self;
     /// Lanes 4q .. 4q + 4 (q < QUADS); one lane repeats in all four.
     #[inline(always)]
     fn quad(self, q: usize) -> Vec4 {
@@ -179,6 +188,21 @@ impl Lane for f32 {
     fn select(m: bool, a: f32, b: f32) -> f32 {
         if m { a } else { b }
     }
+    #[inline(always)]
+    fn split_exponent(self) -> (f32, f32) {
+        let b = self.to_bits();
+        let m = f32::from_bits(b & 0x007f_ffff | 0x3f80_0000);
+        (m, ((b >> 23) as i32 - 127) as f32)
+    }
+    #[inline(always)]
+    fn round_even(self) -> f32 {
+        // + 0: a zero is +0, as the SIMD conversions give it.
+        self.round_ties_even() + 0.0
+    }
+    #[inline(always)]
+    fn exp2_whole(self) -> f32 {
+        f32::from_bits(((self as i32 + 127) as u32) << 23)
+    }
 }
 
 impl Mask for BVec4A {
@@ -276,6 +300,91 @@ impl Lane for Vec4 {
     fn select(m: BVec4A, a: Vec4, b: Vec4) -> Vec4 {
         Vec4::select(m, a, b)
     }
+    #[inline(always)]
+    fn split_exponent(self) -> (Vec4, Vec4) {
+        bits4::split_exponent(self)
+    }
+    #[inline(always)]
+    fn round_even(self) -> Vec4 {
+        bits4::round_even(self)
+    }
+    #[inline(always)]
+    fn exp2_whole(self) -> Vec4 {
+        bits4::exp2_whole(self)
+    }
+}
+
+/// The bit-level steps of four lanes (`Lane::split_exponent`,
+/// `round_even`, `exp2_whole`): SSE2 integer instructions on x86-64, the
+/// scalar steps lane by lane elsewhere.
+mod bits4 {
+    use glam::Vec4;
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn split_exponent(x: Vec4) -> (Vec4, Vec4) {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 only (in every x86-64 target's base features); no
+        // memory is touched.
+        unsafe {
+            let b = _mm_castps_si128(x.into());
+            let e = _mm_sub_epi32(_mm_srli_epi32(b, 23), _mm_set1_epi32(127));
+            let m = _mm_or_si128(
+                _mm_and_si128(b, _mm_set1_epi32(0x007f_ffff)),
+                _mm_set1_epi32(0x3f80_0000),
+            );
+            (
+                Vec4::from(_mm_castsi128_ps(m)),
+                Vec4::from(_mm_cvtepi32_ps(e)),
+            )
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn round_even(z: Vec4) -> Vec4 {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 only; the conversion rounds by MXCSR, which Rust
+        // leaves at its default (to nearest, ties to even).
+        unsafe { Vec4::from(_mm_cvtepi32_ps(_mm_cvtps_epi32(z.into()))) }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn exp2_whole(n: Vec4) -> Vec4 {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 only; no memory is touched. n + 127 lies in [0,
+        // 254]: a biased exponent, 0 being the float 0.
+        unsafe {
+            let e = _mm_add_epi32(_mm_cvttps_epi32(n.into()), _mm_set1_epi32(127));
+            Vec4::from(_mm_castsi128_ps(_mm_slli_epi32(e, 23)))
+        }
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    pub fn split_exponent(x: Vec4) -> (Vec4, Vec4) {
+        use super::Lane;
+        let s = x.to_array().map(f32::split_exponent);
+        (
+            Vec4::from_array(s.map(|s| s.0)),
+            Vec4::from_array(s.map(|s| s.1)),
+        )
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    pub fn round_even(z: Vec4) -> Vec4 {
+        use super::Lane;
+        Vec4::from_array(z.to_array().map(f32::round_even))
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    pub fn exp2_whole(n: Vec4) -> Vec4 {
+        use super::Lane;
+        Vec4::from_array(n.to_array().map(f32::exp2_whole))
+    }
 }
 
 pub use f8::F8;
@@ -300,7 +409,8 @@ mod f8 {
     pub struct M8(__m256);
 
     // SAFETY (every block below): AVX is enabled for the whole build
-    // (`target_feature = "avx"` gates this module); the intrinsics touch
+    // (`target_feature = "avx"` gates this module; the blocks with AVX2
+    // intrinsics are gated by `target_feature = "avx2"`); the intrinsics touch
     // no memory but the arrays named.
     macro_rules! op {
         ($tr:ident, $f:ident, $ty:ident, $intr:ident) => {
@@ -470,6 +580,56 @@ mod f8 {
         fn select(m: M8, a: F8, b: F8) -> F8 {
             F8(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
         }
+        #[cfg(target_feature = "avx2")]
+        #[inline(always)]
+        fn split_exponent(self) -> (F8, F8) {
+            // (Integer AVX2 as `bits4`'s SSE2.)
+            unsafe {
+                let b = _mm256_castps_si256(self.0);
+                let e = _mm256_sub_epi32(_mm256_srli_epi32(b, 23), _mm256_set1_epi32(127));
+                let m = _mm256_or_si256(
+                    _mm256_and_si256(b, _mm256_set1_epi32(0x007f_ffff)),
+                    _mm256_set1_epi32(0x3f80_0000),
+                );
+                (F8(_mm256_castsi256_ps(m)), F8(_mm256_cvtepi32_ps(e)))
+            }
+        }
+        #[cfg(target_feature = "avx2")]
+        #[inline(always)]
+        fn round_even(self) -> F8 {
+            // The conversion rounds by MXCSR, which Rust leaves at its
+            // default (to nearest, ties to even).
+            F8(unsafe { _mm256_cvtepi32_ps(_mm256_cvtps_epi32(self.0)) })
+        }
+        #[cfg(target_feature = "avx2")]
+        #[inline(always)]
+        fn exp2_whole(self) -> F8 {
+            // n + 127 lies in [0, 254]: a biased exponent, 0 being the
+            // float 0.
+            unsafe {
+                let e = _mm256_add_epi32(_mm256_cvttps_epi32(self.0), _mm256_set1_epi32(127));
+                F8(_mm256_castsi256_ps(_mm256_slli_epi32(e, 23)))
+            }
+        }
+        #[cfg(not(target_feature = "avx2"))]
+        #[inline(always)]
+        fn split_exponent(self) -> (F8, F8) {
+            let (lo, hi) = (self.quad(0).split_exponent(), self.quad(1).split_exponent());
+            (
+                F8::from_quads(|q| [lo.0, hi.0][q]),
+                F8::from_quads(|q| [lo.1, hi.1][q]),
+            )
+        }
+        #[cfg(not(target_feature = "avx2"))]
+        #[inline(always)]
+        fn round_even(self) -> F8 {
+            F8::from_quads(|q| self.quad(q).round_even())
+        }
+        #[cfg(not(target_feature = "avx2"))]
+        #[inline(always)]
+        fn exp2_whole(self) -> F8 {
+            F8::from_quads(|q| self.quad(q).exp2_whole())
+        }
     }
 }
 
@@ -611,6 +771,13 @@ mod f8 {
         fn select(m: M8, a: F8, b: F8) -> F8 {
             F8(Vec4::select(m.0, a.0, b.0), Vec4::select(m.1, a.1, b.1))
         }
+        #[inline(always)]
+        fn split_exponent(self) -> (F8, F8) {
+            let (lo, hi) = (self.0.split_exponent(), self.1.split_exponent());
+            (F8(lo.0, hi.0), F8(lo.1, hi.1))
+        }
+        two!(round_even);
+        two!(exp2_whole);
     }
 }
 
@@ -689,6 +856,31 @@ mod tests {
                 let pick = L::select(a.cmplt(b), a, b).lane(k);
                 assert_eq!(bits(pick), bits(if x < y { x } else { y }));
                 assert_eq!(bits(a.map(|x| x * 3.0 + 1.0).lane(k)), bits(x * 3.0 + 1.0));
+            }
+            // The bit-level steps, over their domains.
+            let pos = L::from_fn(|k| v[(start + k) % n].abs().max(f32::MIN_POSITIVE));
+            let w = |k: usize| v[(start + k) % n] * 0.25;
+            let whole = L::from_fn(|k| {
+                if w(k).is_nan() {
+                    0.5
+                } else {
+                    w(k).clamp(-127.0, 127.0)
+                }
+            });
+            let (m, e) = pos.split_exponent();
+            for k in 0..L::WIDTH {
+                let (x, w) = (pos.lane(k), whole.lane(k));
+                let (mx, ex) = x.split_exponent();
+                assert_eq!((bits(m.lane(k)), bits(e.lane(k))), (bits(mx), bits(ex)));
+                assert_eq!(mx * ex.exp2(), x, "{x} = {mx} 2^{ex}");
+                assert_eq!(
+                    bits(whole.round_even().lane(k)),
+                    bits(w.round_ties_even() + 0.0)
+                );
+                let r = w.round_ties_even();
+                let want = if r == -127.0 { 0.0 } else { r.exp2() };
+                assert_eq!(r.round_even().exp2_whole(), want);
+                assert_eq!(bits(whole.round_even().exp2_whole().lane(k)), bits(want));
             }
             let m = a.cmplt(b);
             assert_eq!(m.any(), m.bitmask() != 0);
