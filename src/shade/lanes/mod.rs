@@ -112,16 +112,6 @@ impl<L: Lane> Lanes<L> {
             mask: self.lights,
         }
     }
-
-    /// Quad `q`'s plane normals.
-    #[inline(always)]
-    pub(super) fn geo_normal4(&self, q: usize) -> [Vec3; 4] {
-        let g = &self.geo_normal;
-        if L::WIDTH == 1 {
-            return [g[0]; 4];
-        }
-        [g[4 * q], g[4 * q + 1], g[4 * q + 2], g[4 * q + 3]]
-    }
 }
 
 impl<L: Lane> Coords<'_, L> {
@@ -430,25 +420,13 @@ impl<'a> ShadeContext<'a> {
         let mut lit = reaches & ndl.cmpgt(L::splat(0.0));
         let mut s = L::splat(1.0);
         if light.shadows {
-            // Four lanes at a time.
             let bits = lit.bitmask();
-            s = L::from_quads(|q| {
-                let quad = |v: V3<L>| V3 {
-                    x: v.x.quad(q),
-                    y: v.y.quad(q),
-                    z: v.z.quad(q),
-                };
-                let mask = if L::WIDTH == 1 {
-                    bits
-                } else {
-                    bits >> (4 * q) & 0xf
-                };
-                let mut ng = f.geo_normal4(q);
-                if behind {
-                    ng = ng.map(|g| -g);
-                }
-                self.shadows.visibility4(i, quad(p), &ng, quad(l), mask)
-            });
+            s = if behind {
+                let ng = f.geo_normal.map(|g| -g);
+                self.shadows.visibility(i, p, &ng, l, bits)
+            } else {
+                self.shadows.visibility(i, p, &f.geo_normal, l, bits)
+            };
             lit = lit & s.cmpgt(L::splat(0.0));
         }
         Lit {

@@ -1,12 +1,15 @@
 //! The filters that read a shadow map at placed lookups: "hard" (the one
 //! texel under the point) and PCF (a 3x3-texel box, area-weighted, over
-//! 4x4 texels, four lookups at a time), each comparing the stored depth
-//! with the receiver's plane at the texel's center.
+//! 4x4 texels, one lookup per lane of any width), each comparing the
+//! stored depth with the receiver's plane at the texel's center.
 
 use glam::{Mat4, Vec4};
 
-use super::{MAX_TAN, Placed4, ShadowMap};
-use crate::simd::lanes4;
+use super::{MAX_TAN, Placed, ShadowMap};
+use crate::simd::{Lane, Mask, lanes4};
+
+/// Most lanes of a lookup (`simd::F8`).
+const MAX_LANES: usize = 8;
 
 /// The "hard" filter: the one texel under (`fx`, `fy`), lit when its
 /// stored depth is not nearer (greater) than the receiver's plane at its
@@ -21,37 +24,38 @@ pub(super) fn hard(m: &ShadowMap, (fx, fy): (f32, f32), z: f32, (gx, gy): (f32, 
     if stored <= zr { 1.0 } else { 0.0 }
 }
 
-/// Where four lookups read a map (`kernels4`): per lane, texel
+/// Where lookups read a map (`kernels`), one per lane of `L`: texel
 /// coordinates, the receiver plane's depth there and its slopes per
 /// texel, capped; the lanes inside the map (bit k: lane k).
-pub(super) struct Kernels4 {
-    pub fx: Vec4,
-    pub fy: Vec4,
-    pub z: Vec4,
-    pub gx: Vec4,
-    pub gy: Vec4,
+pub(super) struct Kernels<L: Lane> {
+    pub fx: L,
+    pub fy: L,
+    pub z: L,
+    pub gx: L,
+    pub gy: L,
     pub inside: u32,
 }
 
-/// The kernels of four lookups placed in `m` (`Shadows::place4`): the
+/// The kernels of the lookups placed in `m` (`Shadows::place`): the
 /// plane's slopes capped at `z_per_texel` times the slope cap (`f32`'s
 /// max and min: a NaN cap, from extreme geometry, caps nothing), and the
 /// lanes whose point lies inside the map (the others are lit).
-#[inline]
-pub(super) fn kernels4(m: &ShadowMap, p: &Placed4) -> Kernels4 {
-    let cap = p.z_per_texel * Vec4::splat(MAX_TAN);
+#[inline(always)]
+pub(super) fn kernels<L: Lane>(m: &ShadowMap, p: &Placed<L>) -> Kernels<L> {
+    let cap = p.z_per_texel * L::splat(MAX_TAN);
     // `f32::max`, `f32::min`: a NaN lane takes the other operand (the
     // sign of a zero may differ; it only enters sums compared with <=).
-    let max = |a: Vec4, b: Vec4| Vec4::select(b.is_nan_mask(), a, a.max(b));
-    let min = |a: Vec4, b: Vec4| Vec4::select(b.is_nan_mask(), a, a.min(b));
-    let size = Vec4::splat(m.size as f32);
-    let inside = p.fx.is_finite_mask()
-        & p.fy.is_finite_mask()
-        & p.fx.cmpge(Vec4::ZERO)
-        & p.fy.cmpge(Vec4::ZERO)
+    let max = |a: L, b: L| L::select(b.is_nan(), a, a.max(b));
+    let min = |a: L, b: L| L::select(b.is_nan(), a, a.min(b));
+    let size = L::splat(m.size as f32);
+    let zero = L::splat(0.0);
+    let inside = p.fx.is_finite()
+        & p.fy.is_finite()
+        & p.fx.cmpge(zero)
+        & p.fy.cmpge(zero)
         & p.fx.cmplt(size)
         & p.fy.cmplt(size);
-    Kernels4 {
+    Kernels {
         fx: p.fx,
         fy: p.fy,
         z: p.z,
@@ -61,29 +65,61 @@ pub(super) fn kernels4(m: &ShadowMap, p: &Placed4) -> Kernels4 {
     }
 }
 
-/// The PCF kernel of the lanes in `live` (bit k: lane k of `at`), four
-/// at a time; the other lanes' values are unspecified. Per lane: the lit
-/// fraction of a 3x3-texel box around (`fx`, `fy`), each texel compared
-/// with the receiver's plane (depth `z` at the point, `gx`, `gy` per
-/// texel). The box covers 4x4 texels, the outer ones in part. Each lane
-/// takes the same sums in the same order as it would alone: per row the
-/// products wx[i] * (0 or 1) (= wx[i] or +0) summed along the row from 0
-/// in column order, then the rows weighted and summed from 0 in row order.
-#[inline]
-pub(super) fn pcf4(m: &ShadowMap, at: &Kernels4, live: u32) -> Vec4 {
-    let n = m.size as i32;
-    let sp = Vec4::splat;
+/// The PCF kernel of the lanes in `live` (bit k: lane k of `at`); the
+/// other lanes' values are unspecified. Per lane: the lit fraction of a
+/// 3x3-texel box around (`fx`, `fy`), each texel compared with the
+/// receiver's plane (depth `z` at the point, `gx`, `gy` per texel). The
+/// box covers 4x4 texels, the outer ones in part. Each lane takes the
+/// same sums in the same order at every width: per row the products
+/// wx[i] * (0 or 1) (= wx[i] or +0) summed along the row from 0 in column
+/// order, then the rows weighted and summed from 0 in row order.
+#[inline(always)]
+pub(super) fn pcf<L: Lane>(m: &ShadowMap, at: &Kernels<L>, live: u32) -> L {
+    let sp = L::splat;
     let (fx, fy, z, gx, gy) = (at.fx, at.fy, at.z, at.gx, at.gy);
     // Per lane the box's first texel column and row: [f - 1.5, f + 1.5]
-    // per axis, texel i covering [i, i + 1].
-    let corner: [(i32, i32); 4] =
-        std::array::from_fn(|k| (floor_i32(fx[k] - 1.5), floor_i32(fy[k] - 1.5)));
-    // Per row j and lane k, the 4 texels the box reads (clamped to the
-    // map). Where nothing was drawn under them they are all 0: not read
-    // (the same values; the reads would mostly miss the cache).
-    let mut rows = [[Vec4::ZERO; 4]; 4];
-    for k in (0..4).filter(|k| live & (1 << k) != 0) {
-        let (bx, by) = corner[k];
+    // per axis, texel i covering [i, i + 1] (whole numbers, exact as
+    // floats: far below 2^24).
+    let (bx, by) = ((fx - sp(1.5)).floor(), (fy - sp(1.5)).floor());
+    let rows = box_rows::<L>(m, (bx, by), live);
+    let w = |i: L, f: L| {
+        let lo = i.max(f - sp(1.5));
+        let hi = (i + sp(1.0)).min(f + sp(1.5));
+        (hi - lo).max(sp(0.0)) / sp(3.0)
+    };
+    let xs = [0.0, 1.0, 2.0, 3.0].map(|i| bx + sp(i));
+    let wx = xs.map(|x| w(x, fx));
+    // The receiver's depth at texel (i, j) is (z + tx[i]) + ty[j].
+    let ztx = xs.map(|x| z + gx * ((x + sp(0.5)) - fx));
+    let mut sum = sp(0.0);
+    for (j, row) in rows.iter().enumerate() {
+        let y = by + sp(j as f32);
+        let ty = gy * ((y + sp(0.5)) - fy);
+        // Lane k of `stored[i]` is lane k's texel in column i: each four
+        // lanes' rows turned into columns.
+        let mut t = [Mat4::ZERO; 2];
+        for (q, t) in t.iter_mut().enumerate().take(L::QUADS) {
+            *t = Mat4::from_cols(row[4 * q], row[4 * q + 1], row[4 * q + 2], row[4 * q + 3])
+                .transpose();
+        }
+        let stored = [0, 1, 2, 3].map(|i| L::from_quads(|q| t[q].col(i)));
+        let term = |i: usize| L::select(stored[i].cmple(ztx[i] + ty), wx[i], sp(0.0));
+        let along = (((sp(0.0) + term(0)) + term(1)) + term(2)) + term(3);
+        sum = sum + w(y, fy) * along;
+    }
+    sum
+}
+
+/// Per row j of the PCF boxes whose first texels are (`bx`, `by`) and
+/// lane k in `live`, the 4 texels the box reads (clamped to the map);
+/// 0 elsewhere. Where nothing was drawn under a box, its texels are all
+/// 0: not read (the same values; the reads would mostly miss the cache).
+#[inline(always)]
+fn box_rows<L: Lane>(m: &ShadowMap, (bx, by): (L, L), live: u32) -> [[Vec4; MAX_LANES]; 4] {
+    let n = m.size as i32;
+    let mut rows = [[Vec4::ZERO; MAX_LANES]; 4];
+    for k in (0..L::WIDTH).filter(|k| live & (1 << k) != 0) {
+        let (bx, by) = (bx.lane(k) as i32, by.lane(k) as i32);
         let cols = [0, 1, 2, 3].map(|i| (bx + i).clamp(0, n - 1) as usize);
         let (r0, r3) = (
             by.clamp(0, n - 1) as usize,
@@ -104,54 +140,19 @@ pub(super) fn pcf4(m: &ShadowMap, at: &Kernels4, live: u32) -> Vec4 {
             };
         }
     }
-    // The corners as floats (exact: integers far below 2^24), so column
-    // i of the box is bx + i per lane.
-    let bx = Vec4::from_array(corner.map(|c| c.0 as f32));
-    let by = Vec4::from_array(corner.map(|c| c.1 as f32));
-    let w = |i: Vec4, f: Vec4| {
-        let lo = i.max(f - sp(1.5));
-        let hi = (i + sp(1.0)).min(f + sp(1.5));
-        (hi - lo).max(Vec4::ZERO) / sp(3.0)
-    };
-    let xs = [0.0, 1.0, 2.0, 3.0].map(|i| bx + sp(i));
-    let wx = xs.map(|x| w(x, fx));
-    // The receiver's depth at texel (i, j) is (z + tx[i]) + ty[j].
-    let ztx = xs.map(|x| z + gx * ((x + sp(0.5)) - fx));
-    let mut sum = Vec4::ZERO;
-    for (j, row) in rows.iter().enumerate() {
-        let y = by + sp(j as f32);
-        let ty = gy * ((y + sp(0.5)) - fy);
-        // Lane k of `stored.x_axis` is lane k's texel in column 0.
-        let stored = Mat4::from_cols(row[0], row[1], row[2], row[3]).transpose();
-        let term = |i: usize, s: Vec4| Vec4::select(s.cmple(ztx[i] + ty), wx[i], Vec4::ZERO);
-        let along = (((Vec4::ZERO + term(0, stored.x_axis)) + term(1, stored.y_axis))
-            + term(2, stored.z_axis))
-            + term(3, stored.w_axis);
-        sum += w(y, fy) * along;
-    }
-    sum
+    rows
 }
 
-/// `pcf4` of one lane.
+/// `pcf` of one lane.
 #[cfg(test)]
-pub(super) fn pcf(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
-    let sp = Vec4::splat;
-    let at = Kernels4 {
-        fx: sp(fx),
-        fy: sp(fy),
-        z: sp(z),
-        gx: sp(gx),
-        gy: sp(gy),
+pub(super) fn pcf_one(m: &ShadowMap, fx: f32, fy: f32, z: f32, gx: f32, gy: f32) -> f32 {
+    let at = Kernels {
+        fx,
+        fy,
+        z,
+        gx,
+        gy,
         inside: 1,
     };
-    pcf4(m, &at, 1)[0]
-}
-
-/// `x.floor() as i32` for x in [-2^31, 2^31) (the PCF box's corner, from
-/// texel coordinates inside the map), without a call to libm's `floorf`
-/// (x86-64's base set has no rounding instruction).
-#[inline(always)]
-pub(super) fn floor_i32(x: f32) -> i32 {
-    let t = x as i32;
-    if t as f32 > x { t - 1 } else { t }
+    pcf::<f32>(m, &at, 1)
 }

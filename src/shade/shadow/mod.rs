@@ -24,13 +24,13 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::raytrace::Tracer;
 use crate::scene::ShadowBias;
-use crate::simd::V3;
+use crate::simd::{Lane, Mask, V3};
 
 mod kernel;
 
 #[cfg(test)]
-use kernel::{Kernels4, floor_i32, pcf};
-use kernel::{hard, kernels4, pcf4};
+use kernel::{Kernels, pcf_one};
+use kernel::{hard, kernels, pcf};
 
 /// How a map projects light-view space (looking down -Z) to texels.
 #[derive(Debug, Clone, Copy)]
@@ -248,42 +248,49 @@ impl Shadows<'_> {
         }
     }
 
-    /// Fraction of light `i` reaching the four points `p` (geometric unit
-    /// normals `ng`, facing the viewer; `l` unit towards the light), for
-    /// the lanes k in `lanes` (bit k; the others are 1): 0 in shadow, 1
-    /// lit. A surface facing away from the light is in its own shadow. A
-    /// map's lookups are placed four at a time (`place4`; a point light's
-    /// cube once per face the lanes look into), then filtered: by the PCF
-    /// kernel four at once (`pcf4`), by the hard one lane by lane; rays
-    /// are cast lane by lane. No lane in `lanes`: nothing is looked up.
-    pub fn visibility4(&self, i: usize, p: V3, ng: &[Vec3; 4], l: V3, lanes: u32) -> Vec4 {
-        let mut out = Vec4::ONE;
+    /// Fraction of light `i` reaching the points `p`, one per lane of `L`
+    /// (geometric unit normals `ng`, one per lane, facing the viewer; `l`
+    /// unit towards the light), for the lanes k in `lanes` (bit k; the
+    /// others are 1): 0 in shadow, 1 lit. A surface facing away from the
+    /// light is in its own shadow. A map's lookups are placed for all
+    /// lanes at once (`place`; a point light's cube once per face the
+    /// lanes look into), then filtered: by the PCF kernel all at once
+    /// (`pcf`), by the hard one lane by lane; rays are cast lane by lane.
+    /// No lane in `lanes`: nothing is looked up. Each lane is bit for bit
+    /// its lookup alone, at every width.
+    #[inline(always)]
+    pub fn visibility<L: Lane>(&self, i: usize, p: V3<L>, ng: &[Vec3], l: V3<L>, lanes: u32) -> L {
+        let mut out = L::splat(1.0);
         let Some(s) = self.lights.get(i).filter(|_| lanes != 0) else {
             return out;
         };
-        let n = V3::from_lanes(*ng);
+        let n = V3::<L>::from_fn(|k| ng[k]);
         let cos = n.dot(l);
+        let zero = L::splat(0.0);
         let mut lookup = |m: &ShadowMap, lanes: u32| {
-            let placed = self.place4(m, p, n, cos);
-            let at = kernels4(m, &placed);
+            let placed = self.place(m, p, n, cos);
+            let at = kernels(m, &placed);
             // The lanes that read the map: facing the light, beyond the
             // near plane, inside the map. The others: 0 facing away, else 1.
-            let read = lanes & !cos.cmple(Vec4::ZERO).bitmask() & !placed.before_near & at.inside;
-            for k in (0..4).filter(|k| lanes & !read & (1 << k) != 0) {
-                out[k] = if cos[k] <= 0.0 { 0.0 } else { 1.0 };
-            }
+            let read = lanes & !cos.cmple(zero).bitmask() & !placed.before_near & at.inside;
+            let unread = L::select(cos.cmple(zero), zero, L::splat(1.0));
+            out = L::select(lanes_in::<L>(lanes & !read), unread, out);
             match self.filter {
                 Filter::Pcf if read != 0 => {
-                    let lit = pcf4(m, &at, read);
-                    for k in (0..4).filter(|k| read & (1 << k) != 0) {
-                        out[k] = lit[k];
-                    }
+                    out = L::select(lanes_in::<L>(read), pcf(m, &at, read), out);
                 }
                 Filter::Pcf => {}
                 Filter::Hard => {
-                    for k in (0..4).filter(|k| read & (1 << k) != 0) {
-                        out[k] = hard(m, (at.fx[k], at.fy[k]), at.z[k], (at.gx[k], at.gy[k]));
-                    }
+                    let hard = L::from_fn(|k| {
+                        let (fx, fy) = (at.fx.lane(k), at.fy.lane(k));
+                        let g = (at.gx.lane(k), at.gy.lane(k));
+                        if read & (1 << k) != 0 {
+                            hard(m, (fx, fy), at.z.lane(k), g)
+                        } else {
+                            0.0
+                        }
+                    });
+                    out = L::select(lanes_in::<L>(read), hard, out);
                 }
             }
         };
@@ -291,11 +298,17 @@ impl Shadows<'_> {
             LightShadow::None => {}
             LightShadow::Map(m) => lookup(m, lanes),
             LightShadow::Cube { position, faces } => {
-                let face = [0, 1, 2, 3].map(|k| cube_face(p.lane(k) - *position));
+                let face: [usize; 8] = std::array::from_fn(|k| {
+                    if k < L::WIDTH {
+                        cube_face(p.lane(k) - *position)
+                    } else {
+                        0
+                    }
+                });
                 let mut left = lanes;
                 while left != 0 {
                     let f = face[left.trailing_zeros() as usize];
-                    let same = (0..4)
+                    let same = (0..L::WIDTH)
                         .filter(|&k| left & (1 << k) != 0 && face[k] == f)
                         .fold(0, |m, k| m | 1 << k);
                     lookup(&faces[f], same);
@@ -303,23 +316,28 @@ impl Shadows<'_> {
                 }
             }
             LightShadow::Ray { position, cone } => {
-                for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
-                    out[k] = if *cone > 0.0 && position.is_none() {
+                out = L::from_fn(|k| {
+                    if lanes & (1 << k) == 0 {
+                        1.0
+                    } else if *cone > 0.0 && position.is_none() {
                         self.soft_ray(*cone, p.lane(k), ng[k], l.lane(k))
                     } else {
                         self.ray(position, p.lane(k), ng[k], l.lane(k))
-                    };
-                }
+                    }
+                });
             }
             LightShadow::Disc {
                 center,
                 axis,
                 radius,
             } => {
-                for k in (0..4).filter(|k| lanes & (1 << k) != 0) {
+                out = L::from_fn(|k| {
+                    if lanes & (1 << k) == 0 {
+                        return 1.0;
+                    }
                     let disc = (*center, *axis, *radius);
-                    out[k] = self.soft_ray_to(disc, p.lane(k), ng[k]);
-                }
+                    self.soft_ray_to(disc, p.lane(k), ng[k])
+                });
             }
         }
         out
@@ -340,39 +358,41 @@ impl Shadows<'_> {
     }
 }
 
-/// Four lookups placed in a map (`Shadows::place4`): per lane its texel
+/// Lookups placed in a map (`Shadows::place`), one per lane: its texel
 /// coordinates, the receiver plane's depth there and its slopes per
 /// texel (and their cap's scale), and the lanes nearer than the map's
 /// near plane (bit k: lane k), which it leaves lit.
-struct Placed4 {
+struct Placed<L: Lane> {
     before_near: u32,
-    fx: Vec4,
-    fy: Vec4,
-    z: Vec4,
-    gx: Vec4,
-    gy: Vec4,
-    z_per_texel: Vec4,
+    fx: L,
+    fy: L,
+    z: L,
+    gx: L,
+    gy: L,
+    z_per_texel: L,
 }
 
 impl Shadows<'_> {
-    /// Where four points `p` with geometric normals `n` (`cos` = n.l) fall
+    /// Where the points `p` with geometric normals `n` (`cos` = n.l) fall
     /// in map `m`, biased (the module's notes): the point moved along
     /// its normal, its depth and the plane's slopes in the map's texels.
-    #[inline]
-    fn place4(&self, m: &ShadowMap, p: V3, n: V3, cos: Vec4) -> Placed4 {
+    #[inline(always)]
+    fn place<L: Lane>(&self, m: &ShadowMap, p: V3<L>, n: V3<L>, cos: L) -> Placed<L> {
         let b = &self.bias;
-        let sp = Vec4::splat;
-        let sin = (Vec4::ONE - cos * cos).max(Vec4::ZERO).sqrt();
+        let sp = L::splat;
+        let (zero, one) = (sp(0.0), sp(1.0));
+        // (Lane max and min: NaN takes the second operand, as f32's do.)
+        let sin = (one - cos * cos).max(zero).sqrt();
         let tan = (sin / cos).min(sp(MAX_TAN));
         let size = m.size as f32;
         let v = &m.view_from_world;
-        let q0 = point4(v, p);
+        let q0 = point(v, p);
         // The size of a texel at distance d.
-        let texel = |d: Vec4| match m.projection {
+        let texel = |d: L| match m.projection {
             MapProjection::Ortho(o) => sp((o.x1 - o.x0) / size),
             MapProjection::Perspective { tan_half, .. } => sp(2.0) * d * sp(tan_half) / sp(size),
         };
-        let nv = vector4(v, n);
+        let nv = vector(v, n);
         // Normal offset.
         let q = q0 + nv.scale(sp(b.normal) * sin * texel(-q0.z));
         let d = -q.z;
@@ -386,8 +406,8 @@ impl Shadows<'_> {
                 let z = (sp(o.far) - (d - depth_bias)) * sp(a);
                 // d' = d + (nv.x dx + nv.y dy) / nv.z along the plane.
                 let (tx, ty) = ((o.x1 - o.x0) / size, (o.y1 - o.y0) / size);
-                let inv = Vec4::select(nv.z.abs().cmpgt(sp(1e-12)), Vec4::ONE / nv.z, Vec4::ZERO);
-                Placed4 {
+                let inv = L::select(nv.z.abs().cmpgt(sp(1e-12)), one / nv.z, zero);
+                Placed {
                     before_near: d.cmplt(sp(o.near)).bitmask(),
                     fx,
                     fy,
@@ -405,13 +425,13 @@ impl Shadows<'_> {
                 let nq = nv.dot(q);
                 let k = sp(near * tan_half) / nq * sp(2.0 / size);
                 let usable = nq.abs().cmpgt(sp(1e-20));
-                Placed4 {
+                Placed {
                     before_near: d.cmple(sp(near)).bitmask(),
                     fx: (sx * sp(0.5) + sp(0.5)) * sp(size),
                     fy: (sp(0.5) - sy * sp(0.5)) * sp(size),
                     z: sp(near) / (d - depth_bias).max(sp(near * 1e-3)),
-                    gx: Vec4::select(usable, nv.x * k, Vec4::ZERO),
-                    gy: Vec4::select(usable, -nv.y * k, Vec4::ZERO),
+                    gx: L::select(usable, nv.x * k, zero),
+                    gy: L::select(usable, -nv.y * k, zero),
                     z_per_texel: sp(near) * t / (d * d),
                 }
             }
@@ -419,12 +439,32 @@ impl Shadows<'_> {
     }
 }
 
-/// `m.transform_point3(p)` of four points: per coordinate
-/// ((x p.x + y p.y) + z p.z) + w, as glam sums the columns.
+/// The mask of the lanes in `bits` (bit k: lane k; bits < 2^8): lane k
+/// is set where floor(bits / 2^k) is odd (exact in f32), without taking
+/// the lanes apart.
 #[inline(always)]
-fn point4(m: &Mat4, p: V3) -> V3 {
+fn lanes_in<L: Lane>(bits: u32) -> L::Mask {
+    const STEP: [f32; 8] = [
+        1.0,
+        0.5,
+        0.25,
+        0.125,
+        0.0625,
+        0.031_25,
+        0.015_625,
+        0.007_812_5,
+    ];
+    let t = (L::splat(bits as f32) * L::from_fn(|k| STEP[k])).floor();
+    let half = L::splat(0.5);
+    (t - (t * half).floor() * L::splat(2.0)).cmpgt(half)
+}
+
+/// `m.transform_point3(p)` per lane: per coordinate ((x p.x + y p.y) +
+/// z p.z) + w, as glam sums the columns.
+#[inline(always)]
+fn point<L: Lane>(m: &Mat4, p: V3<L>) -> V3<L> {
     let c = |k: usize| {
-        let col = |v: Vec4| Vec4::splat(v[k]);
+        let col = |v: Vec4| L::splat(v[k]);
         ((col(m.x_axis) * p.x + col(m.y_axis) * p.y) + col(m.z_axis) * p.z) + col(m.w_axis)
     };
     V3 {
@@ -434,11 +474,11 @@ fn point4(m: &Mat4, p: V3) -> V3 {
     }
 }
 
-/// `m.transform_vector3(v)` of four vectors: (x v.x + y v.y) + z v.z.
+/// `m.transform_vector3(v)` per lane: (x v.x + y v.y) + z v.z.
 #[inline(always)]
-fn vector4(m: &Mat4, v: V3) -> V3 {
+fn vector<L: Lane>(m: &Mat4, v: V3<L>) -> V3<L> {
     let c = |k: usize| {
-        let col = |a: Vec4| Vec4::splat(a[k]);
+        let col = |a: Vec4| L::splat(a[k]);
         (col(m.x_axis) * v.x + col(m.y_axis) * v.y) + col(m.z_axis) * v.z
     };
     V3 {
@@ -466,25 +506,7 @@ pub fn cube_face(d: Vec3) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// `floor_i32` is `floor` wherever the PCF box can be: every f32 of
-    /// [-1.5, 16384) near the integers and a sweep between them.
-    #[test]
-    fn floor_without_libm_is_floor() {
-        let mut xs = vec![-1.5f32, -1.0, -0.5, -0.0, 0.0, 1e-30, -1e-30, 16383.99];
-        for i in -2..16384i32 {
-            let f = i as f32;
-            xs.extend([f, f.next_down(), f.next_up(), f + 0.5]);
-        }
-        let mut x = -1.5f32;
-        while x < 4100.0 {
-            xs.push(x);
-            x += 0.013;
-        }
-        for x in xs {
-            assert_eq!(floor_i32(x), x.floor() as i32, "{x}");
-        }
-    }
+    use crate::simd::F8;
 
     /// An 8x8 orthographic map of a light 5 units up, looking down -Y over
     /// [-1, 1] x [-1, 1], distances 0..10, with an occluder at height 1
@@ -515,7 +537,7 @@ mod tests {
 
     /// Light 0's visibility at one point: a lone lane.
     fn one(s: &Shadows, p: Vec3, ng: Vec3, l: Vec3) -> f32 {
-        s.visibility4(0, V3::splat(p), &[ng; 4], V3::splat(l), 1)[0]
+        s.visibility::<f32>(0, V3::from(p), &[ng], V3::from(l), 1)
     }
 
     fn shadows(filter: Filter) -> Shadows<'static> {
@@ -616,7 +638,7 @@ mod tests {
                 (gx, gy)
             };
             let want = pcf_one_by_one(&m, fx, fy, z, gx, gy);
-            let got = pcf(&m, fx, fy, z, gx, gy);
+            let got = pcf_one(&m, fx, fy, z, gx, gy);
             assert_eq!(got.to_bits(), want.to_bits(), "{fx} {fy} {z} {gx} {gy}");
         }
     }
@@ -669,12 +691,12 @@ mod tests {
             let z = 0.25 + 0.05 * (k % 5) as f32;
             points.push((fx, fy, z));
             let (a, b) = (
-                pcf(&marked, fx, fy, z, 0.001, -0.002),
-                pcf(&all, fx, fy, z, 0.001, -0.002),
+                pcf_one(&marked, fx, fy, z, 0.001, -0.002),
+                pcf_one(&all, fx, fy, z, 0.001, -0.002),
             );
             assert_eq!(a.to_bits(), b.to_bits(), "at {fx} {fy}");
             for m in [&unknown, &other] {
-                let c = pcf(m, fx, fy, z, 0.001, -0.002);
+                let c = pcf_one(m, fx, fy, z, 0.001, -0.002);
                 assert_eq!(
                     c.to_bits(),
                     b.to_bits(),
@@ -690,34 +712,49 @@ mod tests {
             "{lit} partial, {} values",
             seen.len()
         );
-        // Four lanes at once, each at another point (lanes in clear
-        // tiles beside lanes that read, some lanes left out): each live
-        // lane is its own lookup. The points are taken out of order so
-        // that a group's lanes lie far apart.
+        // Eight and four lanes at once, each at another point (lanes in
+        // clear tiles beside lanes that read, some lanes left out): each
+        // live lane is its own lookup. The points are taken out of order
+        // so that a group's lanes lie far apart.
         let order: Vec<usize> = (0..points.len()).map(|i| i * 37 % points.len()).collect();
-        for (g, group) in order.chunks_exact(4).enumerate() {
-            let lane = |f: fn(&(f32, f32, f32)) -> f32| {
-                Vec4::from_array([0, 1, 2, 3].map(|k| f(&points[group[k]])))
-            };
-            let at = Kernels4 {
+        for (g, group) in order.chunks_exact(8).enumerate() {
+            let lane = |f: fn(&(f32, f32, f32)) -> f32| F8::from_fn(|k| f(&points[group[k]]));
+            let at = Kernels {
                 fx: lane(|p| p.0),
                 fy: lane(|p| p.1),
                 z: lane(|p| p.2),
-                gx: Vec4::splat(0.001),
-                gy: Vec4::splat(-0.002),
-                inside: 0b1111,
+                gx: F8::splat(0.001),
+                gy: F8::splat(-0.002),
+                inside: 0xff,
             };
-            let live = [0b1111, 0b0101, 0b1000, 0b0110][g % 4];
-            let got = pcf4(&marked, &at, live);
-            for k in (0..4).filter(|k| live & (1 << k) != 0) {
+            let live = [0xff, 0b0101_1010, 0b1000_0001, 0b0110_1111][g % 4];
+            let got = pcf(&marked, &at, live);
+            let quad = |v: F8| v.quad(0);
+            let at4 = Kernels {
+                fx: quad(at.fx),
+                fy: quad(at.fy),
+                z: quad(at.z),
+                gx: quad(at.gx),
+                gy: quad(at.gy),
+                inside: 0xf,
+            };
+            let got4 = pcf(&marked, &at4, live & 0xf);
+            for k in (0..8).filter(|k| live & (1 << k) != 0) {
                 let (fx, fy, z) = points[group[k]];
-                let want = pcf(&marked, fx, fy, z, 0.001, -0.002);
-                assert_eq!(got[k].to_bits(), want.to_bits(), "lane {k} at {fx} {fy}");
+                let want = pcf_one(&marked, fx, fy, z, 0.001, -0.002);
+                assert_eq!(
+                    got.lane(k).to_bits(),
+                    want.to_bits(),
+                    "lane {k} at {fx} {fy}"
+                );
+                if k < 4 {
+                    assert_eq!(got4[k].to_bits(), want.to_bits(), "lane {k} of 4");
+                }
             }
         }
     }
 
-    /// The four lanes' kernels (`kernels4`) cap the slopes as `f32::max`
+    /// The four lanes' kernels (`kernels`) cap the slopes as `f32::max`
     /// and `f32::min` do, lane by lane (a NaN takes the other operand; a
     /// zero's sign aside), and take the lanes inside the map as the
     /// one-lane test does, at NaN, infinite, negative, edge and inside
@@ -758,7 +795,7 @@ mod tests {
                 let lanes = |set: &[f32], s: usize| {
                     Vec4::from_array([0, 1, 2, 3].map(|k| pick(set, k + s)))
                 };
-                let placed = Placed4 {
+                let placed = Placed {
                     before_near: 0,
                     fx: lanes(&coords, 0),
                     fy: lanes(&coords, 5),
@@ -768,7 +805,7 @@ mod tests {
                     z_per_texel: Vec4::splat(zpt),
                 };
                 i += 1;
-                let at = kernels4(&m, &placed);
+                let at: Kernels<Vec4> = kernels(&m, &placed);
                 for k in 0..4 {
                     let cap = zpt * MAX_TAN;
                     let (gx, gy) = (placed.gx[k], placed.gy[k]);
@@ -812,7 +849,7 @@ mod tests {
         m
     }
 
-    /// Each lane of a four-lane lookup is the lookup of that lane alone,
+    /// Each lane of an eight- and a four-lane lookup is the lookup of that lane alone,
     /// bit for bit: in an orthographic map, a perspective map and a
     /// point light's cube whose faces hold different depths (so a lane
     /// read in another lane's face shows); both filters, two biases;
@@ -860,25 +897,43 @@ mod tests {
                 };
                 for _ in 0..3000 {
                     let mut v = |s: f32| (r() * 2.0 - 1.0) * s;
-                    let p = [0, 1, 2, 3].map(|_| Vec3::new(v(1.3), v(6.0), v(1.3)));
-                    let ng = [0, 1, 2, 3].map(|_| {
+                    let p: [Vec3; 8] = std::array::from_fn(|_| Vec3::new(v(1.3), v(6.0), v(1.3)));
+                    let ng: [Vec3; 8] = std::array::from_fn(|_| {
                         let g = Vec3::new(v(1.0), v(1.0) + 0.3, v(1.0));
                         g.try_normalize().unwrap_or(Vec3::Y)
                     });
-                    let l = [0, 1, 2, 3].map(|_| Vec3::new(v(0.3), 1.0, v(0.3)).normalize());
-                    let lanes = (r() * 16.0) as u32 | 1;
-                    let four = s.visibility4(0, V3::from_lanes(p), &ng, V3::from_lanes(l), lanes);
-                    for k in 0..4 {
+                    let l: [Vec3; 8] =
+                        std::array::from_fn(|_| Vec3::new(v(0.3), 1.0, v(0.3)).normalize());
+                    let lanes = (r() * 256.0) as u32 | 1;
+                    let eight = s.visibility(
+                        0,
+                        V3::<F8>::from_fn(|k| p[k]),
+                        &ng,
+                        V3::<F8>::from_fn(|k| l[k]),
+                        lanes,
+                    );
+                    let four = s.visibility(
+                        0,
+                        V3::<Vec4>::from_fn(|k| p[k]),
+                        &ng,
+                        V3::<Vec4>::from_fn(|k| l[k]),
+                        lanes & 0xf,
+                    );
+                    for k in 0..8 {
                         let want = if lanes & (1 << k) != 0 {
                             one(&s, p[k], ng[k], l[k])
                         } else {
                             1.0
                         };
+                        let got = eight.lane(k);
                         assert_eq!(
-                            four[k].to_bits(),
+                            got.to_bits(),
                             want.to_bits(),
                             "lane {k}: {p:?} {ng:?} {l:?}"
                         );
+                        if k < 4 {
+                            assert_eq!(four[k].to_bits(), want.to_bits(), "lane {k} of four");
+                        }
                         shaded += (want == 0.0) as usize;
                         partial += (want > 0.0 && want < 1.0) as usize;
                     }
@@ -888,9 +943,18 @@ mod tests {
         // Shadowed and partly shadowed lanes, so the comparison means
         // something.
         assert!(
-            shaded > 3000 && partial > 1500,
+            shaded > 6000 && partial > 3000,
             "{shaded} shadowed, {partial} partial"
         );
+    }
+
+    #[test]
+    fn lane_masks_hold_their_bits() {
+        for bits in 0..256u32 {
+            assert_eq!(lanes_in::<F8>(bits).bitmask(), bits);
+            assert_eq!(lanes_in::<Vec4>(bits).bitmask(), bits & 0xf);
+            assert_eq!(lanes_in::<f32>(bits).bitmask(), bits & 1);
+        }
     }
 
     #[test]
