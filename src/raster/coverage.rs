@@ -6,7 +6,7 @@
 
 use std::cell::RefCell;
 
-use glam::Vec4;
+use glam::{BVec4A, Vec4};
 
 use super::bin::TileRect;
 use super::setup::{Edge, SUBPIXEL, Tri};
@@ -425,12 +425,17 @@ fn test_groups<const REVERSE_Z: bool, const G: usize>(
             z.cmplt(old)
         };
         let pass = (z.cmpge(Vec4::ZERO) & z.cmple(Vec4::ONE) & front).bitmask() & mask;
-        for s in 0..4 {
-            if pass & (1 << s) != 0 {
-                depth[base + s] = z[s];
-                ids[base + s] = id;
-            }
+        if pass == 0 {
+            return;
         }
+        // The four samples written at once: a blend of bits (no float
+        // arithmetic; the ids pass through as bit patterns).
+        let m = BVec4A::new(pass & 1 != 0, pass & 2 != 0, pass & 4 != 0, pass & 8 != 0);
+        Vec4::select(m, z, old).write_to_slice(&mut depth[base..base + 4]);
+        let slot = &mut ids[base..base + 4];
+        let old_ids = Vec4::from_array([slot[0], slot[1], slot[2], slot[3]].map(f32::from_bits));
+        let new = Vec4::select(m, Vec4::splat(f32::from_bits(id)), old_ids);
+        slot.copy_from_slice(&new.to_array().map(f32::to_bits));
     });
 }
 
