@@ -347,10 +347,11 @@ pub fn raster_triangle<F: FnMut(i32, i32, f32)>(t: &Tri, rect: TileRect, mut vis
 pub fn raster_depth_max(t: &Tri, rect: TileRect, d: &mut [f32], stride: usize) {
     let e = t.edges();
     let plane = DepthPlane::new(t, &e);
+    // Written either way, a select and not a branch: the processor
+    // mispredicts a branch along every overlap.
     let keep = |d: &mut f32, z: f32| {
-        if z <= 1.0 && z > *d {
-            *d = z;
-        }
+        let m = 0u32.wrapping_sub((z <= 1.0 && z > *d) as u32);
+        *d = f32::from_bits(z.to_bits() & m | d.to_bits() & !m);
     };
     let at = |px: i32, py: i32| (py - rect.y0) as usize * stride + (px - rect.x0) as usize;
     if t.max_x.min(rect.x1 - 1) - t.min_x.max(rect.x0) < SPAN_WIDTH {
