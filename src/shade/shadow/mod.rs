@@ -381,7 +381,8 @@ impl Shadows<'_> {
         let b = &self.bias;
         let sp = L::splat;
         let (zero, one) = (sp(0.0), sp(1.0));
-        // (Lane max and min: NaN takes the second operand, as f32's do.)
+        // (Lane max and min: a NaN first operand takes the second, at
+        // every width; no second operand here is NaN.)
         let sin = (one - cos * cos).max(zero).sqrt();
         let tan = (sin / cos).min(sp(MAX_TAN));
         let size = m.size as f32;
