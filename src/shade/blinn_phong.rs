@@ -39,14 +39,6 @@ pub struct SurfaceColor<L: Lane = f32> {
     pub illum: u8,
 }
 
-/// The specular exponent of a lane call: one for every lane, or one per
-/// lane (an Ns map).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Exponent<L: Lane> {
-    One(f32),
-    PerLane(L),
-}
-
 /// `factor` times texels, where there are any.
 #[inline(always)]
 fn times<L: Lane>(factor: Vec3, texel: Option<V3<L>>) -> V3<L> {
@@ -119,12 +111,7 @@ impl ShadeContext<'_> {
                     Some(map) => fetch.normal(map),
                     None => f.normal,
                 };
-                // One exponent for every lane unless an Ns map varies it.
-                let ns = match m.map_ns {
-                    None => Exponent::One(m.ns),
-                    Some(_) => Exponent::PerLane(c.ns),
-                };
-                (n, self.light_sums(f, [n, v], ns, specular))
+                (n, self.light_sums(f, [n, v], c.ns, specular))
             }
         };
         let ambient = V3::splat(self.ambient).scale(f.ao);
@@ -144,7 +131,7 @@ impl ShadeContext<'_> {
         &self,
         f: &Lanes<L>,
         [n, v]: [V3<L>; 2],
-        ns: Exponent<L>,
+        ns: L,
         specular: bool,
     ) -> (V3<L>, V3<L>) {
         let zero = L::splat(0.0);
@@ -170,10 +157,7 @@ impl ShadeContext<'_> {
                 if shine.any() {
                     // Lanes that do not shine give what they give (x = 0:
                     // 2^-126 raised), left out by the select.
-                    let pw = match ns {
-                        Exponent::One(ns) => crate::powers::pow(ndh, L::splat(ns)),
-                        Exponent::PerLane(ns) => crate::powers::pow(ndh, ns),
-                    };
+                    let pw = crate::powers::pow(ndh, ns);
                     spec = spec + V3::select(shine, e.scale(pw), V3::zero());
                 }
             }
@@ -269,12 +253,8 @@ fn disc<L: Lane>(light: &Light, p: V3<L>) -> Option<L> {
 /// distribution: D(r.h) / 4 is its density at l; alpha^2 = 2 / (Ns + 2),
 /// widened by the disc as `PbrColor::widened` does).
 #[inline(always)]
-fn image_light<L: Lane>([n, v, l]: [V3<L>; 3], e: V3<L>, ns: Exponent<L>, w2: L) -> (V3<L>, V3<L>) {
+fn image_light<L: Lane>([n, v, l]: [V3<L>; 3], e: V3<L>, ns: L, w2: L) -> (V3<L>, V3<L>) {
     let one = L::splat(1.0);
-    let ns = match ns {
-        Exponent::One(ns) => L::splat(ns),
-        Exponent::PerLane(ns) => ns,
-    };
     let a2 = (L::splat(2.0) / (ns.max(L::splat(0.0)) + L::splat(2.0)) + w2).min(one);
     let r = n.scale(L::splat(2.0) * n.dot(v)) - v;
     let h = (l + r).normalize_or(V3::zero());

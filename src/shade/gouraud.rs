@@ -7,7 +7,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::ShadeContext;
-use super::blinn_phong::Exponent;
 use super::lanes::{Lanes, MAX_LANES};
 use super::light::LightMask;
 use crate::scene::Model;
@@ -53,7 +52,7 @@ pub fn vertex_light(
                 lights: LightMask::ALL,
                 vertex_light: None,
             };
-            let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), Exponent::One(ns[i]), spec[i]);
+            let (d, s) = ctx.light_sums(&f, [nn, v].map(V3::from), ns[i], spec[i]);
             (d.into(), s.into())
         })
         .collect()
